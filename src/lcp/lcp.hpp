@@ -1,0 +1,102 @@
+// The LCP layer: w = M z + q, 0 <= z ⟂ w >= 0 (thesis eq. (3.11)-(3.12)).
+//
+// Public face of src/lcp. Eigen only. Every solver returns a Result value and
+// never throws: the status says what happened, the diagnostics say how well.
+#pragma once
+
+#include <Eigen/Dense>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace lcsim::lcp {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+enum class Status {
+  kSolved,            // a complementary solution within tolerance
+  kRayTermination,    // Lemke: secondary ray, no solution found (e.g. infeasible LCP)
+  kIterationLimit,    // iterative solver or pivot cap hit before convergence
+  kNumericalFailure,  // singular pivot, non-finite values, or residual check failed
+  kInvalidInput,      // dimensions disagree, empty or non-finite data
+};
+std::string_view to_string(Status s);
+
+struct Result {
+  Status status = Status::kInvalidInput;
+  VectorXd z;              // the solution (size k); empty only on kInvalidInput
+  VectorXd w;              // M z + q
+  int pivots = 0;          // pivoting solvers: number of pivots
+  int iterations = 0;      // iterative solvers: sweeps
+  double residual = 0.0;   // natural residual ||min(z, w)||_inf
+  double min_z = 0.0;      // most negative entry of z (0 if none negative)
+  double min_w = 0.0;      // most negative entry of w (0 if none negative)
+  std::string message;     // human-readable detail ("" when solved cleanly)
+  bool ok() const { return status == Status::kSolved; }
+};
+
+// Diagnostics of a candidate z: fills w, residual, min_z, min_w.
+Result evaluate(const MatrixXd& M, const VectorXd& q, const VectorXd& z);
+// ||min(z, w)||_inf with w = M z + q.
+double natural_residual(const MatrixXd& M, const VectorXd& q, const VectorXd& z);
+// Empty string if (M, q) is a well-formed LCP, else what is wrong.
+std::string validate(const MatrixXd& M, const VectorXd& q);
+
+struct Options {
+  // Accept a solution when residual <= tolerance * (1 + ||q||_inf).
+  double tolerance = 1e-12;
+  // Pivoting solvers: cap on pivots (0 = default, 50 * k + 1000 for Lemke).
+  int max_pivots = 0;
+  // Iterative solvers.
+  int max_iterations = 10000;
+  double relaxation = 1.0;  // SOR parameter omega in (0, 2); 1 is Gauss–Seidel
+  const VectorXd* warm_start = nullptr;  // initial z (projected onto z >= 0)
+};
+
+// Lemke's complementary pivoting with covering vector e = (1,...,1) and
+// lexicographic degeneracy resolution (no cycling on degenerate q or ties).
+// Returns kRayTermination on a secondary ray.
+Result solve_lemke(const MatrixXd& M, const VectorXd& q, const Options& opt = {});
+
+// Principal pivoting (Murty's least-index method) for P-matrices, nonsymmetric
+// included. On a non-P matrix it may fail: it then reports kNumericalFailure
+// or kIterationLimit, never a wrong "solved".
+Result solve_principal_pivoting(const MatrixXd& M, const VectorXd& q, const Options& opt = {});
+
+// Projected Gauss–Seidel / SOR with relaxation, tolerance, iteration cap and
+// warm start. Converges for symmetric positive (semi)definite M with positive
+// diagonal; elsewhere it reports kIterationLimit.
+Result solve_pgs(const MatrixXd& M, const VectorXd& q, const Options& opt = {});
+
+// Enumeration of all 2^k complementary bases (k <= 16): the test oracle.
+struct EnumerationResult {
+  Status status = Status::kInvalidInput;
+  std::vector<VectorXd> solutions;  // every distinct solution z found
+  std::string message;
+};
+EnumerationResult enumerate_solutions(const MatrixXd& M, const VectorXd& q,
+                                      const Options& opt = {});
+// The first solution of the enumeration as a Result (kNumericalFailure if none).
+Result solve_enumeration(const MatrixXd& M, const VectorXd& q, const Options& opt = {});
+
+// Matrix classes. Tolerances are relative to the matrix scale.
+bool is_p_matrix(const MatrixXd& M, double rel_tol = 1e-12);  // all principal minors > 0 (k <= 20)
+bool is_positive_definite(const MatrixXd& M, double rel_tol = 1e-12);      // x'Mx > 0, M not nec. symmetric
+bool is_positive_semidefinite(const MatrixXd& M, double rel_tol = 1e-12);  // x'Mx >= 0
+bool is_symmetric(const MatrixXd& M, double rel_tol = 1e-12);
+
+// Strategy interface: solvers chosen by name ("lemke", "pivot", "pgs", "enum",
+// and later back-ends registered by other layers, e.g. Bullet's).
+class Solver {
+ public:
+  virtual ~Solver() = default;
+  virtual std::string name() const = 0;
+  virtual Result solve(const MatrixXd& M, const VectorXd& q, const Options& opt) const = 0;
+};
+// Throws std::invalid_argument naming the unknown solver and the known names.
+std::unique_ptr<Solver> make_solver(std::string_view name);
+std::vector<std::string> solver_names();
+
+}  // namespace lcsim::lcp

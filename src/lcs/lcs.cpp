@@ -1,0 +1,88 @@
+// Markov parameters (3.32) and leading row/column indices and coefficient
+// matrices (3.39).
+#include "lcs/lcs.hpp"
+
+#include <Eigen/SVD>
+#include <algorithm>
+
+namespace lcsim::lcs {
+
+double rank_tolerance(const MatrixXd& X) {
+  if (X.size() == 0) return 0.0;
+  const double scale = Eigen::JacobiSVD<MatrixXd>(X).singularValues()(0);
+  const double dim = static_cast<double>(std::max(X.rows(), X.cols()));
+  return dim * 1e-12 * (scale > 0.0 ? scale : 1.0);
+}
+
+std::vector<MatrixXd> markov_parameters(const Lcs& sys, int count) {
+  std::vector<MatrixXd> H;
+  H.reserve(std::max(count, 0));
+  if (count <= 0) return H;
+  H.push_back(sys.D);
+  MatrixXd AiB = sys.B;  // A^{i-1} B
+  for (int i = 1; i < count; ++i) {
+    H.push_back(sys.C * AiB);
+    AiB = sys.A * AiB;
+  }
+  return H;
+}
+
+namespace {
+
+// A row or column of H^i counts as nonzero when its largest entry exceeds a
+// tolerance relative to the scale of the whole Markov sequence at that order,
+// so that rounding in C A^{i-1} B is not mistaken for structure.
+double markov_zero_tol(const std::vector<MatrixXd>& H, const Lcs& sys, int i) {
+  double scale = H[i].cwiseAbs().maxCoeff();
+  if (i > 0) {
+    // ||C|| ||A||^{i-1} ||B|| bounds the size of the terms summed.
+    const double a = std::max(sys.A.cwiseAbs().rowwise().sum().maxCoeff(), 1e-300);
+    const double c = sys.C.cwiseAbs().rowwise().sum().maxCoeff();
+    const double b = sys.B.cwiseAbs().colwise().sum().maxCoeff();
+    scale = std::max(scale, c * std::pow(a, i - 1) * b);
+  }
+  return 1e-12 * scale;
+}
+
+std::vector<int> leading_indices(const Lcs& sys, bool rows) {
+  const int n = sys.n();
+  const int k = sys.k();
+  const auto H = markov_parameters(sys, n + 1);
+  std::vector<int> idx(k, kInfiniteIndex);
+  for (int j = 0; j < k; ++j) {
+    for (int i = 0; i <= n; ++i) {
+      if (H[i].size() == 0) continue;
+      const double v = rows ? H[i].row(j).cwiseAbs().maxCoeff() : H[i].col(j).cwiseAbs().maxCoeff();
+      if (v > markov_zero_tol(H, sys, i)) {
+        idx[j] = i;
+        break;
+      }
+    }
+  }
+  return idx;
+}
+
+}  // namespace
+
+std::vector<int> leading_row_indices(const Lcs& sys) { return leading_indices(sys, true); }
+std::vector<int> leading_column_indices(const Lcs& sys) { return leading_indices(sys, false); }
+
+MatrixXd leading_row_coefficients(const Lcs& sys) {
+  const auto rho = leading_row_indices(sys);
+  const auto H = markov_parameters(sys, sys.n() + 1);
+  MatrixXd M = MatrixXd::Zero(sys.k(), sys.k());
+  for (int i = 0; i < sys.k(); ++i)
+    if (rho[i] != kInfiniteIndex) M.row(i) = H[rho[i]].row(i);
+  return M;
+}
+
+MatrixXd leading_column_coefficients(const Lcs& sys) {
+  const auto eta = leading_column_indices(sys);
+  const auto H = markov_parameters(sys, sys.n() + 1);
+  MatrixXd N = MatrixXd::Zero(sys.k(), sys.k());
+  for (int j = 0; j < sys.k(); ++j)
+    if (eta[j] != kInfiniteIndex) N.col(j) = H[eta[j]].col(j);
+  return N;
+}
+
+}  // namespace lcsim::lcs

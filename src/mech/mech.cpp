@@ -1,0 +1,83 @@
+#include "mech/mech.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace lcsim::mech {
+
+void fill_defaults(MechanicalModel& m) {
+  const int n = m.dofs();
+  const int k = m.num_constraints();
+  if (m.D.size() == 0) m.D = MatrixXd::Zero(n, n);
+  if (m.K.size() == 0) m.K = MatrixXd::Zero(n, n);
+  if (m.E.size() == 0) m.E = MatrixXd::Zero(0, n);
+  if (m.g.size() == 0) m.g = VectorXd::Zero(k);
+  if (m.f.size() == 0) m.f = VectorXd::Zero(n);
+  if (m.restitution.size() == 0) m.restitution = VectorXd::Zero(k);
+  if (m.coordinates.empty())
+    for (int i = 0; i < n; ++i) m.coordinates.push_back("q" + std::to_string(i + 1));
+  if (m.constraints.empty())
+    for (int i = 0; i < k; ++i) m.constraints.push_back("c" + std::to_string(i + 1));
+}
+
+lcs::Lcs to_lcs(const MechanicalModel& m) {
+  const int n = m.dofs();
+  const int k = m.num_constraints();
+  const Eigen::LLT<MatrixXd> llt(m.M);
+  lcs::Lcs s;
+  s.A = MatrixXd::Zero(2 * n + 1, 2 * n + 1);
+  s.A.block(0, n, n, n) = MatrixXd::Identity(n, n);
+  s.A.block(n, 0, n, n) = -llt.solve(m.K);
+  s.A.block(n, n, n, n) = -llt.solve(m.D);
+  s.A.block(n, 2 * n, n, 1) = llt.solve(m.f);
+  s.B = MatrixXd::Zero(2 * n + 1, k);
+  s.B.block(n, 0, n, k) = llt.solve(m.E.transpose());
+  s.C = MatrixXd::Zero(k, 2 * n + 1);
+  s.C.block(0, 0, k, n) = m.E;
+  s.C.col(2 * n) = m.g;
+  s.D = MatrixXd::Zero(k, k);
+  return s;
+}
+
+double kinetic_energy(const MechanicalModel& m, const VectorXd& v) {
+  return 0.5 * v.dot(m.M * v);
+}
+
+double potential_energy(const MechanicalModel& m, const VectorXd& q) {
+  return 0.5 * q.dot(m.K * q) - m.f.dot(q);
+}
+
+double total_energy(const MechanicalModel& m, const VectorXd& q, const VectorXd& v) {
+  return kinetic_energy(m, v) + potential_energy(m, q);
+}
+
+VectorXd gaps(const MechanicalModel& m, const VectorXd& q) { return m.E * q + m.g; }
+
+double worst_violation(const MechanicalModel& m, const VectorXd& q) {
+  if (m.num_constraints() == 0) return 0.0;
+  return std::min(0.0, gaps(m, q).minCoeff());
+}
+
+MatrixXd delassus(const MechanicalModel& m) {
+  return m.E * Eigen::LLT<MatrixXd>(m.M).solve(m.E.transpose());
+}
+
+int Model::state_size() const {
+  if (mechanical) return 2 * mechanical->dofs();
+  if (lcs) return lcs->n();
+  return 0;
+}
+
+int Model::num_constraints() const {
+  if (mechanical) return mechanical->num_constraints();
+  if (lcs) return lcs->k();
+  return 0;
+}
+
+lcs::Lcs Model::as_lcs() const {
+  if (mechanical) return to_lcs(*mechanical);
+  if (lcs) return *lcs;
+  throw std::logic_error("Model::as_lcs: empty model");
+}
+
+}  // namespace lcsim::mech

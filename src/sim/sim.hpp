@@ -1,0 +1,95 @@
+// The simulation layer: integrators behind one interface, each producing the
+// same Trajectory (samples + events) for a Model.
+//
+// Public face of src/sim. Nothing throws inside the integration loop: trouble
+// ends the run with a status and a message, and warnings are counted.
+#pragma once
+
+#include <Eigen/Dense>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "impact/impact.hpp"
+#include "mech/mech.hpp"
+
+namespace lcsim::sim {
+
+using Eigen::VectorXd;
+using IndexSet = std::vector<int>;
+
+enum class EventType { kImpact, kRelease, kContact, kAccumulation, kStart };
+std::string_view to_string(EventType t);
+
+struct Sample {
+  double t = 0.0;
+  VectorXd x;  // state: q then v for mechanical models
+  VectorXd u;  // multipliers (regular part)
+  VectorXd y;  // gaps / outputs
+  IndexSet mode;
+};
+
+struct Event {
+  double t = 0.0;
+  EventType type = EventType::kContact;
+  VectorXd state_before, state_after;
+  IndexSet mode_after;
+  VectorXd impulse;  // u^0 (size k); zero when no jump
+};
+
+enum class RunStatus { kCompleted, kFailed };
+
+struct Trajectory {
+  std::string method;
+  RunStatus status = RunStatus::kCompleted;
+  std::string message;  // why it failed, or "" when completed
+  double t_end = 0.0;
+  std::vector<Sample> samples;  // at a jump two samples share t (before, after)
+  std::vector<Event> events;
+  VectorXd final_state;
+  double energy_initial = 0.0, energy_final = 0.0;  // mechanical models only
+  double max_violation = 0.0;  // most negative gap over the run (0 if none)
+  long lcp_solves = 0;
+  long steps = 0;              // time-stepping steps, or continuous phases
+  int warnings = 0;
+  std::vector<std::string> warning_messages;  // first few, for the report
+  double wall_time_s = 0.0;
+};
+
+struct Options {
+  double t_end = 1.0;   // horizon (s)
+  double dt_out = 0.0;  // output grid (s); 0 = events only (plus start and end)
+  double h = 1e-3;      // time step of time-stepping methods (s)
+  double theta = 0.5;   // Moreau–Jean theta
+  std::string impact = "moreau";  // impact law name (src/impact)
+  std::string lcp_solver = "pivot";
+  // Event-driven: root accuracy in time (s) and the cap on events per unit
+  // time that ends a run that would loop forever (Zeno without limit).
+  double event_time_tol = 1e-13;
+  double max_events_per_unit_time = 1e6;
+  long max_events = 1000000;
+  // Accumulation (right-Zeno, Remark 3.4.11): when the gap between impacts
+  // falls below this, the limit state is taken and the run continues.
+  double accumulation_dt = 1e-10;
+  bool record_samples = true;
+};
+
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+  virtual std::string name() const = 0;
+  virtual Trajectory run(const mech::Model& model, const VectorXd& x0,
+                         const Options& opt) const = 0;
+};
+// Throws std::invalid_argument naming the unknown method and the known ones.
+std::unique_ptr<Integrator> make_integrator(std::string_view name);
+std::vector<std::string> integrator_names();
+
+// Event-driven integration (Algorithm 3.7.1): exact matrix-exponential phases,
+// events as roots of Bohl functions, re-initialisation by the impact law
+// (mechanical models) or by the LDCP and P_I (general LCS).
+Trajectory simulate_event_driven(const mech::Model& model, const VectorXd& x0,
+                                 const Options& opt);
+
+}  // namespace lcsim::sim
