@@ -26,14 +26,14 @@ std::string_view to_string(Status s);
 
 struct Result {
   Status status = Status::kInvalidInput;
-  VectorXd z;              // the solution (size k); empty only on kInvalidInput
-  VectorXd w;              // M z + q
-  int pivots = 0;          // pivoting solvers: number of pivots
-  int iterations = 0;      // iterative solvers: sweeps
-  double residual = 0.0;   // natural residual ||min(z, w)||_inf
-  double min_z = 0.0;      // most negative entry of z (0 if none negative)
-  double min_w = 0.0;      // most negative entry of w (0 if none negative)
-  std::string message;     // human-readable detail ("" when solved cleanly)
+  VectorXd z;             // the solution (size k); empty only on kInvalidInput
+  VectorXd w;             // M z + q
+  int pivots = 0;         // pivoting solvers: number of pivots
+  int iterations = 0;     // iterative solvers: sweeps
+  double residual = 0.0;  // natural residual ||min(z, w)||_inf
+  double min_z = 0.0;     // most negative entry of z (0 if none negative)
+  double min_w = 0.0;     // most negative entry of w (0 if none negative)
+  std::string message;    // human-readable detail ("" when solved cleanly)
   bool ok() const { return status == Status::kSolved; }
 };
 
@@ -51,7 +51,7 @@ struct Options {
   int max_pivots = 0;
   // Iterative solvers.
   int max_iterations = 10000;
-  double relaxation = 1.0;  // SOR parameter omega in (0, 2); 1 is Gauss–Seidel
+  double relaxation = 1.0;               // SOR parameter omega in (0, 2); 1 is Gauss–Seidel
   const VectorXd* warm_start = nullptr;  // initial z (projected onto z >= 0)
 };
 
@@ -60,10 +60,15 @@ struct Options {
 // Returns kRayTermination on a secondary ray.
 Result solve_lemke(const MatrixXd& M, const VectorXd& q, const Options& opt = {});
 
-// Principal pivoting (Murty's least-index method) for P-matrices, nonsymmetric
-// included. On a non-P matrix it may fail: it then reports kNumericalFailure
-// or kIterationLimit, never a wrong "solved".
+// Principal pivoting for P-matrices, nonsymmetric included: block principal
+// pivoting (Júdice–Pires) that falls back to Murty's least-index rule when the
+// number of infeasibilities stalls. pivots counts index flips, iterations the
+// principal subsystems solved. On a non-P matrix it may fail: it then reports
+// kNumericalFailure or kIterationLimit, never a wrong "solved".
 Result solve_principal_pivoting(const MatrixXd& M, const VectorXd& q, const Options& opt = {});
+// Murty's least-index principal pivoting alone (one flip per pivot): finite on
+// every P-matrix, 2^k - 1 pivots in the worst case. Mainly for tests.
+Result solve_murty(const MatrixXd& M, const VectorXd& q, const Options& opt = {});
 
 // Projected Gauss–Seidel / SOR with relaxation, tolerance, iteration cap and
 // warm start. Converges for symmetric positive (semi)definite M with positive
@@ -83,7 +88,8 @@ Result solve_enumeration(const MatrixXd& M, const VectorXd& q, const Options& op
 
 // Matrix classes. Tolerances are relative to the matrix scale.
 bool is_p_matrix(const MatrixXd& M, double rel_tol = 1e-12);  // all principal minors > 0 (k <= 20)
-bool is_positive_definite(const MatrixXd& M, double rel_tol = 1e-12);      // x'Mx > 0, M not nec. symmetric
+bool is_positive_definite(const MatrixXd& M,
+                          double rel_tol = 1e-12);  // x'Mx > 0, M not nec. symmetric
 bool is_positive_semidefinite(const MatrixXd& M, double rel_tol = 1e-12);  // x'Mx >= 0
 bool is_symmetric(const MatrixXd& M, double rel_tol = 1e-12);
 

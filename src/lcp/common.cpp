@@ -1,0 +1,193 @@
+// Diagnostics, validation and the solver registry of the LCP layer.
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "lcp/detail.hpp"
+#include "lcp/lcp.hpp"
+
+namespace lcsim::lcp {
+
+std::string_view to_string(Status s) {
+  switch (s) {
+    case Status::kSolved:
+      return "solved";
+    case Status::kRayTermination:
+      return "ray termination";
+    case Status::kIterationLimit:
+      return "iteration limit";
+    case Status::kNumericalFailure:
+      return "numerical failure";
+    case Status::kInvalidInput:
+      return "invalid input";
+  }
+  return "unknown";
+}
+
+std::string validate(const MatrixXd& M, const VectorXd& q) {
+  std::ostringstream os;
+  if (M.rows() == 0 || M.cols() == 0)
+    return "empty LCP: M is " + std::to_string(M.rows()) + "x" + std::to_string(M.cols());
+  if (M.rows() != M.cols()) {
+    os << "M must be square, got " << M.rows() << "x" << M.cols();
+    return os.str();
+  }
+  if (q.size() != M.rows()) {
+    os << "q has size " << q.size() << " but M is " << M.rows() << "x" << M.cols();
+    return os.str();
+  }
+  for (Eigen::Index j = 0; j < M.cols(); ++j)
+    for (Eigen::Index i = 0; i < M.rows(); ++i)
+      if (!std::isfinite(M(i, j))) {
+        os << "M(" << i << "," << j << ") = " << M(i, j) << " is not finite";
+        return os.str();
+      }
+  for (Eigen::Index i = 0; i < q.size(); ++i)
+    if (!std::isfinite(q(i))) {
+      os << "q(" << i << ") = " << q(i) << " is not finite";
+      return os.str();
+    }
+  return "";
+}
+
+double natural_residual(const MatrixXd& M, const VectorXd& q, const VectorXd& z) {
+  if (z.size() != q.size() || M.rows() != q.size() || M.cols() != z.size())
+    return std::numeric_limits<double>::infinity();
+  if (z.size() == 0) return 0.0;
+  const VectorXd w = M * z + q;
+  return z.cwiseMin(w).cwiseAbs().maxCoeff();
+}
+
+Result evaluate(const MatrixXd& M, const VectorXd& q, const VectorXd& z) {
+  const std::string bad = validate(M, q);
+  if (!bad.empty()) return detail::invalid(bad);
+  if (z.size() != q.size())
+    return detail::invalid("z has size " + std::to_string(z.size()) + ", expected " +
+                           std::to_string(q.size()));
+  // Status kSolved iff z passes the default acceptance test (Options{}.tolerance).
+  return detail::finish(M, q, z, Status::kSolved, Options{}, "");
+}
+
+namespace detail {
+
+double acceptance(const VectorXd& q, const Options& opt) {
+  const double qn = q.size() ? q.cwiseAbs().maxCoeff() : 0.0;
+  return opt.tolerance * (1.0 + qn);
+}
+
+std::string validate_all(const MatrixXd& M, const VectorXd& q, const Options& opt) {
+  std::string bad = validate(M, q);
+  if (!bad.empty()) return bad;
+  std::ostringstream os;
+  if (!(opt.tolerance >= 0.0) || !std::isfinite(opt.tolerance)) {
+    os << "tolerance must be finite and >= 0, got " << opt.tolerance;
+    return os.str();
+  }
+  if (opt.max_pivots < 0) {
+    os << "max_pivots must be >= 0, got " << opt.max_pivots;
+    return os.str();
+  }
+  if (opt.max_iterations < 0) {
+    os << "max_iterations must be >= 0, got " << opt.max_iterations;
+    return os.str();
+  }
+  if (!(opt.relaxation > 0.0 && opt.relaxation < 2.0)) {
+    os << "relaxation must be in (0, 2), got " << opt.relaxation;
+    return os.str();
+  }
+  if (opt.warm_start) {
+    if (opt.warm_start->size() != q.size()) {
+      os << "warm start has size " << opt.warm_start->size() << ", expected " << q.size();
+      return os.str();
+    }
+    if (!opt.warm_start->allFinite()) return "warm start is not finite";
+  }
+  return "";
+}
+
+Result invalid(std::string message) {
+  Result r;
+  r.status = Status::kInvalidInput;
+  r.message = std::move(message);
+  return r;
+}
+
+Result finish(const MatrixXd& M, const VectorXd& q, VectorXd z, Status claimed, const Options& opt,
+              std::string message) {
+  Result r;
+  r.z = std::move(z);
+  r.w = M * r.z + q;
+  r.residual = r.z.cwiseMin(r.w).cwiseAbs().maxCoeff();
+  r.min_z = std::min(0.0, r.z.minCoeff());
+  r.min_w = std::min(0.0, r.w.minCoeff());
+  r.status = claimed;
+  r.message = std::move(message);
+  const bool finite = r.z.allFinite() && r.w.allFinite();
+  if (!finite) {
+    r.status = Status::kNumericalFailure;
+    r.message = "non-finite values in the solution" + (r.message.empty() ? "" : ": " + r.message);
+    return r;
+  }
+  if (claimed == Status::kSolved) {
+    const double acc = acceptance(q, opt);
+    if (!(r.residual <= acc && r.min_z >= -acc && r.min_w >= -acc)) {
+      std::ostringstream os;
+      os << "residual check failed: residual " << r.residual << ", min z " << r.min_z << ", min w "
+         << r.min_w << " against tolerance " << acc;
+      r.status = Status::kNumericalFailure;
+      r.message = os.str();
+    }
+  }
+  return r;
+}
+
+}  // namespace detail
+
+namespace {
+
+using SolveFn = Result (*)(const MatrixXd&, const VectorXd&, const Options&);
+
+class FnSolver final : public Solver {
+ public:
+  FnSolver(std::string name, SolveFn fn) : name_(std::move(name)), fn_(fn) {}
+  std::string name() const override { return name_; }
+  Result solve(const MatrixXd& M, const VectorXd& q, const Options& opt) const override {
+    return fn_(M, q, opt);
+  }
+
+ private:
+  std::string name_;
+  SolveFn fn_;
+};
+
+struct Entry {
+  const char* name;
+  SolveFn fn;
+};
+constexpr Entry kSolvers[] = {
+    {"lemke", &solve_lemke},
+    {"pivot", &solve_principal_pivoting},
+    {"pgs", &solve_pgs},
+    {"enum", &solve_enumeration},
+};
+
+}  // namespace
+
+std::vector<std::string> solver_names() {
+  std::vector<std::string> names;
+  for (const auto& e : kSolvers) names.emplace_back(e.name);
+  return names;
+}
+
+std::unique_ptr<Solver> make_solver(std::string_view name) {
+  for (const auto& e : kSolvers)
+    if (name == e.name) return std::make_unique<FnSolver>(e.name, e.fn);
+  std::string known;
+  for (const auto& e : kSolvers) known += std::string(known.empty() ? "" : ", ") + e.name;
+  throw std::invalid_argument("unknown LCP solver '" + std::string(name) +
+                              "'; known solvers: " + known);
+}
+
+}  // namespace lcsim::lcp

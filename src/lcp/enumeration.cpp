@@ -1,0 +1,84 @@
+// Enumeration of all 2^k complementary bases (k <= 16): the test oracle.
+// For each index set a, solve M_aa z_a = -q_a (skipping singular M_aa) and
+// keep z when z_a >= 0 and w = M z + q >= 0 within the acceptance tolerance.
+// Only solutions at nonsingular complementary bases are found; when M is
+// singular the solution set may be a polyhedron whose vertices these are.
+#include <algorithm>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "lcp/detail.hpp"
+#include "lcp/lcp.hpp"
+
+namespace lcsim::lcp {
+namespace {
+
+constexpr int kMaxEnumeration = 16;
+
+EnumerationResult enumerate(const MatrixXd& M, const VectorXd& q, const Options& opt) {
+  EnumerationResult out;
+  const int k = static_cast<int>(q.size());
+  const double acc = detail::acceptance(q, opt);
+  std::vector<int> alpha;
+  VectorXd z(k), w(k);
+  for (unsigned mask = 0; mask < (1u << k); ++mask) {
+    alpha.clear();
+    for (int i = 0; i < k; ++i)
+      if (mask & (1u << i)) alpha.push_back(i);
+    z.setZero();
+    if (!alpha.empty()) {
+      Eigen::FullPivLU<MatrixXd> lu(M(alpha, alpha));
+      lu.setThreshold(1e-13);
+      if (!lu.isInvertible()) continue;
+      z(alpha) = -lu.solve(q(alpha));
+    }
+    if (z.minCoeff() < -acc) continue;
+    z = z.cwiseMax(0.0);
+    w.noalias() = M * z;
+    w += q;
+    if (w.minCoeff() < -acc || z.cwiseMin(w).cwiseAbs().maxCoeff() > acc) continue;
+    const double tol = 1e-9 * (1.0 + z.cwiseAbs().maxCoeff());
+    const bool seen =
+        std::any_of(out.solutions.begin(), out.solutions.end(),
+                    [&](const VectorXd& s) { return (s - z).cwiseAbs().maxCoeff() <= tol; });
+    if (!seen) out.solutions.push_back(z);
+  }
+  out.status = out.solutions.empty() ? Status::kNumericalFailure : Status::kSolved;
+  if (out.solutions.empty()) out.message = "no complementary basis gives a solution";
+  return out;
+}
+
+}  // namespace
+
+EnumerationResult enumerate_solutions(const MatrixXd& M, const VectorXd& q, const Options& opt) {
+  EnumerationResult out;
+  std::string bad = detail::validate_all(M, q, opt);
+  if (bad.empty() && q.size() > kMaxEnumeration)
+    bad = "enumeration is limited to k <= " + std::to_string(kMaxEnumeration) +
+          ", got k = " + std::to_string(q.size());
+  if (!bad.empty()) {
+    out.message = bad;
+    return out;
+  }
+  try {
+    return enumerate(M, q, opt);
+  } catch (const std::exception& e) {
+    out.status = Status::kNumericalFailure;
+    out.message = std::string("exception in enumeration: ") + e.what();
+    return out;
+  }
+}
+
+Result solve_enumeration(const MatrixXd& M, const VectorXd& q, const Options& opt) {
+  EnumerationResult e = enumerate_solutions(M, q, opt);
+  if (e.status == Status::kInvalidInput) return detail::invalid(e.message);
+  if (e.solutions.empty())
+    return detail::finish(M, q, VectorXd::Zero(q.size()), Status::kNumericalFailure, opt,
+                          e.message);
+  Result r = detail::finish(M, q, e.solutions.front(), Status::kSolved, opt, "");
+  r.iterations = 1 << q.size();
+  return r;
+}
+
+}  // namespace lcsim::lcp
