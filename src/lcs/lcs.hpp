@@ -125,3 +125,59 @@ struct LdcpOptions {
 ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions& opt = {});
 
 }  // namespace lcsim::lcs
+
+// ---------------------------------------------------------------------------
+// Details of the subspace and well-posedness part (src/lcs/subspaces.cpp,
+// src/lcs/wellposedness.cpp), appended to the declarations above.
+//
+// - consistent_subspace, jump_space, projection, mode_feedback and
+//   is_regular_state throw std::invalid_argument when the Lcs dimensions
+//   disagree or I is not a sorted set of distinct indices in [0, k).
+// - V_I and T_I: before the recursions (3.4)/(3.7) the mode quadruple
+//   (A, B_.I, C_I., D_II) is balanced by exact equivalences that do not change
+//   V or T (time scaling of (A, B_.I), scaling of each output row and each
+//   input column); rank decisions use rank_tolerance of the balanced
+//   [A B_.I; C_I. D_II] (an a-priori scale), so they do not depend on units.
+// - projection: ok = false also when Ker [B_.I; D_II] != {0} (the other half
+//   of Lemma 3.3.3 (3)); P is still filled whenever V_I ⊕ T_I = R^n.
+// - mode_feedback uses the leading rows of the mode's own system
+//   (A, B_.I, C_I., D_II); they coincide with rho_i and script M_II of the full
+//   system whenever H^{rho_i}_{iI} != 0.
+// - is_regular_state: tol is relative. C_i A^j x counts as zero when
+//   |C_i A^j x| <= tol * ||C_i||_1 * a^j * ||x||_inf, a = largest absolute row
+//   sum of A (a bound on the terms summed). An infinite rho_i uses n terms.
+//   1e-9 is a sensible value for data accurate to ~1e-12.
+// - analyze_well_posedness, passivity (§7.2; K = K' > 0 with
+//   L(K) = [A'K+KA, KB-C'; B'K-C, -(D+D')] <= 0). Each necessary condition
+//   below follows from L(K) <= 0 with K > 0 for ANY realisation (minimality is
+//   not needed); the first that fails gives passive = "no":
+//     N1  D + D' >= 0 (lower-right block of L(K)).
+//     N2  on Z = Ker(D + D'): (KB - C') Z = 0 (a PSD matrix with a zero
+//         diagonal block has zero off-diagonal blocks), hence Z'CBZ = Z'B'KBZ
+//         is symmetric positive semidefinite and Ker(Z'CBZ) = Ker(BZ).
+//         (This is what fails for every mechanical LCS (3.65) with position
+//         output y = E q + g and E != 0: CB = 0, B != 0.)
+//     N3  G(l) + G(l)^* >= 0 at sample points l with Re l >= 0 that are not
+//         near eigenvalues of A (x = (lI - A)^{-1} B u turns L(K) <= 0 into
+//         u^*(G + G^*)u >= 2 Re(l) x^*Kx >= 0): a log grid of |l| over
+//         [1e-4, 1e4] * max(||A||_2, 1) at arg l = 0, 30, 60, 90 degrees.
+//   Sufficient: passive = "yes" when the candidate K = I is verified by
+//   verify_passivity_certificate (e.g. circuits in port-Hamiltonian form with
+//   A + A' <= 0, B = C'). A mechanical model with velocity output y = E v is
+//   passive with K = blockdiag(stiffness, mass) (plus a constant-state block),
+//   but M is not recoverable from (A, B, C) alone, so that certificate must
+//   be checked by the caller that knows M through verify_passivity_certificate.
+//   Otherwise passive = "unknown"; passivity_reason says what was checked.
+namespace lcsim::lcs {
+
+struct PassivityCertificateCheck {
+  bool ok = false;
+  double lmi_max_eigenvalue = 0.0;  // largest eigenvalue of L(K) (must be <= ~0)
+  double k_min_eigenvalue = 0.0;    // smallest eigenvalue of K (must be > 0)
+  std::string message;
+};
+// Verifies K = K' > 0 and L(K) <= 0 up to 1e-10 relative to the scale
+// ||K|| (||A|| + ||B||) + ||C|| + ||D|| of the entries of L(K).
+PassivityCertificateCheck verify_passivity_certificate(const Lcs& sys, const MatrixXd& K);
+
+}  // namespace lcsim::lcs
