@@ -1,0 +1,147 @@
+// The well-posedness report: Markov parameters (3.32), leading indices and
+// coefficient matrices (3.39), Theorem 3.6.3, the backward Euler guard of
+// Example 7.3.3 and the passivity checks of §7.2.
+//
+// Tolerances: the data are small integers and the Markov parameters are
+// products of at most n + 1 = 7 such matrices, exact in floating point; the
+// comparisons use 1e-12 only to avoid asserting bitwise equality.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include "lcs/lcs.hpp"
+
+namespace lcsim::lcs {
+namespace {
+
+constexpr double kExact = 1e-12;
+
+Lcs two_carts() {  // eq. (3.1)
+  Lcs s;
+  s.A.resize(4, 4);
+  s.A << 0, 0, 1, 0,  //
+      0, 0, 0, 1,     //
+      -2, 1, 0, 0,    //
+      1, -1, 0, 0;
+  s.B = (MatrixXd(4, 1) << 0, 0, 1, 0).finished();
+  s.C = (MatrixXd(1, 4) << 1, 0, 0, 0).finished();
+  s.D = MatrixXd::Zero(1, 1);
+  return s;
+}
+
+Lcs triple_integrator() {  // Example 7.3.3
+  Lcs s;
+  s.A = (MatrixXd(3, 3) << 0, 1, 0, 0, 0, 1, 0, 0, 0).finished();
+  s.B = (MatrixXd(3, 1) << 0, 0, 1).finished();
+  s.C = (MatrixXd(1, 3) << 1, 0, 0).finished();
+  s.D = MatrixXd::Zero(1, 1);
+  return s;
+}
+
+Lcs scalar(double a, double b, double c, double d) {
+  Lcs s;
+  s.A = MatrixXd::Constant(1, 1, a);
+  s.B = MatrixXd::Constant(1, 1, b);
+  s.C = MatrixXd::Constant(1, 1, c);
+  s.D = MatrixXd::Constant(1, 1, d);
+  return s;
+}
+
+TEST(WellPosedness, TwoCartsMarkovParametersAndIndices) {
+  const Lcs s = two_carts();
+  // DESIGN.md (misprint note on §3.7): 0, 0, 1, 0, -2, 0, 5, ...
+  const auto H = markov_parameters(s, 7);
+  const double expected[] = {0, 0, 1, 0, -2, 0, 5};
+  for (int i = 0; i < 7; ++i) EXPECT_NEAR(H[i](0, 0), expected[i], kExact) << "H^" << i;
+
+  const auto r = analyze_well_posedness(s);
+  EXPECT_EQ(r.n, 4);
+  EXPECT_EQ(r.k, 1);
+  ASSERT_EQ(r.markov.size(), 5u);  // H^0..H^n
+  for (int i = 0; i < 5; ++i) EXPECT_NEAR(r.markov[i](0, 0), expected[i], kExact);
+  EXPECT_EQ(r.rho, std::vector<int>{2});
+  EXPECT_EQ(r.eta, std::vector<int>{2});
+  EXPECT_NEAR(r.row_coefficients(0, 0), 1.0, kExact);  // script M = 1 (§3.7)
+  EXPECT_NEAR(r.column_coefficients(0, 0), 1.0, kExact);
+  EXPECT_TRUE(r.row_p_matrix);
+  EXPECT_TRUE(r.column_p_matrix);
+  EXPECT_TRUE(r.locally_well_posed);
+  EXPECT_FALSE(r.backward_euler_risky);
+  // Position output of a mechanical system: CB = 0 with B != 0, so no K > 0
+  // can satisfy the KYP LMI (lcs.hpp, N2).
+  EXPECT_EQ(r.passive, "no");
+  EXPECT_NE(r.passivity_reason.find("CB"), std::string::npos) << r.passivity_reason;
+}
+
+TEST(WellPosedness, TripleIntegratorIsRiskyForBackwardEuler) {
+  const auto r = analyze_well_posedness(triple_integrator());
+  EXPECT_EQ(r.rho, std::vector<int>{3});
+  EXPECT_TRUE(r.backward_euler_risky);  // Example 7.3.3
+  EXPECT_TRUE(r.locally_well_posed);    // script M = script N = 1
+  EXPECT_EQ(r.passive, "no");
+}
+
+TEST(WellPosedness, NonPMatrixAndInfiniteIndex) {
+  // script M = -1: not a P-matrix, Theorem 3.6.3 does not apply.
+  auto r = analyze_well_posedness(scalar(-1, 1, -1, 0));
+  EXPECT_EQ(r.rho, std::vector<int>{1});
+  EXPECT_FALSE(r.row_p_matrix);
+  EXPECT_FALSE(r.locally_well_posed);
+  // B = 0, D = 0: every Markov parameter vanishes, the index is infinite.
+  r = analyze_well_posedness(scalar(-1, 0, 1, 0));
+  EXPECT_EQ(r.rho, std::vector<int>{kInfiniteIndex});
+  EXPECT_FALSE(r.row_p_matrix);
+  EXPECT_FALSE(r.column_p_matrix);
+  EXPECT_FALSE(r.locally_well_posed);
+}
+
+TEST(Passivity, NegativeFeedthroughIsNotPassive) {
+  const auto r = analyze_well_posedness(scalar(-1, 1, 1, -1));
+  EXPECT_EQ(r.passive, "no");
+  EXPECT_NE(r.passivity_reason.find("D + D'"), std::string::npos) << r.passivity_reason;
+}
+
+TEST(Passivity, UnstablePoleFailsOnTheImaginaryAxis) {
+  // G(s) = 1/(s - 1): CB = 1 > 0 passes N2, but Re G(jw) = -1/(w^2 + 1) < 0.
+  const auto r = analyze_well_posedness(scalar(1, 1, 1, 0));
+  EXPECT_EQ(r.passive, "no");
+  EXPECT_NE(r.passivity_reason.find("G(l)"), std::string::npos) << r.passivity_reason;
+}
+
+TEST(Passivity, RcCircuitHasIdentityCertificate) {
+  // G(s) = 1/(s + 1): A + A' = -2 <= 0 and B = C', so K = I works.
+  const auto r = analyze_well_posedness(scalar(-1, 1, 1, 0));
+  EXPECT_EQ(r.passive, "yes");
+  EXPECT_NE(r.passivity_reason.find("K = I"), std::string::npos) << r.passivity_reason;
+}
+
+TEST(Passivity, VelocityOutputMassSpringNeedsItsEnergyCertificate) {
+  // m v' = -k q - d v + u, y = v (collocated velocity output): passive with
+  // storage = energy, K = blockdiag(k, m), which the report cannot guess from
+  // (A, B, C) when m != 1, so it says "unknown" and the certificate checks.
+  const double m = 2.0, k = 3.0, d = 0.5;
+  Lcs s;
+  s.A = (MatrixXd(2, 2) << 0, 1, -k / m, -d / m).finished();
+  s.B = (MatrixXd(2, 1) << 0, 1 / m).finished();
+  s.C = (MatrixXd(1, 2) << 0, 1).finished();
+  s.D = MatrixXd::Zero(1, 1);
+  const auto r = analyze_well_posedness(s);
+  EXPECT_EQ(r.passive, "unknown") << r.passivity_reason;
+  const MatrixXd K = (MatrixXd(2, 2) << k, 0, 0, m).finished();
+  const auto cert = verify_passivity_certificate(s, K);
+  EXPECT_TRUE(cert.ok) << cert.message;
+  // LMI = diag(0, -2d) exactly: largest eigenvalue 0.
+  EXPECT_NEAR(cert.lmi_max_eigenvalue, 0.0, kExact);
+  EXPECT_FALSE(verify_passivity_certificate(s, MatrixXd::Identity(2, 2)).ok);
+  EXPECT_FALSE(verify_passivity_certificate(s, -K).ok);
+}
+
+TEST(Passivity, ReasonIsAlwaysStated) {
+  for (const Lcs& s : {two_carts(), triple_integrator(), scalar(-1, 1, 1, 0)}) {
+    const auto r = analyze_well_posedness(s);
+    EXPECT_FALSE(r.passivity_reason.empty());
+  }
+}
+
+}  // namespace
+}  // namespace lcsim::lcs
