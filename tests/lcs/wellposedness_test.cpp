@@ -115,6 +115,19 @@ TEST(Passivity, RcCircuitHasIdentityCertificate) {
   EXPECT_NE(r.passivity_reason.find("K = I"), std::string::npos) << r.passivity_reason;
 }
 
+TEST(Passivity, LosslessLcCircuitIsNotFlaggedByRounding) {
+  // G(s) = s/(s^2 + 1): G(jw) + G(jw)^* = 0 exactly on the imaginary axis
+  // (lossless), so the frequency test sees only rounding there and must not
+  // call it a violation; K = I is a certificate (A + A' = 0, B = C').
+  Lcs s;
+  s.A = (MatrixXd(2, 2) << 0, 1, -1, 0).finished();
+  s.B = (MatrixXd(2, 1) << 0, 1).finished();
+  s.C = (MatrixXd(1, 2) << 0, 1).finished();
+  s.D = MatrixXd::Zero(1, 1);
+  const auto r = analyze_well_posedness(s);
+  EXPECT_EQ(r.passive, "yes") << r.passivity_reason;
+}
+
 TEST(Passivity, VelocityOutputMassSpringNeedsItsEnergyCertificate) {
   // m v' = -k q - d v + u, y = v (collocated velocity output): passive with
   // storage = energy, K = blockdiag(k, m), which the report cannot guess from
