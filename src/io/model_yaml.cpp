@@ -1,0 +1,427 @@
+// Model files and LCP files (YAML, through yaml-cpp), and vectors given on the
+// command line. Format: docs/model-format.md. All validation happens here, so
+// the layers below may assume well-formed models; every error names the file,
+// the key and the offending value.
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "io/detail.hpp"
+#include "io/io.hpp"
+
+namespace lcsim::io {
+
+namespace {
+
+using Keys = std::map<std::string, YAML::Node>;
+
+[[noreturn]] void fail(const std::string& source, const std::string& key, const std::string& what) {
+  throw InputError(source + ": " + key + ": " + what);
+}
+
+// What a node holds, for "(got ...)" in messages.
+std::string describe(const YAML::Node& n) {
+  switch (n.Type()) {
+    case YAML::NodeType::Scalar:
+      return "'" + n.Scalar() + "'";
+    case YAML::NodeType::Sequence:
+      return "a list of " + std::to_string(n.size()) + " entries";
+    case YAML::NodeType::Map:
+      return "a mapping";
+    case YAML::NodeType::Null:
+      return "nothing";
+    default:
+      return "an undefined value";
+  }
+}
+
+std::string join(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+YAML::Node load_yaml(const std::string& text, const std::string& source) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    // yaml-cpp marks are 0-based; editors count from 1.
+    throw InputError(source + ": malformed YAML at line " + std::to_string(e.mark.line + 1) +
+                     ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
+  }
+}
+
+// The entries of a mapping by key; unknown and duplicate keys are errors so
+// that a typo ("restitutoin") never passes silently.
+Keys mapping(const YAML::Node& node, const std::string& source, const std::string& key,
+             const std::vector<std::string>& allowed) {
+  const std::string where = key.empty() ? "top level" : key;
+  if (!node.IsMap()) fail(source, where, "expected a mapping of keys (got " + describe(node) + ")");
+  Keys out;
+  for (const auto& kv : node) {
+    if (!kv.first.IsScalar())
+      fail(source, where, "keys must be plain names (got " + describe(kv.first) + ")");
+    const std::string name = kv.first.Scalar();
+    const std::string full = key.empty() ? name : key + "." + name;
+    if (std::find(allowed.begin(), allowed.end(), name) == allowed.end())
+      fail(source, full, "unknown key (expected one of " + join(allowed) + ")");
+    if (out.count(name)) fail(source, full, "duplicate key");
+    out.emplace(name, kv.second);
+  }
+  return out;
+}
+
+double number(const YAML::Node& n, const std::string& source, const std::string& key) {
+  if (!n.IsScalar()) fail(source, key, "expected a number (got " + describe(n) + ")");
+  double x = 0.0;
+  try {
+    x = n.as<double>();
+  } catch (const YAML::Exception&) {
+    fail(source, key, "not a number (got '" + n.Scalar() + "')");
+  }
+  if (!std::isfinite(x)) fail(source, key, "not finite (got '" + n.Scalar() + "')");
+  return x;
+}
+
+VectorXd vector(const YAML::Node& n, const std::string& source, const std::string& key) {
+  if (!n.IsSequence()) fail(source, key, "expected a list of numbers (got " + describe(n) + ")");
+  VectorXd v(static_cast<Eigen::Index>(n.size()));
+  for (std::size_t i = 0; i < n.size(); ++i)
+    v(static_cast<Eigen::Index>(i)) = number(n[i], source, key + "[" + std::to_string(i) + "]");
+  return v;
+}
+
+// A list of rows. `cols_if_empty` gives the column count of `[]` (0 rows).
+MatrixXd matrix(const YAML::Node& n, const std::string& source, const std::string& key,
+                Eigen::Index cols_if_empty) {
+  if (!n.IsSequence())
+    fail(source, key, "expected a matrix as a list of rows (got " + describe(n) + ")");
+  const auto rows = static_cast<Eigen::Index>(n.size());
+  if (rows == 0) return MatrixXd::Zero(0, cols_if_empty);
+  Eigen::Index cols = -1;
+  MatrixXd m;
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    const YAML::Node row = n[static_cast<std::size_t>(i)];
+    const std::string rkey = key + "[" + std::to_string(i) + "]";
+    if (!row.IsSequence())
+      fail(source, rkey,
+           "expected a matrix row as a list of numbers (got " + describe(row) +
+               "); write a matrix as a list of rows, e.g. [[1, 0], [0, 1]]");
+    const auto c = static_cast<Eigen::Index>(row.size());
+    if (cols < 0) {
+      cols = c;
+      m.resize(rows, cols);
+    } else if (c != cols) {
+      fail(source, key,
+           "rows differ in length (row " + std::to_string(i) + " has " + std::to_string(c) +
+               " entries but row 0 has " + std::to_string(cols) + ")");
+    }
+    for (Eigen::Index j = 0; j < c; ++j)
+      m(i, j) =
+          number(row[static_cast<std::size_t>(j)], source, rkey + "[" + std::to_string(j) + "]");
+  }
+  return m;
+}
+
+std::string dims(const MatrixXd& m) {
+  return std::to_string(m.rows()) + " x " + std::to_string(m.cols());
+}
+
+void expect_dims(const MatrixXd& m, Eigen::Index rows, Eigen::Index cols, const std::string& source,
+                 const std::string& key, const std::string& why) {
+  if (m.rows() != rows || m.cols() != cols)
+    fail(source, key,
+         "expected " + std::to_string(rows) + " x " + std::to_string(cols) + " " + why + " (got " +
+             dims(m) + ")");
+}
+
+void expect_size(const VectorXd& v, Eigen::Index size, const std::string& source,
+                 const std::string& key, const std::string& why) {
+  if (v.size() != size)
+    fail(source, key,
+         "expected " + std::to_string(size) + " entries " + why + " (got " +
+             std::to_string(v.size()) + ")");
+}
+
+std::vector<std::string> names(const YAML::Node& n, Eigen::Index size, const std::string& source,
+                               const std::string& key, const std::string& why) {
+  if (!n.IsSequence()) fail(source, key, "expected a list of names (got " + describe(n) + ")");
+  if (static_cast<Eigen::Index>(n.size()) != size)
+    fail(source, key,
+         "expected " + std::to_string(size) + " names " + why + " (got " +
+             std::to_string(n.size()) + ")");
+  std::vector<std::string> out;
+  std::set<std::string> seen;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const std::string ikey = key + "[" + std::to_string(i) + "]";
+    if (!n[i].IsScalar() || n[i].Scalar().empty())
+      fail(source, ikey, "expected a non-empty name (got " + describe(n[i]) + ")");
+    const std::string name = n[i].Scalar();
+    if (!seen.insert(name).second) fail(source, ikey, "duplicate name '" + name + "'");
+    out.push_back(name);
+  }
+  return out;
+}
+
+// M symmetric (relative tolerance 1e-12 of its largest entry) and positive
+// definite: Cholesky succeeds and the smallest eigenvalue is not negligible
+// against the largest (N * eps relative), so a numerically singular M whose
+// Cholesky squeaks through on rounding is refused as well.
+void check_mass_matrix(const MatrixXd& M, const std::string& source) {
+  const double scale = M.cwiseAbs().maxCoeff();
+  for (Eigen::Index i = 0; i < M.rows(); ++i)
+    for (Eigen::Index j = i + 1; j < M.cols(); ++j)
+      if (std::abs(M(i, j) - M(j, i)) > 1e-12 * scale)
+        fail(source, "mechanical.M",
+             "not symmetric (M[" + std::to_string(i) + "][" + std::to_string(j) +
+                 "] = " + format_number(M(i, j)) + " but M[" + std::to_string(j) + "][" +
+                 std::to_string(i) + "] = " + format_number(M(j, i)) + ")");
+  const MatrixXd S = 0.5 * (M + M.transpose());
+  const Eigen::LLT<MatrixXd> llt(S);
+  const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<MatrixXd>(S).eigenvalues();
+  const double eps = std::numeric_limits<double>::epsilon();
+  if (llt.info() != Eigen::Success ||
+      ev.minCoeff() <= static_cast<double>(M.rows()) * eps * std::abs(ev.maxCoeff())) {
+    // Computed values, not input: 6 digits read better than 17.
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "smallest eigenvalue %.6g, largest %.6g", ev.minCoeff(),
+                  ev.maxCoeff());
+    fail(source, "mechanical.M", "not positive definite (" + std::string(buf) + ")");
+  }
+}
+
+mech::MechanicalModel parse_mechanical(const YAML::Node& node, const std::string& source) {
+  const Keys keys =
+      mapping(node, source, "mechanical",
+              {"M", "D", "K", "E", "g", "f", "restitution", "coordinates", "constraints"});
+  const auto has = [&](const char* k) { return keys.count(k) > 0; };
+  mech::MechanicalModel m;
+  if (!has("M")) fail(source, "mechanical.M", "missing (the mass matrix is required)");
+  m.M = matrix(keys.at("M"), source, "mechanical.M", 0);
+  if (m.M.rows() == 0)
+    fail(source, "mechanical.M", "empty (a model needs at least one coordinate)");
+  if (m.M.rows() != m.M.cols())
+    fail(source, "mechanical.M", "expected a square matrix (got " + dims(m.M) + ")");
+  const Eigen::Index N = m.M.rows();
+  check_mass_matrix(m.M, source);
+  const std::string nn = "(N = " + std::to_string(N) + " coordinates, from M)";
+  if (has("D")) {
+    m.D = matrix(keys.at("D"), source, "mechanical.D", N);
+    expect_dims(m.D, N, N, source, "mechanical.D", nn);
+  }
+  if (has("K")) {
+    m.K = matrix(keys.at("K"), source, "mechanical.K", N);
+    expect_dims(m.K, N, N, source, "mechanical.K", nn);
+  }
+  m.E = MatrixXd::Zero(0, N);
+  if (has("E")) {
+    m.E = matrix(keys.at("E"), source, "mechanical.E", N);
+    if (m.E.cols() != N)
+      fail(source, "mechanical.E",
+           "expected " + std::to_string(N) + " columns " + nn + " (got " + dims(m.E) + ")");
+  }
+  const Eigen::Index k = m.E.rows();
+  const std::string kk = "(k = " + std::to_string(k) + " constraints, from the rows of E)";
+  if (has("g")) {
+    m.g = vector(keys.at("g"), source, "mechanical.g");
+    expect_size(m.g, k, source, "mechanical.g", kk);
+  }
+  if (has("f")) {
+    m.f = vector(keys.at("f"), source, "mechanical.f");
+    expect_size(m.f, N, source, "mechanical.f", nn);
+  }
+  if (has("restitution")) {
+    m.restitution = vector(keys.at("restitution"), source, "mechanical.restitution");
+    expect_size(m.restitution, k, source, "mechanical.restitution", kk);
+    for (Eigen::Index i = 0; i < k; ++i)
+      if (m.restitution(i) < 0.0 || m.restitution(i) > 1.0)
+        fail(source, "mechanical.restitution[" + std::to_string(i) + "]",
+             "outside [0, 1] (got " + format_number(m.restitution(i)) + ")");
+  }
+  if (has("coordinates"))
+    m.coordinates = names(keys.at("coordinates"), N, source, "mechanical.coordinates", nn);
+  if (has("constraints"))
+    m.constraints = names(keys.at("constraints"), k, source, "mechanical.constraints", kk);
+  // fill_defaults leaves the zero-row E alone and sizes g and restitution to
+  // k, so a model without constraints (E omitted or []) is complete as well.
+  mech::fill_defaults(m);
+  return m;
+}
+
+lcs::Lcs parse_lcs(const YAML::Node& node, const std::string& source) {
+  const Keys keys = mapping(node, source, "lcs", {"A", "B", "C", "D"});
+  for (const char* k : {"A", "B", "C"})
+    if (!keys.count(k)) fail(source, std::string("lcs.") + k, "missing (A, B and C are required)");
+  lcs::Lcs s;
+  s.A = matrix(keys.at("A"), source, "lcs.A", 0);
+  if (s.A.rows() == 0) fail(source, "lcs.A", "empty (an LCS needs at least one state)");
+  if (s.A.rows() != s.A.cols())
+    fail(source, "lcs.A", "expected a square matrix (got " + dims(s.A) + ")");
+  const Eigen::Index n = s.A.rows();
+  s.B = matrix(keys.at("B"), source, "lcs.B", 0);
+  if (s.B.rows() != n)
+    fail(source, "lcs.B",
+         "expected " + std::to_string(n) + " rows (n = " + std::to_string(n) +
+             " states, from A) (got " + dims(s.B) + ")");
+  const Eigen::Index k = s.B.cols();
+  const std::string kk = "(k = " + std::to_string(k) + " complementarity pairs, from B)";
+  s.C = matrix(keys.at("C"), source, "lcs.C", n);
+  expect_dims(s.C, k, n, source, "lcs.C", kk);
+  s.D = MatrixXd::Zero(k, k);
+  if (keys.count("D")) {
+    s.D = matrix(keys.at("D"), source, "lcs.D", k);
+    expect_dims(s.D, k, k, source, "lcs.D", kk);
+  }
+  return s;
+}
+
+std::string read_file(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec))
+    throw InputError(path.string() + ": cannot open: no such file");
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(path.string() + ": cannot open: is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string() + ": cannot open: permission denied or unreadable");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw InputError(path.string() + ": read error");
+  return ss.str();
+}
+
+}  // namespace
+
+mech::Model parse_model(const std::string& yaml_text, const std::string& source) {
+  const YAML::Node root = load_yaml(yaml_text, source);
+  if (root.IsNull() || !root.IsDefined())
+    throw InputError(source +
+                     ": empty file (expected `name` and a `mechanical:` or `lcs:` section)");
+  const Keys keys = mapping(root, source, "", {"name", "mechanical", "lcs", "initial", "t_end"});
+  mech::Model model;
+  model.source = source;
+  if (keys.count("name")) {
+    const YAML::Node& n = keys.at("name");
+    if (!n.IsScalar() || n.Scalar().empty())
+      fail(source, "name", "expected a non-empty name (got " + describe(n) + ")");
+    model.name = n.Scalar();
+  } else {
+    model.name = std::filesystem::path(source).stem().string();
+  }
+  const bool has_mech = keys.count("mechanical") > 0;
+  const bool has_lcs = keys.count("lcs") > 0;
+  if (has_mech && has_lcs)
+    fail(source, "mechanical, lcs", "a model is one or the other; give only one of the sections");
+  if (!has_mech && !has_lcs)
+    fail(source, "mechanical", "missing (expected a `mechanical:` or an `lcs:` section)");
+  if (has_mech) model.mechanical = parse_mechanical(keys.at("mechanical"), source);
+  if (has_lcs) model.lcs = parse_lcs(keys.at("lcs"), source);
+  if (keys.count("initial")) {
+    model.initial = vector(keys.at("initial"), source, "initial");
+    const std::string why = model.is_mechanical()
+                                ? "(the state: " + std::to_string(model.mechanical->dofs()) +
+                                      " positions q then " +
+                                      std::to_string(model.mechanical->dofs()) + " velocities v)"
+                                : "(the state x, n = " + std::to_string(model.state_size()) + ")";
+    expect_size(model.initial, model.state_size(), source, "initial", why);
+  }
+  if (keys.count("t_end")) {
+    model.t_end = number(keys.at("t_end"), source, "t_end");
+    if (!(model.t_end > 0.0))
+      fail(source, "t_end", "must be > 0 (got " + format_number(model.t_end) + ")");
+  }
+  return model;
+}
+
+mech::Model load_model(const std::filesystem::path& path) {
+  return parse_model(read_file(path), path.string());
+}
+
+std::vector<std::string> model_notes(const mech::Model& model) {
+  std::vector<std::string> notes;
+  if (model.is_mechanical()) {
+    const mech::MechanicalModel& m = *model.mechanical;
+    const int k = m.num_constraints();
+    if (k == 0) {
+      notes.push_back("no unilateral constraints: the model is a free linear system");
+    } else {
+      const Eigen::JacobiSVD<MatrixXd> svd(m.E);
+      const double tol = lcs::rank_tolerance(m.E);
+      const auto rank = (svd.singularValues().array() > tol).count();
+      if (rank < k)
+        notes.push_back("dependent constraints: E (" + std::to_string(k) + " x " +
+                        std::to_string(m.dofs()) + ") has rank " + std::to_string(rank) + " < " +
+                        std::to_string(k) +
+                        "; legal (thesis §4.6.1): post-impact velocities are unique, impulses "
+                        "need not be");
+    }
+    if (model.initial.size() == model.state_size() && k > 0) {
+      const VectorXd y = mech::gaps(m, model.initial.head(m.dofs()));
+      for (int i = 0; i < k; ++i)
+        if (y(i) < 0.0)
+          notes.push_back("initial state violates constraint " + m.constraints[i] + " (gap " +
+                          format_number(y(i)) +
+                          " < 0); an impact changes velocities only and cannot repair it");
+    }
+  }
+  if (model.initial.size() == 0) notes.push_back("no initial state in the file");
+  if (std::isnan(model.t_end)) notes.push_back("no t_end in the file");
+  return notes;
+}
+
+LcpProblem load_lcp(const std::filesystem::path& path) {
+  const std::string source = path.string();
+  const YAML::Node root = load_yaml(read_file(path), source);
+  if (root.IsNull() || !root.IsDefined())
+    throw InputError(source + ": empty file (expected `M` and `q`)");
+  const Keys keys = mapping(root, source, "", {"name", "M", "q"});
+  for (const char* k : {"M", "q"})
+    if (!keys.count(k)) fail(source, k, "missing (an LCP file gives M and q)");
+  LcpProblem p;
+  p.M = matrix(keys.at("M"), source, "M", 0);
+  if (p.M.rows() == 0) fail(source, "M", "empty");
+  if (p.M.rows() != p.M.cols())
+    fail(source, "M", "expected a square matrix (got " + dims(p.M) + ")");
+  p.q = vector(keys.at("q"), source, "q");
+  expect_size(p.q, p.M.rows(), source, "q", "(k, from M)");
+  return p;
+}
+
+VectorXd parse_vector(const std::string& text, const std::string& what) {
+  std::vector<double> out;
+  std::size_t start = 0;
+  int index = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    const std::size_t end = comma == std::string::npos ? text.size() : comma;
+    std::size_t b = start, e = end;
+    while (b < e && std::isspace(static_cast<unsigned char>(text[b]))) ++b;
+    while (e > b && std::isspace(static_cast<unsigned char>(text[e - 1]))) --e;
+    const std::string token = text.substr(b, e - b);
+    const std::string where = what + ": entry " + std::to_string(index) + " of '" + text + "'";
+    if (token.empty()) throw InputError(where + ": empty (expected comma-separated numbers)");
+    double x = 0.0;
+    const char* first = token.data();
+    const char* last = token.data() + token.size();
+    if (*first == '+') ++first;  // from_chars refuses a leading '+'
+    const auto [ptr, ec] = std::from_chars(first, last, x);
+    if (ec != std::errc() || ptr != last)
+      throw InputError(where + ": not a number (got '" + token + "')");
+    if (!std::isfinite(x)) throw InputError(where + ": not finite (got '" + token + "')");
+    out.push_back(x);
+    ++index;
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return Eigen::Map<const VectorXd>(out.data(), static_cast<Eigen::Index>(out.size()));
+}
+
+}  // namespace lcsim::io

@@ -1,0 +1,232 @@
+// Writers: atomic file output, the CSV trajectory and the JSON run summary.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "io/io.hpp"
+
+namespace lcsim::io {
+namespace {
+
+namespace fs = std::filesystem;
+using Eigen::VectorXd;
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// A fresh empty directory per test.
+fs::path scratch_dir(const std::string& name) {
+  const fs::path dir = fs::path(::testing::TempDir()) / ("lcsim_io_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::vector<std::string> entries(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+TEST(WriteFileAtomic, WritesAndReplaces) {
+  const fs::path dir = scratch_dir("write");
+  const fs::path file = dir / "out.csv";
+  write_file_atomic(file, "first\n");
+  EXPECT_EQ(slurp(file), "first\n");
+  write_file_atomic(file, "second\n");
+  EXPECT_EQ(slurp(file), "second\n");
+  write_file_atomic(file, "");
+  EXPECT_EQ(slurp(file), "");
+  EXPECT_EQ(entries(dir), std::vector<std::string>{"out.csv"});  // no temporary left over
+}
+
+TEST(WriteFileAtomic, FailureLeavesNoPartialFile) {
+  const fs::path dir = scratch_dir("fail");
+  // The target is a directory: the temporary file is written in full, then
+  // the rename fails. The temporary must be removed and the directory kept.
+  const fs::path target = dir / "taken";
+  fs::create_directory(target);
+  std::ofstream(dir / "keep.txt") << "old";
+  try {
+    write_file_atomic(target, std::string(1 << 16, 'x'));
+    FAIL() << "wrote over a directory";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(target.string() + ": cannot write: ", 0), 0u) << e.what();
+  }
+  EXPECT_EQ(entries(dir), (std::vector<std::string>{"keep.txt", "taken"}));
+  EXPECT_TRUE(fs::is_directory(target));
+  EXPECT_TRUE(fs::is_empty(target));
+
+  // A directory that does not exist: nothing can be created at all.
+  const fs::path missing = dir / "no" / "such" / "out.json";
+  try {
+    write_file_atomic(missing, "{}");
+    FAIL() << "wrote into a missing directory";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              missing.string() + ": cannot write: No such file or directory");
+  }
+  EXPECT_FALSE(fs::exists(dir / "no"));
+  EXPECT_EQ(slurp(dir / "keep.txt"), "old");
+}
+
+mech::Model two_carts_model() {
+  return parse_model(
+      "name: carts\n"
+      "mechanical:\n"
+      "  M: [[1, 0], [0, 1]]\n"
+      "  K: [[2, -1], [-1, 1]]\n"
+      "  E: [[1, 0], [1, -1]]\n"
+      "  coordinates: [x1, x2]\n"
+      "  constraints: [stop, hook]\n",
+      "carts.yaml");
+}
+
+// A hand-made trajectory: one impact at t = 0.1 with a jump (two samples
+// share t), a sample with empty u and y, and non-representable decimals.
+sim::Trajectory hand_made() {
+  sim::Trajectory tr;
+  tr.method = "event";
+  tr.t_end = 3.0;
+  sim::Sample a;
+  a.t = 0.0;
+  a.x = (VectorXd(4) << 1.0 / 3.0, 0.1, -1, 2).finished();
+  a.u = VectorXd::Zero(2);
+  a.y = (VectorXd(2) << 1.0 / 3.0, 0.1).finished();
+  sim::Sample b = a;
+  b.t = 0.1;
+  b.u = VectorXd();  // not recorded: blank cells
+  b.y = VectorXd();
+  b.mode = {0, 1};
+  tr.samples = {a, b};
+  sim::Event e;
+  e.t = 0.1;
+  e.type = sim::EventType::kImpact;
+  e.state_before = a.x;
+  e.state_after = (VectorXd(4) << 0, 0, 0.5, 0.5).finished();
+  e.mode_after = {0, 1};
+  e.impulse = (VectorXd(2) << 1.5, 0.25).finished();
+  tr.events = {e};
+  tr.final_state = e.state_after;
+  tr.energy_initial = 2.5;
+  tr.energy_final = 1.0 / 7.0;
+  tr.max_violation = -1e-17;
+  tr.lcp_solves = 3;
+  tr.steps = 2;
+  tr.warnings = 1;
+  tr.warning_messages = {"grazing contact at t = 0.1"};
+  tr.wall_time_s = 0.125;
+  return tr;
+}
+
+TEST(TrajectoryCsv, HeaderAndRowsMechanical) {
+  const std::string csv = trajectory_csv(two_carts_model(), hand_made());
+  std::istringstream in(csv);
+  std::string header, row0, row1, extra;
+  std::getline(in, header);
+  std::getline(in, row0);
+  std::getline(in, row1);
+  EXPECT_EQ(header, "t,x1,x2,v_x1,v_x2,u_stop,u_hook,y_stop,y_hook,mode");
+  // %.17g: 1/3 and 0.1 are printed with 17 significant digits and read back exactly.
+  EXPECT_EQ(row0,
+            "0,0.33333333333333331,0.10000000000000001,-1,2,0,0,0.33333333333333331,"
+            "0.10000000000000001,");
+  EXPECT_EQ(row1, "0.10000000000000001,0.33333333333333331,0.10000000000000001,-1,2,,,,,0;1");
+  EXPECT_FALSE(std::getline(in, extra));
+  EXPECT_EQ(std::stod("0.33333333333333331"), 1.0 / 3.0);
+}
+
+TEST(TrajectoryCsv, HeaderLcs) {
+  const mech::Model model =
+      parse_model("lcs:\n  A: [[0, 1], [0, 0]]\n  B: [[0], [1]]\n  C: [[1, 0]]\n", "lcs.yaml");
+  sim::Trajectory tr;
+  sim::Sample s;
+  s.t = 0.5;
+  s.x = (VectorXd(2) << 1, 2).finished();
+  s.u = (VectorXd(1) << 3).finished();
+  s.y = (VectorXd(1) << 4).finished();
+  s.mode = {0};
+  tr.samples = {s};
+  EXPECT_EQ(trajectory_csv(model, tr), "t,x1,x2,u1,y1,mode\n0.5,1,2,3,4,0\n");
+}
+
+TEST(TrajectoryCsv, QuotesNamesWithCommas) {
+  const mech::Model model = parse_model(
+      "mechanical:\n  M: [[1]]\n  E: [[1]]\n  coordinates: ['a,b']\n  constraints: ['say "
+      "\"hi\"']\n",
+      "q.yaml");
+  EXPECT_EQ(trajectory_csv(model, sim::Trajectory{}),
+            "t,\"a,b\",\"v_a,b\",\"u_say \"\"hi\"\"\",\"y_say \"\"hi\"\"\",mode\n");
+}
+
+TEST(TrajectoryCsv, WrongStateSizeIsAProgrammingError) {
+  sim::Trajectory tr = hand_made();
+  tr.samples[0].x = VectorXd::Zero(5);  // e.g. the augmented (q, v, 1)
+  EXPECT_THROW(trajectory_csv(two_carts_model(), tr), std::logic_error);
+}
+
+TEST(TrajectoryJson, RoundTrip) {
+  const sim::Trajectory tr = hand_made();
+  const std::string text = trajectory_json(two_carts_model(), tr).dump(2);
+  const nlohmann::json j = nlohmann::json::parse(text);
+  for (const char* key :
+       {"model", "method", "t_end", "final_state", "events", "energy_initial", "energy_final",
+        "max_violation", "lcp_solves", "steps", "warnings", "status", "message", "wall_time_s"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  // nlohmann writes the shortest text that reads back as the same double, so
+  // the round trip is exact (EXPECT_EQ, no tolerance).
+  EXPECT_EQ(j["model"], "carts");
+  EXPECT_EQ(j["method"], "event");
+  EXPECT_EQ(j["t_end"].get<double>(), 3.0);
+  EXPECT_EQ(j["final_state"].get<std::vector<double>>(), (std::vector<double>{0, 0, 0.5, 0.5}));
+  ASSERT_EQ(j["events"].size(), 1u);
+  const nlohmann::json& e = j["events"][0];
+  EXPECT_EQ(e["t"].get<double>(), 0.1);
+  EXPECT_EQ(e["type"], "impact");
+  EXPECT_EQ(e["state_before"].get<std::vector<double>>(),
+            (std::vector<double>{1.0 / 3.0, 0.1, -1, 2}));
+  EXPECT_EQ(e["state_after"].get<std::vector<double>>(), (std::vector<double>{0, 0, 0.5, 0.5}));
+  EXPECT_EQ(e["mode_after"].get<std::vector<int>>(), (std::vector<int>{0, 1}));
+  EXPECT_EQ(e["impulse"].get<std::vector<double>>(), (std::vector<double>{1.5, 0.25}));
+  EXPECT_EQ(j["energy_initial"].get<double>(), 2.5);
+  EXPECT_EQ(j["energy_final"].get<double>(), 1.0 / 7.0);
+  EXPECT_EQ(j["max_violation"].get<double>(), -1e-17);
+  EXPECT_EQ(j["lcp_solves"].get<long>(), 3);
+  EXPECT_EQ(j["steps"].get<long>(), 2);
+  EXPECT_EQ(j["warnings"].get<int>(), 1);
+  EXPECT_EQ(j["warning_messages"][0], "grazing contact at t = 0.1");
+  EXPECT_EQ(j["status"], "completed");
+  EXPECT_EQ(j["message"], "");
+  EXPECT_EQ(j["wall_time_s"].get<double>(), 0.125);
+}
+
+TEST(TrajectoryJson, FailedRunAndLcsEnergies) {
+  const mech::Model model = parse_model("lcs:\n  A: [[0]]\n  B: [[1]]\n  C: [[1]]\n", "lcs.yaml");
+  sim::Trajectory tr;
+  tr.status = sim::RunStatus::kFailed;
+  tr.message = "LCP ray termination at t = 0.5";
+  const nlohmann::json j = trajectory_json(model, tr);
+  EXPECT_EQ(j["status"], "failed");
+  EXPECT_EQ(j["message"], "LCP ray termination at t = 0.5");
+  EXPECT_TRUE(j["energy_initial"].is_null());  // no energy for a general LCS
+  EXPECT_TRUE(j["events"].is_array());
+  EXPECT_TRUE(j["final_state"].is_array());
+}
+
+TEST(ToJson, MatrixIsListOfRows) {
+  const Eigen::MatrixXd m = (Eigen::MatrixXd(2, 3) << 1, 2, 3, 4, 5, 6).finished();
+  EXPECT_EQ(to_json(m).dump(), "[[1.0,2.0,3.0],[4.0,5.0,6.0]]");
+  EXPECT_EQ(to_json(VectorXd()).dump(), "[]");
+}
+
+}  // namespace
+}  // namespace lcsim::io
