@@ -1,0 +1,41 @@
+// Internal helpers shared by the impact rules (not part of the public face).
+#pragma once
+
+#include <optional>
+
+#include "impact/impact.hpp"
+
+namespace lcsim::impact::detail {
+
+// The data every rule needs on the closed set J.
+struct Setup {
+  int k = 0;        // constraints in the model
+  VectorXd e;       // restitution (k)
+  MatrixXd EJ;      // rows of E on J (|J| x N)
+  MatrixXd MinvEt;  // M^{-1} E_J' (N x |J|)
+  MatrixXd W;       // Delassus matrix E_J M^{-1} E_J' (|J| x |J|)
+  VectorXd a;       // pre-impact rates E_J v (|J|)
+  VectorXd e_J;     // restitution on J (|J|)
+};
+
+// Validates the input and fills `out` with the no-impact defaults (v_after = v,
+// zero impulse, energy_before = energy_after). Returns nullopt when there is
+// nothing more to do: out.ok says whether the input was valid (an empty J is a
+// valid input with no impact).
+std::optional<Setup> prepare(const ImpactInput& in, ImpactResult& out);
+
+// Fills impulse (per constraint, from the impulse on J), mode (impulse_J(i) >
+// mode_threshold), v_after, energy_after, worst_rate and admissible
+// (E_J v+ >= -1e-9 scale-relative and impulse >= -1e-9 relative: rounding and
+// the interior-point solver stay far inside that).
+void finish(const ImpactInput& in, const Setup& s, const VectorXd& impulse_J,
+            const VectorXd& v_after, double mode_threshold, ImpactResult& out);
+
+// Solves the impact LCP w = W z + q, 0 <= z ⟂ w >= 0 with `solver` after
+// scaling it to a unit diagonal and |q| = 1, falling back to Lemke and then
+// projected Gauss–Seidel (dependent constraints make W singular, PSD but not
+// P). On failure sets out.message and returns nullopt.
+std::optional<VectorXd> solve_impact_lcp(const MatrixXd& W, const VectorXd& q,
+                                         const lcp::Solver& solver, ImpactResult& out);
+
+}  // namespace lcsim::impact::detail
