@@ -64,9 +64,8 @@ TEST(ShippedModels, TwoCartsMatchEq31) {
   // exact values (~2.5e-16 absolute); e^{A} is orthogonal in the energy norm
   // (A has imaginary eigenvalues), so ||e^{A}||_2 <= sqrt(cond(K)) ≈ 2.62
   // amplifies that to ~7e-16, and computing e^{A} adds a few eps of |x| ≈ 1.2.
-  // Together a few 1e-15; 1e-14 leaves a margin while a wrong digit in the
-  // file (>= 1e-17 relative in the 17th digit is the last one kept) would show
-  // as soon as it exceeds the rounding.
+  // Together a few 1e-15; 1e-14 leaves a margin of a few, while an error in
+  // the 13th significant digit of the file (e.g. a mistyped entry) fails.
   const MatrixXd A = mech::to_lcs(m).A.topLeftCorner(4, 4);
   const Eigen::Matrix4d A4 = A;
   const Eigen::Matrix4d eA = A4.exp();
@@ -283,9 +282,10 @@ TEST(ModelFileErrors, MalformedYamlGivesLineAndColumn) {
   const std::string e = error_of("name: x\nmechanical:\n  M: [[1, 0], [0, 1]\n");
   EXPECT_TRUE(contains(e, "bad.yaml: malformed YAML at line ")) << e;
   EXPECT_TRUE(contains(e, ", column ")) << e;
-  // A bad indentation on line 3 (1-based) is reported on line 3.
+  // Line 4 (1-based) is indented by one space, neither a key of `mechanical`
+  // nor a top-level key: yaml-cpp reports it there.
   const std::string f = error_of("name: x\nmechanical:\n  M: [[1]]\n E: [[1]]\n");
-  EXPECT_TRUE(contains(f, "malformed YAML at line ")) << f;
+  EXPECT_TRUE(contains(f, "bad.yaml: malformed YAML at line 4, column ")) << f;
 }
 
 TEST(ModelFileErrors, MissingFileNamesThePath) {
