@@ -119,7 +119,9 @@ struct LdcpOptions {
   // absolute values of the terms that formed it) + tol_abs.
   double tol_rel = 1e-9;
   double tol_abs = 1e-13;
-  int first_level = 0;  // 0 = start at -n+1 (impulsive levels); 1 = regular part only
+  // true: the state is known to be regular; impulsive levels are not solved
+  // (u = 0 there) and a negative free coefficient is reported (Theorem 3.6.7).
+  bool regular_only = false;
   const lcp::Solver* solver = nullptr;  // nullptr = principal pivoting
 };
 ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions& opt = {});
