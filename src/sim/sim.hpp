@@ -64,9 +64,10 @@ struct Options {
   double theta = 0.5;   // Moreau–Jean theta
   std::string impact = "moreau";  // impact law name (src/impact)
   std::string lcp_solver = "pivot";
-  // Event-driven: root accuracy in time (s) and the cap on events per unit
+  // Event-driven: extra root tolerance in time (s) and the cap on events per unit
   // time that ends a run that would loop forever (Zeno without limit).
-  double event_time_tol = 1e-13;
+  // 0 = to machine precision (Brent's 2 ulp(t)), the default.
+  double event_time_tol = 0.0;
   double max_events_per_unit_time = 1e6;
   long max_events = 1000000;
   // Accumulation (right-Zeno, Remark 3.4.11): when the gap between impacts

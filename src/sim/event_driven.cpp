@@ -1,0 +1,620 @@
+// Event-driven integration: Algorithm 3.7.1 of the thesis.
+//
+// Step one/three (mode selection and re-initialisation): for mechanical
+// models the impact law on the closed contacts (Moreau's LCP (3.69)-(3.70),
+// with Newton restitution, §8.2.2), then the LDCP on the regular part
+// (contact forces at acceleration level and, where those vanish, higher
+// derivatives: Theorem 3.6.7). For general LCS the full LDCP_n including the
+// impulsive levels, whose jump equals P_I x0 (eq. (3.10)).
+// Step four: in mode I the dynamics are x' = (A + B_.I F_I) x, integrated
+// exactly with the matrix exponential; output samples are exact too.
+// Step five: the next event is the first time a free output y_i (i not in I)
+// or an active multiplier u_i (i in I) turns negative: a root of a Bohl
+// function, bracketed on a sampling grid fine enough for its frequencies and
+// refined by Brent's method; grazing minima between samples are checked.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <unsupported/Eigen/MatrixFunctions>
+
+#include "sim/sim.hpp"
+
+namespace lcsim::sim {
+
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::RowVectorXd;
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+
+// Brent's method (Dekker–Brent zeroin) for a root of f in [a, b] with
+// f(a) f(b) <= 0. Returns the bracket end at which |f| is smallest once the
+// bracket is shorter than tol.
+template <class F>
+double brent_root(F&& f, double a, double b, double fa, double fb, double tol) {
+  if (fa == 0.0) return a;
+  if (fb == 0.0) return b;
+  double c = a, fc = fa, d = b - a, e = d;
+  for (int iter = 0; iter < 200; ++iter) {
+    if ((fb > 0) == (fc > 0)) {
+      c = a;
+      fc = fa;
+      d = e = b - a;
+    }
+    if (std::abs(fc) < std::abs(fb)) {
+      a = b;
+      b = c;
+      c = a;
+      fa = fb;
+      fb = fc;
+      fc = fa;
+    }
+    const double tol1 = 2.0 * kEps * std::abs(b) + 0.5 * tol;
+    const double xm = 0.5 * (c - b);
+    if (std::abs(xm) <= tol1 || fb == 0.0) return b;
+    if (std::abs(e) >= tol1 && std::abs(fa) > std::abs(fb)) {
+      double p, q, r;
+      const double s = fb / fa;
+      if (a == c) {
+        p = 2.0 * xm * s;
+        q = 1.0 - s;
+      } else {
+        q = fa / fc;
+        r = fb / fc;
+        p = s * (2.0 * xm * q * (q - r) - (b - a) * (r - 1.0));
+        q = (q - 1.0) * (r - 1.0) * (s - 1.0);
+      }
+      if (p > 0) q = -q;
+      p = std::abs(p);
+      if (2.0 * p < std::min(3.0 * xm * q - std::abs(tol1 * q), std::abs(e * q))) {
+        e = d;
+        d = p / q;
+      } else {
+        d = xm;
+        e = d;
+      }
+    } else {
+      d = xm;
+      e = d;
+    }
+    a = b;
+    fa = fb;
+    b += std::abs(d) > tol1 ? d : (xm > 0 ? tol1 : -tol1);
+    fb = f(b);
+  }
+  return b;
+}
+
+struct Monitor {
+  RowVectorXd w;    // phi(t) = w x(t)
+  RowVectorXd wA;   // phi'(t) = w Acl x(t)
+  double scale;     // |w| |x| scale for tolerances
+  int constraint;   // which constraint
+  bool multiplier;  // true: u_i of an active constraint; false: free output y_i
+};
+
+struct Phase {
+  lcs::IndexSet mode;
+  MatrixXd Acl;  // closed-loop matrix
+  MatrixXd F;    // u_I = F x (|I| x n)
+  std::vector<Monitor> monitors;
+};
+
+struct EventResult {
+  bool ok = false;
+  std::string message;
+  VectorXd x_plus;
+  lcs::IndexSet mode;
+  VectorXd impulse;  // sum of the impulses applied (size k)
+  bool jumped = false;
+  bool accumulation = false;
+  long lcp_solves = 0;
+};
+
+class EventDriven {
+ public:
+  EventDriven(const mech::Model& model, const Options& opt)
+      : model_(model), opt_(opt), sys_(model.as_lcs()) {
+    n_ = sys_.n();
+    k_ = sys_.k();
+    if (model.is_mechanical()) {
+      N_ = model.mechanical->dofs();
+      restitution_ = model.mechanical->restitution;
+    }
+    solver_ = lcp::make_solver(opt.lcp_solver);
+    impact_ = impact::make_impact_law(opt.impact);
+    last_impact_.assign(k_, -std::numeric_limits<double>::infinity());
+    ldcp_.solver = solver_.get();
+  }
+
+  Trajectory run(const VectorXd& x0_user);
+
+ private:
+  VectorXd augment(const VectorXd& x) const {
+    if (!model_.is_mechanical()) return x;
+    VectorXd xa(n_);
+    xa << x, 1.0;
+    return xa;
+  }
+  VectorXd user(const VectorXd& xa) const {
+    return model_.is_mechanical() ? VectorXd(xa.head(2 * N_)) : xa;
+  }
+  bool is_zero(double value, double scale) const {
+    return std::abs(value) <= ldcp_.tol_rel * scale + ldcp_.tol_abs;
+  }
+
+  Phase make_phase(const lcs::IndexSet& mode, const lcs::IndexSet& undetermined,
+                   const VectorXd& xa, std::string& err) const;
+  EventResult process_event(double t, const VectorXd& xa);
+  EventResult process_mechanical(double t, const VectorXd& xa);
+  EventResult process_lcs(const VectorXd& xa);
+  void record(Trajectory& tr, double t, const VectorXd& xa, const Phase& ph) const;
+  VectorXd multipliers(const Phase& ph, const VectorXd& xa) const {
+    VectorXd u = VectorXd::Zero(k_);
+    if (!ph.mode.empty()) {
+      const VectorXd uI = ph.F * xa;
+      for (size_t i = 0; i < ph.mode.size(); ++i) u(ph.mode[i]) = uI(i);
+    }
+    return u;
+  }
+  double violation(const VectorXd& xa) const {
+    if (k_ == 0) return 0.0;
+    const VectorXd y = sys_.C * xa;  // D u is zero for mechanical models
+    return std::min(0.0, y.minCoeff());
+  }
+  double energy(const VectorXd& xa) const {
+    if (!model_.is_mechanical()) return 0.0;
+    return mech::total_energy(*model_.mechanical, xa.head(N_), xa.segment(N_, N_));
+  }
+  void warn(Trajectory& tr, const std::string& w) const {
+    ++tr.warnings;
+    if (tr.warning_messages.size() < 10) tr.warning_messages.push_back(w);
+  }
+
+  const mech::Model& model_;
+  const Options& opt_;
+  lcs::Lcs sys_;
+  int n_ = 0, k_ = 0, N_ = 0;
+  VectorXd restitution_;
+  std::unique_ptr<lcp::Solver> solver_;
+  std::unique_ptr<impact::ImpactLaw> impact_;
+  lcs::LdcpOptions ldcp_;
+  std::vector<double> last_impact_;
+  lcs::IndexSet ldcp_undetermined_;  // K of the last mode selection
+};
+
+Phase EventDriven::make_phase(const lcs::IndexSet& mode, const lcs::IndexSet& undetermined,
+                              const VectorXd& xa, std::string& err) const {
+  Phase ph;
+  ph.mode = mode;
+  ph.Acl = sys_.A;
+  ph.F = MatrixXd::Zero(mode.size(), n_);
+  if (!mode.empty()) {
+    const lcs::ModeFeedback fb = lcs::mode_feedback(sys_, mode);
+    if (!fb.ok) {
+      err = "mode feedback F_I unavailable: " + fb.message;
+      return ph;
+    }
+    ph.F = fb.F;
+    MatrixXd BI(n_, mode.size());
+    for (size_t i = 0; i < mode.size(); ++i) BI.col(i) = sys_.B.col(mode[i]);
+    ph.Acl += BI * ph.F;
+  }
+  for (int r = 0; r < k_; ++r) {
+    const auto in_mode = std::find(mode.begin(), mode.end(), r);
+    Monitor mon;
+    mon.constraint = r;
+    if (in_mode != mode.end()) {
+      mon.multiplier = true;
+      mon.w = ph.F.row(in_mode - mode.begin());
+    } else {
+      if (std::find(undetermined.begin(), undetermined.end(), r) != undetermined.end())
+        continue;  // y_r and u_r vanish identically in this mode (Remark 3.4.8)
+      mon.multiplier = false;
+      RowVectorXd w = sys_.C.row(r);
+      for (size_t i = 0; i < mode.size(); ++i) w += sys_.D(r, mode[i]) * ph.F.row(i);
+      mon.w = w;
+    }
+    mon.wA = mon.w * ph.Acl;
+    mon.scale = mon.w.cwiseAbs().dot(xa.cwiseAbs());
+    ph.monitors.push_back(std::move(mon));
+  }
+  return ph;
+}
+
+EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
+  EventResult out;
+  out.impulse = VectorXd::Zero(k_);
+  VectorXd xa = xa0;
+  const mech::MechanicalModel& m = *model_.mechanical;
+  for (int iter = 0; iter < 100; ++iter) {
+    const VectorXd q = xa.head(N_), v = xa.segment(N_, N_);
+    const VectorXd gap = m.E * q + m.g;
+    const VectorXd gap_scale = m.E.cwiseAbs() * q.cwiseAbs() + m.g.cwiseAbs();
+    const VectorXd rate = m.E * v;
+    const VectorXd rate_scale = m.E.cwiseAbs() * v.cwiseAbs();
+    impact::ImpactInput in;
+    in.model = &m;
+    in.q = q;
+    in.v = v;
+    bool approaching = false;
+    bool accumulation = false;
+    for (int r = 0; r < k_; ++r) {
+      if (gap(r) < 0.0 && !is_zero(gap(r), gap_scale(r))) {
+        std::ostringstream msg;
+        msg.precision(6);
+        msg << "constraint '" << m.constraints[r] << "' is violated at t = " << t
+            << " (gap = " << gap(r)
+            << "): the state is infeasible, E q + g >= 0 must hold (thesis §3.8)";
+        out.message = msg.str();
+        return out;
+      }
+      if (!is_zero(gap(r), gap_scale(r))) continue;
+      in.closed.push_back(r);
+      if (rate(r) < 0.0 && !is_zero(rate(r), rate_scale(r))) {
+        approaching = true;
+        if (restitution_(r) > 0.0 && t - last_impact_[r] < opt_.accumulation_dt)
+          accumulation = true;
+      }
+    }
+    if (!approaching) break;
+    // Right-accumulation of impacts (Remark 3.4.11): the bounces have become
+    // shorter than accumulation_dt; take the limit, an inelastic impact.
+    in.restitution = restitution_;
+    if (accumulation) {
+      in.restitution = VectorXd::Zero(k_);
+      out.accumulation = true;
+    }
+    const impact::ImpactResult ir = impact_->apply(in, *solver_);
+    out.lcp_solves += ir.lcp_solves;
+    if (!ir.ok) {
+      out.message = "impact at t = " + std::to_string(t) + ": " + ir.message;
+      return out;
+    }
+    xa.segment(N_, N_) = ir.v_after;
+    out.impulse += ir.impulse;
+    out.jumped = true;
+    for (int r : in.closed)
+      if (ir.impulse(r) > 0.0) last_impact_[r] = t;
+    if (iter == 99) {
+      out.message = "impacts at t = " + std::to_string(t) +
+                    " did not end after 100 rounds of the impact law";
+      return out;
+    }
+  }
+  lcs::LdcpOptions o = ldcp_;
+  o.regular_only = true;  // the state is now regular: contact forces and higher
+  const lcs::ModeSelection sel = lcs::select_mode(sys_, xa, o);
+  out.lcp_solves += sel.lcp_solves;
+  if (!sel.ok) {
+    out.message = "mode selection at t = " + std::to_string(t) + ": " + sel.message;
+    return out;
+  }
+  out.mode = sel.mode;
+  out.x_plus = xa;
+  out.ok = true;
+  ldcp_undetermined_ = sel.undetermined;
+  return out;
+}
+
+EventResult EventDriven::process_lcs(const VectorXd& xa0) {
+  EventResult out;
+  out.impulse = VectorXd::Zero(k_);
+  VectorXd xa = xa0;
+  // Theorem 3.6.3: with P-matrix leading coefficients at most one jump occurs;
+  // a few more rounds are allowed and then reported.
+  for (int iter = 0; iter < 4; ++iter) {
+    const lcs::ModeSelection sel = lcs::select_mode(sys_, xa, ldcp_);
+    out.lcp_solves += sel.lcp_solves;
+    if (!sel.ok) {
+      out.message = "mode selection: " + sel.message;
+      return out;
+    }
+    bool impulsive = false;
+    for (const auto& imp : sel.impulse)
+      if (!imp.isZero(0.0)) impulsive = true;
+    if (!impulsive) {
+      out.mode = sel.mode;
+      out.x_plus = xa;
+      out.ok = true;
+      ldcp_undetermined_ = sel.undetermined;
+      return out;
+    }
+    out.impulse += sel.impulse[0];
+    out.jumped = true;
+    xa = sel.x_plus;
+  }
+  out.message = "re-initialisation did not reach a regular state after 4 jumps";
+  return out;
+}
+
+EventResult EventDriven::process_event(double t, const VectorXd& xa) {
+  return model_.is_mechanical() ? process_mechanical(t, xa) : process_lcs(xa);
+}
+
+void EventDriven::record(Trajectory& tr, double t, const VectorXd& xa, const Phase& ph) const {
+  tr.max_violation = std::min(tr.max_violation, violation(xa));
+  if (!opt_.record_samples) return;
+  Sample s;
+  s.t = t;
+  s.x = user(xa);
+  s.u = multipliers(ph, xa);
+  s.y = sys_.C * xa + sys_.D * s.u;
+  s.mode = ph.mode;
+  tr.samples.push_back(std::move(s));
+}
+
+Trajectory EventDriven::run(const VectorXd& x0_user) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  Trajectory tr;
+  tr.method = "event";
+  tr.t_end = opt_.t_end;
+  auto fail = [&](const std::string& msg) {
+    tr.status = RunStatus::kFailed;
+    tr.message = msg;
+  };
+  VectorXd xa = augment(x0_user);
+  tr.energy_initial = energy(xa);
+  double t = 0.0;
+
+  // Initial mode selection (and jump, if the initial state is not regular).
+  EventResult ev = process_event(t, xa);
+  tr.lcp_solves += ev.lcp_solves;
+  std::string err;
+  Phase phase;
+  if (!ev.ok) {
+    fail(ev.message);
+  } else {
+    phase = make_phase(ev.mode, ldcp_undetermined_, ev.x_plus, err);
+    if (!err.empty()) fail(err);
+  }
+  if (tr.status == RunStatus::kFailed) {
+    tr.final_state = x0_user;
+    tr.energy_final = tr.energy_initial;
+    return tr;
+  }
+  if (ev.jumped) {
+    Phase before = phase;
+    before.mode.clear();
+    before.F.resize(0, n_);
+    record(tr, t, xa, before);
+    Event e;
+    e.t = t;
+    e.type = EventType::kImpact;
+    e.state_before = user(xa);
+    e.state_after = user(ev.x_plus);
+    e.mode_after = ev.mode;
+    e.impulse = ev.impulse;
+    tr.events.push_back(std::move(e));
+  }
+  xa = ev.x_plus;
+  record(tr, t, xa, phase);
+
+  const double t_end = opt_.t_end;
+  long events_in_window = 0;
+  double window_start = 0.0;
+  while (t < t_end) {
+    ++tr.steps;
+    // Sampling step: a quarter of the fastest time scale of the closed loop,
+    // so a Bohl function changes the sign of its derivative at most once
+    // between samples; first steps shorter where a monitor starts at zero.
+    Eigen::EigenSolver<MatrixXd> es(phase.Acl, false);
+    const double rho = es.eigenvalues().cwiseAbs().maxCoeff();
+    double h_max = t_end - t;
+    if (rho > 0.0) h_max = std::min(h_max, 0.5 / rho);
+    h_max = std::min(h_max, (t_end - t) / 4.0 + 1e-300);
+    double h_first = h_max;
+    const VectorXd xstart = xa;
+    // Noise level of each monitor at the phase start: rounding of its terms
+    // plus the time quantisation of the event time (ulp(t) times its rate).
+    std::vector<double> noise(phase.monitors.size());
+    for (size_t j = 0; j < phase.monitors.size(); ++j) {
+      const Monitor& mon = phase.monitors[j];
+      // Consistent with the zero test of mode selection (LdcpOptions), so a
+      // value the mode selection called zero is not taken for a crossing.
+      noise[j] = ldcp_.tol_rel * mon.scale + ldcp_.tol_abs +
+                 (16.0 * kEps * std::max(1.0, std::abs(t)) + opt_.event_time_tol) *
+                     std::abs(mon.wA.dot(xstart));
+    }
+    {
+      // Derivatives of the monitors at the phase start: d_m = w Acl^m x.
+      std::vector<VectorXd> d;
+      VectorXd Amx = xstart;
+      for (int m = 0; m <= n_; ++m) {
+        VectorXd col(phase.monitors.size());
+        for (size_t j = 0; j < phase.monitors.size(); ++j) col(j) = phase.monitors[j].w * Amx;
+        d.push_back(col);
+        Amx = phase.Acl * Amx;
+      }
+      for (size_t j = 0; j < phase.monitors.size(); ++j) {
+        // Time scale of the first two nonzero Taylor terms.
+        int m0 = -1;
+        for (int m = 0; m <= n_; ++m) {
+          if (std::abs(d[m](j)) > (m == 0 ? noise[j] : 1e-300)) {
+            m0 = m;
+            break;
+          }
+        }
+        if (m0 < 0) continue;
+        for (int m = m0 + 1; m <= n_; ++m) {
+          if (std::abs(d[m](j)) > 1e-300) {
+            // |d_m0| t^m0/m0! = |d_m| t^m/m!  ->  t = (|d_m0| m!/(m0! |d_m|))^(1/(m-m0))
+            double ratio = std::abs(d[m0](j)) / std::abs(d[m](j));
+            double f = 1.0;
+            for (int i = m0 + 1; i <= m; ++i) f *= i;
+            const double tau = std::pow(ratio * f, 1.0 / (m - m0));
+            h_first = std::min(h_first, 0.25 * tau);
+            break;
+          }
+        }
+      }
+    }
+    h_first = std::max(h_first, 1e-15 * std::max(1.0, std::abs(t)));
+
+    // March over the samples of this phase.
+    double ta = t;
+    VectorXd xa_a = xstart;
+    double h = h_first;
+    double t_event = std::numeric_limits<double>::infinity();
+    bool event_found = false;
+    double next_out = opt_.dt_out > 0 ? (std::floor(t / opt_.dt_out + 1e-9) + 1) * opt_.dt_out
+                                      : std::numeric_limits<double>::infinity();
+    auto state_at = [&](double tt) -> VectorXd {
+      return (phase.Acl * (tt - t)).exp() * xstart;
+    };
+    while (ta < t_end && !event_found) {
+      const double tb = std::min(ta + h, t_end);
+      const MatrixXd Phi = (phase.Acl * (tb - ta)).exp();
+      const VectorXd xa_b = Phi * xa_a;
+      for (size_t j = 0; j < phase.monitors.size(); ++j) {
+        const Monitor& mon = phase.monitors[j];
+        const double fa = mon.w * xa_a;
+        const double fb = mon.w * xa_b;
+        const double tol_f = 1e-12 * mon.scale;
+        auto phi = [&](double tt) -> double { return mon.w * ((phase.Acl * (tt - ta)).exp() * xa_a); };
+        auto dphi = [&](double tt) -> double { return mon.wA * ((phase.Acl * (tt - ta)).exp() * xa_a); };
+        double root = std::numeric_limits<double>::infinity();
+        const bool at_start = ta == t;
+        if (at_start && fa <= noise[j] && fb >= -noise[j]) {
+          // Still within rounding of zero just after the phase start.
+        } else if (fb < 0.0) {
+          double lo = ta, flo = fa;
+          if (fa <= (at_start ? noise[j] : 0.0)) {
+            // Only at a phase start: the function starts at zero (a gap just
+            // released, a force just engaged) and is positive just after by
+            // the lexicographic mode selection. Start the bracket where it is.
+            double c = ta + (tb - ta) / 1024.0;
+            double fc = phi(c);
+            int tries = 0;
+            while (fc <= 0.0 && tries++ < 40) {
+              c = ta + (c - ta) / 2.0;
+              fc = phi(c);
+            }
+            if (fc <= 0.0 || ta != t) {
+              root = ta;  // it turns negative at once: an event now
+            } else {
+              lo = c;
+              flo = fc;
+            }
+          }
+          if (!std::isfinite(root))
+            root = brent_root(phi, lo, tb, flo, fb, opt_.event_time_tol);
+        } else if (fa > 0.0) {
+          // Grazing: positive at both ends, derivative from - to +.
+          const double da = mon.wA * xa_a;
+          const double db = mon.wA * xa_b;
+          if (da < 0.0 && db > 0.0) {
+            const double tm = brent_root(dphi, ta, tb, da, db, opt_.event_time_tol);
+            const double fm = phi(tm);
+            if (fm < 0.0) {
+              root = brent_root(phi, ta, tm, fa, fm, opt_.event_time_tol);
+            } else if (fm <= tol_f) {
+              root = tm;  // touches zero with zero rate
+            }
+          }
+        }
+        if (root < t_event) t_event = root;
+      }
+      if (std::isfinite(t_event)) {
+        event_found = true;
+      } else {
+        // Exact output samples inside (ta, tb].
+        while (next_out <= tb && next_out < t_end) {
+          record(tr, next_out, state_at(next_out), phase);
+          next_out += opt_.dt_out;
+        }
+        ta = tb;
+        xa_a = xa_b;
+        h = std::min(2.0 * h, h_max);
+      }
+    }
+    if (!event_found) {
+      // Reached the horizon.
+      const VectorXd xend = state_at(t_end);
+      record(tr, t_end, xend, phase);
+      xa = xend;
+      t = t_end;
+      break;
+    }
+    // Output samples before the event.
+    while (next_out < t_event) {
+      record(tr, next_out, state_at(next_out), phase);
+      next_out += opt_.dt_out;
+    }
+    const VectorXd x_minus = state_at(t_event);
+    record(tr, t_event, x_minus, phase);
+    t = t_event;
+    // Zeno guard.
+    if (t - window_start > 1.0) {
+      window_start = t;
+      events_in_window = 0;
+    }
+    if (++events_in_window > opt_.max_events_per_unit_time ||
+        static_cast<long>(tr.events.size()) >= opt_.max_events) {
+      std::ostringstream msg;
+      msg << "more than " << events_in_window << " events in less than unit time near t = " << t
+          << ": the event times accumulate without a limit the simulator can take";
+      fail(msg.str());
+      xa = x_minus;
+      break;
+    }
+    ev = process_event(t, x_minus);
+    tr.lcp_solves += ev.lcp_solves;
+    if (!ev.ok) {
+      fail(ev.message);
+      xa = x_minus;
+      break;
+    }
+    const lcs::IndexSet old_mode = phase.mode;
+    phase = make_phase(ev.mode, ldcp_undetermined_, ev.x_plus, err);
+    if (!err.empty()) {
+      fail(err);
+      xa = x_minus;
+      break;
+    }
+    xa = ev.x_plus;
+    Event e;
+    e.t = t;
+    e.state_before = user(x_minus);
+    e.state_after = user(xa);
+    e.mode_after = ev.mode;
+    e.impulse = ev.impulse;
+    if (ev.accumulation) {
+      e.type = EventType::kAccumulation;
+    } else if (ev.jumped) {
+      e.type = EventType::kImpact;
+    } else {
+      bool gained = false, lost = false;
+      for (int r : ev.mode)
+        if (std::find(old_mode.begin(), old_mode.end(), r) == old_mode.end()) gained = true;
+      for (int r : old_mode)
+        if (std::find(ev.mode.begin(), ev.mode.end(), r) == ev.mode.end()) lost = true;
+      e.type = lost && !gained ? EventType::kRelease : EventType::kContact;
+      if (!gained && !lost) {
+        // A graze or a re-selection of the same mode: not a mode change.
+        record(tr, t, xa, phase);
+        continue;
+      }
+    }
+    tr.events.push_back(std::move(e));
+    record(tr, t, xa, phase);
+  }
+  tr.final_state = user(xa);
+  tr.energy_final = energy(xa);
+  tr.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return tr;
+}
+
+}  // namespace
+
+Trajectory simulate_event_driven(const mech::Model& model, const VectorXd& x0,
+                                 const Options& opt) {
+  EventDriven ed(model, opt);
+  return ed.run(x0);
+}
+
+}  // namespace lcsim::sim
