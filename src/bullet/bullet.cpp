@@ -1,0 +1,14 @@
+#include "bullet/bullet.hpp"
+
+#include <LinearMath/btScalar.h>
+
+namespace lcsim::bullet {
+
+std::string version_string() {
+  static_assert(sizeof(btScalar) == sizeof(double), "lcsim links Bullet in double precision");
+  const int v = btGetVersion();
+  return "Bullet " + std::to_string(v / 100) + "." + std::to_string(v % 100) +
+         " (double precision)";
+}
+
+}  // namespace lcsim::bullet
