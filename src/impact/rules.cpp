@@ -113,10 +113,17 @@ ImpactResult flip_rule(const ImpactInput& in) {
   if (!out.admissible) {
     std::ostringstream msg;
     msg << "not an admissible solution:";
-    for (int i : sel)
-      if (impulse_J(i) < 0.0)
-        msg << " impulse " << impulse_J(i) << " < 0 on constraint " << in.closed[i] << ";";
-    if (out.worst_rate < 0.0) msg << " worst E_J v+ = " << out.worst_rate << ";";
+    bool negative = false;
+    for (int i : sel) {
+      if (impulse_J(i) >= 0.0) continue;
+      const int c = in.closed[i];
+      const std::string name = c < static_cast<int>(in.model->constraints.size())
+                                   ? in.model->constraints[c]
+                                   : std::to_string(c);
+      msg << " impulse " << impulse_J(i) << " < 0 on constraint '" << name << "';";
+      negative = true;
+    }
+    if (!negative) msg << " E_J v+ = " << out.worst_rate << " < 0;";
     out.message = msg.str();
     out.message.pop_back();
     out.message += " (rule [177], Example 3.8.3)";

@@ -1,0 +1,314 @@
+// `lcsim impacts MODEL`: compare the impact rules of src/impact on one state,
+// or draw the impact map of thesis Figure 3.5 for a two-coordinate model.
+//
+//   lcsim impacts MODEL [--x0 q,v] [--rules all|a,b] [--restitution e|e1,e2,..] [--json]
+//   lcsim impacts MODEL --map lo:hi[:n],lo:hi[:n] [--x0 q,v] [--plot map.png]  (q = 0 by default)
+//
+// The closed set is the constraints with zero gap at q, with the integrator's
+// tolerance |gap| <= 1e-9 (|E_i||q| + |g_i|) + 1e-13. Exit 2 on bad input, 3
+// if a rule failed (the table is printed first).
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "cli/command.hpp"
+#include "impact/impact.hpp"
+#include "io/io.hpp"
+
+namespace lcsim::cli {
+namespace {
+
+struct ImpactsArgs {
+  std::string model;
+  std::string x0;
+  std::string rules = "all";
+  std::string restitution;
+  bool json = false;
+  std::string map;
+  std::string plot;
+};
+
+std::string fmt_vec(const Eigen::VectorXd& v) {
+  std::string s = "(";
+  char buf[64];
+  for (int i = 0; i < v.size(); ++i) {
+    std::snprintf(buf, sizeof buf, "%s%.6g", i ? ", " : "", v(i));
+    s += buf;
+  }
+  return s + ")";
+}
+
+std::string mode_text(const mech::MechanicalModel& m, const impact::IndexSet& mode,
+                      const char* sep) {
+  if (mode.empty()) return "unconstrained";
+  std::string s;
+  for (size_t i = 0; i < mode.size(); ++i) s += (i ? sep : "") + m.constraints[mode[i]];
+  return s;
+}
+
+std::vector<std::string> split(const std::string& text, char sep) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, sep)) out.push_back(item);
+  return out;
+}
+
+// The state (q, v) to work on: --x0 or the model's initial state.
+Eigen::VectorXd initial_state(const ImpactsArgs& a, const mech::Model& model) {
+  Eigen::VectorXd x0 = model.initial;
+  if (!a.x0.empty()) x0 = io::parse_vector(a.x0, "--x0");
+  if (x0.size() == 0)
+    throw io::InputError(a.model + ": no state: give --x0 or `initial` in the model");
+  if (x0.size() != model.state_size())
+    throw io::InputError("--x0: has " + std::to_string(x0.size()) + " entries, the model '" +
+                         model.name + "' has a state of size " +
+                         std::to_string(model.state_size()) + " (q then v)");
+  return x0;
+}
+
+Eigen::VectorXd restitution(const ImpactsArgs& a, const mech::MechanicalModel& m) {
+  const int k = m.num_constraints();
+  if (a.restitution.empty()) return m.restitution;
+  Eigen::VectorXd e = io::parse_vector(a.restitution, "--restitution");
+  if (e.size() == 1) e = Eigen::VectorXd::Constant(k, e(0));
+  if (e.size() != k)
+    throw io::InputError("--restitution: give one coefficient or " + std::to_string(k) +
+                         " (one per constraint), got " + std::to_string(e.size()));
+  for (int i = 0; i < k; ++i)
+    if (!(e(i) >= 0.0 && e(i) <= 1.0))
+      throw io::InputError("--restitution: coefficients must lie in [0, 1] (got " +
+                           std::to_string(e(i)) + ")");
+  return e;
+}
+
+// Closed set at q; an open-violated constraint is an input error.
+impact::IndexSet closed_set(const mech::MechanicalModel& m, const Eigen::VectorXd& q) {
+  const Eigen::VectorXd gap = m.E * q + m.g;
+  const Eigen::VectorXd scale = m.E.cwiseAbs() * q.cwiseAbs() + m.g.cwiseAbs();
+  impact::IndexSet closed;
+  for (int i = 0; i < m.num_constraints(); ++i) {
+    const bool zero = std::abs(gap(i)) <= 1e-9 * scale(i) + 1e-13;
+    if (!zero && gap(i) < 0.0) {
+      std::ostringstream msg;
+      msg << "--x0: constraint '" << m.constraints[i] << "' is violated (gap = " << gap(i)
+          << "): E q + g >= 0 must hold before an impact (thesis §3.8)";
+      throw io::InputError(msg.str());
+    }
+    if (zero) closed.push_back(i);
+  }
+  return closed;
+}
+
+std::vector<std::string> rule_list(const std::string& text) {
+  if (text == "all") return impact::impact_law_names();
+  std::vector<std::string> out = split(text, ',');
+  if (out.empty()) throw io::InputError("--rules: empty list (give all or a,b,...)");
+  for (const auto& n : out) (void)impact::make_impact_law(n);  // invalid_argument -> exit 2
+  return out;
+}
+
+void run_compare(const ImpactsArgs& a, const mech::Model& model) {
+  const mech::MechanicalModel& m = *model.mechanical;
+  const int N = m.dofs();
+  const Eigen::VectorXd x0 = initial_state(a, model);
+  const std::vector<std::string> rules = rule_list(a.rules);
+  impact::ImpactInput in;
+  in.model = &m;
+  in.q = x0.head(N);
+  in.v = x0.tail(N);
+  in.closed = closed_set(m, in.q);
+  in.restitution = restitution(a, m);
+  const auto solver = lcp::make_solver("pivot");
+  std::vector<std::pair<std::string, impact::ImpactResult>> results;
+  for (const auto& name : rules)
+    results.emplace_back(name, impact::make_impact_law(name)->apply(in, *solver));
+
+  std::string failures;
+  for (const auto& [name, r] : results)
+    if (!r.ok) failures += (failures.empty() ? "" : "; ") + name + ": " + r.message;
+  if (a.json) {
+    nlohmann::json j;
+    j["model"] = model.name;
+    j["state_before"] = io::to_json(x0);
+    nlohmann::json closed = nlohmann::json::array();
+    for (int i : in.closed) closed.push_back(m.constraints[i]);
+    j["closed"] = closed;
+    j["restitution"] = io::to_json(in.restitution);
+    nlohmann::json js = nlohmann::json::object();
+    for (const auto& [name, r] : results) {
+      Eigen::VectorXd after(2 * N);
+      after << in.q, r.v_after;
+      nlohmann::json mode = nlohmann::json::array();
+      for (int i : r.mode) mode.push_back(m.constraints[i]);
+      js[name] = {{"ok", r.ok},
+                  {"state_after", io::to_json(after)},
+                  {"impulse", io::to_json(r.impulse)},
+                  {"mode", mode},
+                  {"energy_before", r.energy_before},
+                  {"energy_after", r.energy_after},
+                  {"worst_violation", r.worst_rate},
+                  {"admissible", r.admissible},
+                  {"message", r.message}};
+    }
+    j["rules"] = js;
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::printf("model %s at state %s, closed {", model.name.c_str(), fmt_vec(x0).c_str());
+    for (size_t i = 0; i < in.closed.size(); ++i)
+      std::printf("%s%s", i ? ", " : "", m.constraints[in.closed[i]].c_str());
+    std::printf("}, restitution %s\n", fmt_vec(in.restitution).c_str());
+    std::printf("%-19s %-28s %-24s %-18s %-12s %-12s %-10s %s\n", "rule", "velocity after",
+                "impulse", "mode", "T before", "T after", "worst Ev+", "note");
+    for (const auto& [name, r] : results) {
+      std::string note = r.ok ? (r.admissible ? "" : "NOT ADMISSIBLE ") : "FAILED ";
+      note += r.message;
+      std::printf("%-19s %-28s %-24s %-18s %-12.6g %-12.6g %-10.3g %s\n", name.c_str(),
+                  fmt_vec(r.v_after).c_str(), fmt_vec(r.impulse).c_str(),
+                  mode_text(m, r.mode, ",").c_str(), r.energy_before, r.energy_after, r.worst_rate,
+                  note.c_str());
+    }
+  }
+  std::cout.flush();
+  if (!failures.empty()) throw NumericalError(failures);
+}
+
+struct Range {
+  double lo, hi;
+  int n;
+};
+
+Range parse_range(const std::string& text) {
+  const std::vector<std::string> parts = split(text, ':');
+  const std::string what = "--map: range '" + text + "'";
+  if (parts.size() < 2 || parts.size() > 3)
+    throw io::InputError(what + ": expected lo:hi or lo:hi:n");
+  Range r{};
+  try {
+    size_t pos = 0;
+    r.lo = std::stod(parts[0], &pos);
+    if (pos != parts[0].size()) throw std::invalid_argument("");
+    r.hi = std::stod(parts[1], &pos);
+    if (pos != parts[1].size()) throw std::invalid_argument("");
+    r.n = parts.size() == 3 ? std::stoi(parts[2], &pos) : 41;
+    if (parts.size() == 3 && pos != parts[2].size()) throw std::invalid_argument("");
+  } catch (const std::exception&) {
+    throw io::InputError(what + ": not numbers");
+  }
+  if (!std::isfinite(r.lo) || !std::isfinite(r.hi) || !(r.lo < r.hi))
+    throw io::InputError(what + ": need finite lo < hi");
+  if (r.n < 2 || r.n > 2001) throw io::InputError(what + ": n must lie in [2, 2001]");
+  return r;
+}
+
+std::filesystem::path find_plot_script() {
+  namespace fs = std::filesystem;
+  if (const char* env = std::getenv("LCSIM_PLOT_IMPACT_MAP")) return env;
+  std::vector<fs::path> roots = {fs::current_path()};
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec)
+    for (fs::path p = exe.parent_path(); !p.empty() && p != p.root_path(); p = p.parent_path())
+      roots.push_back(p);
+  for (const auto& r : roots)
+    if (fs::exists(r / "bench" / "plot_impact_map.py")) return r / "bench" / "plot_impact_map.py";
+  throw std::runtime_error(
+      "bench/plot_impact_map.py not found near the working directory or the lcsim binary "
+      "(set LCSIM_PLOT_IMPACT_MAP)");
+}
+
+void run_map(const ImpactsArgs& a, const mech::Model& model) {
+  const mech::MechanicalModel& m = *model.mechanical;
+  if (m.dofs() != 2)
+    throw io::InputError("--map: needs a model with two coordinates, '" + model.name + "' has " +
+                         std::to_string(m.dofs()));
+  const std::vector<std::string> ranges = split(a.map, ',');
+  if (ranges.size() != 2) throw io::InputError("--map: expected v1range,v2range (lo:hi[:n] each)");
+  const Range r1 = parse_range(ranges[0]), r2 = parse_range(ranges[1]);
+  // Figure 3.5 is drawn at x1 = x2 = 0: q = 0 unless --x0 gives another q.
+  const Eigen::VectorXd x0 = a.x0.empty() ? Eigen::VectorXd::Zero(4) : initial_state(a, model);
+  impact::ImpactInput in;
+  in.model = &m;
+  in.q = x0.head(2);
+  in.closed = closed_set(m, in.q);
+  if (static_cast<int>(in.closed.size()) != m.num_constraints())
+    throw io::InputError("--map: every gap must be zero at q = " + fmt_vec(in.q) +
+                         " (Figure 3.5 is drawn at x1 = x2 = 0)");
+  in.restitution = restitution(a, m);
+  const auto law = impact::make_impact_law("moreau");
+  const auto solver = lcp::make_solver("pivot");
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "v1,v2,mode,v1+,v2+\n";
+  for (int i = 0; i < r1.n; ++i)
+    for (int j = 0; j < r2.n; ++j) {
+      in.v.resize(2);
+      in.v << r1.lo + (r1.hi - r1.lo) * i / (r1.n - 1), r2.lo + (r2.hi - r2.lo) * j / (r2.n - 1);
+      const impact::ImpactResult r = law->apply(in, *solver);
+      if (!r.ok)
+        throw NumericalError("--map: moreau failed at v = " + fmt_vec(in.v) + ": " + r.message);
+      csv << in.v(0) << "," << in.v(1) << "," << mode_text(m, r.mode, "+") << "," << r.v_after(0)
+          << "," << r.v_after(1) << "\n";
+    }
+  std::cout << csv.str();
+  std::cout.flush();
+  if (a.plot.empty()) return;
+  const std::filesystem::path script = find_plot_script();
+  const std::filesystem::path tmp = std::filesystem::temp_directory_path() /
+                                    ("lcsim_impact_map_" + std::to_string(::getpid()) + ".csv");
+  {
+    std::ofstream f(tmp);
+    f << csv.str();
+    if (!f) throw io::InputError("--plot: cannot write the temporary file " + tmp.string());
+  }
+  const std::string cmd = "/usr/bin/python3 '" + script.string() + "' '" + tmp.string() + "' '" +
+                          a.plot + "' --title '" + model.name + ": Moreau impact map (Figure 3.5)'";
+  const int rc = std::system(cmd.c_str());
+  std::filesystem::remove(tmp);
+  if (rc != 0) throw std::runtime_error("--plot: the plot script failed (" + cmd + ")");
+  std::cerr << "impact map written to " << a.plot << "\n";
+}
+
+void run_impacts(const ImpactsArgs& a) {
+  const mech::Model model = io::load_model(a.model);
+  if (!model.is_mechanical())
+    throw io::InputError(a.model + ": impact rules need a mechanical model (M, E), not `lcs:`");
+  if (!a.plot.empty() && a.map.empty()) throw io::InputError("--plot: only with --map");
+  if (a.plot.find('\'') != std::string::npos)
+    throw io::InputError("--plot: path must not contain '");
+  if (a.map.empty())
+    run_compare(a, model);
+  else
+    run_map(a, model);
+}
+
+void setup(CLI::App& app) {
+  auto a = std::make_shared<ImpactsArgs>();
+  auto* cmd = app.add_subcommand("impacts", "Compare impact rules on one state, or map them");
+  cmd->add_option("model", a->model, "Model file (YAML, mechanical)")->required();
+  cmd->add_option("--x0", a->x0, "State a,b,... (q then v); default: the model's");
+  std::string names;
+  for (const auto& n : impact::impact_law_names()) names += (names.empty() ? "" : ", ") + n;
+  cmd->add_option("--rules", a->rules, "all, or a comma list of: " + names);
+  cmd->add_option(
+      "--restitution", a->restitution,
+      "One coefficient for all constraints or one per constraint (default: the model's)");
+  cmd->add_flag("--json", a->json, "Print the results as JSON");
+  cmd->add_option(
+      "--map", a->map,
+      "Impact map of a two-coordinate model: v1lo:v1hi[:n],v2lo:v2hi[:n] (CSV on stdout)");
+  cmd->add_option("--plot", a->plot, "With --map: draw the map to this PNG (matplotlib)");
+  cmd->callback([a] { run_impacts(*a); });
+}
+
+LCSIM_REGISTER_COMMAND(setup);
+
+}  // namespace
+}  // namespace lcsim::cli
