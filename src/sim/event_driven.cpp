@@ -111,6 +111,7 @@ struct EventResult {
   VectorXd impulse;  // sum of the impulses applied (size k)
   bool jumped = false;
   bool accumulation = false;
+  double t_star = 0.0;  // extrapolated accumulation time (accumulation only)
   long lcp_solves = 0;
 };
 
@@ -126,7 +127,7 @@ class EventDriven {
     }
     solver_ = lcp::make_solver(opt.lcp_solver);
     impact_ = impact::make_impact_law(opt.impact);
-    last_impact_.assign(k_, -std::numeric_limits<double>::infinity());
+    impact_times_.assign(k_, {});
     ldcp_.solver = solver_.get();
   }
 
@@ -149,6 +150,7 @@ class EventDriven {
   Phase make_phase(const lcs::IndexSet& mode, const lcs::IndexSet& undetermined,
                    const VectorXd& xa, std::string& err) const;
   EventResult process_event(double t, const VectorXd& xa);
+  double accumulation_time(int r, double t) const;
   EventResult process_mechanical(double t, const VectorXd& xa);
   EventResult process_lcs(const VectorXd& xa);
   void record(Trajectory& tr, double t, const VectorXd& xa, const Phase& ph) const;
@@ -182,7 +184,7 @@ class EventDriven {
   std::unique_ptr<lcp::Solver> solver_;
   std::unique_ptr<impact::ImpactLaw> impact_;
   lcs::LdcpOptions ldcp_;
-  std::vector<double> last_impact_;
+  std::vector<std::vector<double>> impact_times_;  // last few impacts per contact
   lcs::IndexSet ldcp_undetermined_;  // K of the last mode selection
 };
 
@@ -225,6 +227,26 @@ Phase EventDriven::make_phase(const lcs::IndexSet& mode, const lcs::IndexSet& un
   return ph;
 }
 
+// Impacts of contact r at t_{k-3}, t_{k-2}, t_{k-1} and now t: when the
+// intervals shrink geometrically (two successive ratios agree to 1e-3) the
+// remaining bounces sum to d r/(1-r) (d the last interval, r the ratio); when
+// that tail is below 1e-5 max(1, t) s (or the last interval is below
+// accumulation_dt) the limit is taken. Returns the accumulation time, or -1.
+double EventDriven::accumulation_time(int r, double t) const {
+  const auto& h = impact_times_[r];
+  if (h.empty()) return -1.0;
+  const double d2 = t - h.back();
+  if (d2 < opt_.accumulation_dt) return t;
+  if (h.size() < 3) return -1.0;
+  const double d1 = h[h.size() - 1] - h[h.size() - 2];
+  const double d0 = h[h.size() - 2] - h[h.size() - 3];
+  if (!(d1 > 0.0 && d0 > 0.0)) return -1.0;
+  const double ratio = d2 / d1, ratio0 = d1 / d0;
+  if (!(ratio < 1.0) || std::abs(ratio - ratio0) > 1e-3 * ratio) return -1.0;
+  const double tail = d2 * ratio / (1.0 - ratio);
+  return tail < 1e-5 * std::max(1.0, std::abs(t)) ? t + tail : -1.0;
+}
+
 EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
   EventResult out;
   out.impulse = VectorXd::Zero(k_);
@@ -243,7 +265,11 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
     bool approaching = false;
     bool accumulation = false;
     for (int r = 0; r < k_; ++r) {
-      if (gap(r) < 0.0 && !is_zero(gap(r), gap_scale(r))) {
+      // Zero within rounding, or within what the event time's resolution
+      // (a few ulp of t times the rate) leaves in the gap.
+      const double gap_tol = ldcp_.tol_rel * gap_scale(r) + ldcp_.tol_abs +
+                             16.0 * kEps * std::max(1.0, std::abs(t)) * std::abs(rate(r));
+      if (gap(r) < -gap_tol) {
         std::ostringstream msg;
         msg.precision(6);
         msg << "constraint '" << m.constraints[r] << "' is violated at t = " << t
@@ -252,17 +278,22 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
         out.message = msg.str();
         return out;
       }
-      if (!is_zero(gap(r), gap_scale(r))) continue;
+      if (gap(r) > gap_tol) continue;
       in.closed.push_back(r);
       if (rate(r) < 0.0 && !is_zero(rate(r), rate_scale(r))) {
         approaching = true;
-        if (restitution_(r) > 0.0 && t - last_impact_[r] < opt_.accumulation_dt)
-          accumulation = true;
+        if (restitution_(r) > 0.0) {
+          const double ts = accumulation_time(r, t);
+          if (ts >= t) {
+            accumulation = true;
+            out.t_star = std::max(out.t_star, ts);
+          }
+        }
       }
     }
     if (!approaching) break;
-    // Right-accumulation of impacts (Remark 3.4.11): the bounces have become
-    // shorter than accumulation_dt; take the limit, an inelastic impact.
+    // Right-accumulation of impacts (Remark 3.4.11): take the limit, an
+    // inelastic impact, and continue from the accumulation time.
     in.restitution = restitution_;
     if (accumulation) {
       in.restitution = VectorXd::Zero(k_);
@@ -278,7 +309,11 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
     out.impulse += ir.impulse;
     out.jumped = true;
     for (int r : in.closed)
-      if (ir.impulse(r) > 0.0) last_impact_[r] = t;
+      if (ir.impulse(r) > 0.0) {
+        auto& h = impact_times_[r];
+        if (h.empty() || h.back() != t) h.push_back(t);
+        if (h.size() > 4) h.erase(h.begin());
+      }
     if (iter == 99) {
       out.message = "impacts at t = " + std::to_string(t) +
                     " did not end after 100 rounds of the impact law";
@@ -413,34 +448,43 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     std::vector<double> noise(phase.monitors.size());
     for (size_t j = 0; j < phase.monitors.size(); ++j) {
       const Monitor& mon = phase.monitors[j];
-      // Consistent with the zero test of mode selection (LdcpOptions), so a
-      // value the mode selection called zero is not taken for a crossing.
-      noise[j] = ldcp_.tol_rel * mon.scale + ldcp_.tol_abs +
+      noise[j] = 64.0 * kEps * mon.w.cwiseAbs().sum() * xstart.cwiseAbs().maxCoeff() +
                  (16.0 * kEps * std::max(1.0, std::abs(t)) + opt_.event_time_tol) *
                      std::abs(mon.wA.dot(xstart));
     }
     {
       // Derivatives of the monitors at the phase start: d_m = w Acl^m x.
-      std::vector<VectorXd> d;
+      // A derivative is rounding noise when below the zero test of mode
+      // selection applied to the magnitudes of its terms |w| |Acl|^m |x|.
+      std::vector<VectorXd> d, dzero;
       VectorXd Amx = xstart;
+      VectorXd Amx_abs = xstart.cwiseAbs();
+      const MatrixXd Acl_abs = phase.Acl.cwiseAbs();
       for (int m = 0; m <= n_; ++m) {
-        VectorXd col(phase.monitors.size());
-        for (size_t j = 0; j < phase.monitors.size(); ++j) col(j) = phase.monitors[j].w * Amx;
+        VectorXd col(phase.monitors.size()), zcol(phase.monitors.size());
+        for (size_t j = 0; j < phase.monitors.size(); ++j) {
+          col(j) = phase.monitors[j].w * Amx;
+          zcol(j) = m == 0 ? noise[j]
+                           : ldcp_.tol_rel * phase.monitors[j].w.cwiseAbs().dot(Amx_abs) +
+                                 ldcp_.tol_abs;
+        }
         d.push_back(col);
+        dzero.push_back(zcol);
         Amx = phase.Acl * Amx;
+        Amx_abs = Acl_abs * Amx_abs;
       }
       for (size_t j = 0; j < phase.monitors.size(); ++j) {
         // Time scale of the first two nonzero Taylor terms.
         int m0 = -1;
         for (int m = 0; m <= n_; ++m) {
-          if (std::abs(d[m](j)) > (m == 0 ? noise[j] : 1e-300)) {
+          if (std::abs(d[m](j)) > dzero[m](j)) {
             m0 = m;
             break;
           }
         }
         if (m0 < 0) continue;
         for (int m = m0 + 1; m <= n_; ++m) {
-          if (std::abs(d[m](j)) > 1e-300) {
+          if (std::abs(d[m](j)) > dzero[m](j)) {
             // |d_m0| t^m0/m0! = |d_m| t^m/m!  ->  t = (|d_m0| m!/(m0! |d_m|))^(1/(m-m0))
             double ratio = std::abs(d[m0](j)) / std::abs(d[m](j));
             double f = 1.0;
@@ -455,6 +499,9 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     h_first = std::max(h_first, 1e-15 * std::max(1.0, std::abs(t)));
 
     // March over the samples of this phase.
+    std::vector<char> armed(phase.monitors.size());
+    for (size_t j = 0; j < phase.monitors.size(); ++j)
+      armed[j] = phase.monitors[j].w.dot(xstart) > noise[j];
     double ta = t;
     VectorXd xa_a = xstart;
     double h = h_first;
@@ -477,31 +524,18 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
         auto phi = [&](double tt) -> double { return mon.w * ((phase.Acl * (tt - ta)).exp() * xa_a); };
         auto dphi = [&](double tt) -> double { return mon.wA * ((phase.Acl * (tt - ta)).exp() * xa_a); };
         double root = std::numeric_limits<double>::infinity();
-        const bool at_start = ta == t;
-        if (at_start && fa <= noise[j] && fb >= -noise[j]) {
-          // Still within rounding of zero just after the phase start.
-        } else if (fb < 0.0) {
-          double lo = ta, flo = fa;
-          if (fa <= (at_start ? noise[j] : 0.0)) {
-            // Only at a phase start: the function starts at zero (a gap just
-            // released, a force just engaged) and is positive just after by
-            // the lexicographic mode selection. Start the bracket where it is.
-            double c = ta + (tb - ta) / 1024.0;
-            double fc = phi(c);
-            int tries = 0;
-            while (fc <= 0.0 && tries++ < 40) {
-              c = ta + (c - ta) / 2.0;
-              fc = phi(c);
-            }
-            if (fc <= 0.0 || ta != t) {
-              root = ta;  // it turns negative at once: an event now
-            } else {
-              lo = c;
-              flo = fc;
-            }
+        if (!armed[j]) {
+          // Started within rounding of zero: positive by mode selection, but
+          // only a departure beyond the noise band counts as a sign.
+          if (fb > noise[j]) {
+            armed[j] = true;
+          } else if (fb < -noise[j]) {
+            auto shifted = [&](double tt) { return phi(tt) + noise[j]; };
+            root = brent_root(shifted, ta, tb, fa + noise[j], fb + noise[j],
+                              opt_.event_time_tol);
           }
-          if (!std::isfinite(root))
-            root = brent_root(phi, lo, tb, flo, fb, opt_.event_time_tol);
+        } else if (fb < 0.0) {
+          root = fa <= 0.0 ? ta : brent_root(phi, ta, tb, fa, fb, opt_.event_time_tol);
         } else if (fa > 0.0) {
           // Grazing: positive at both ends, derivative from - to +.
           const double da = mon.wA * xa_a;
@@ -576,6 +610,12 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
       break;
     }
     xa = ev.x_plus;
+    if (ev.accumulation && ev.t_star > t) {
+      // Continue from the accumulation time in the limit mode; the bounces
+      // left out last ev.t_star - t seconds in all.
+      xa = (phase.Acl * (ev.t_star - t)).exp() * xa;
+      t = ev.t_star;
+    }
     Event e;
     e.t = t;
     e.state_before = user(x_minus);

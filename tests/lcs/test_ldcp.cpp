@@ -1,0 +1,109 @@
+// Mode selection by the LDCP (§3.5.2) against the thesis's worked examples,
+// and the jump it computes against the projection P_I of §3.4.2.
+//
+// Tolerances: the LDCP here involves a handful of products of O(1) matrices
+// and LCPs of size <= 2 solved by pivoting, so its numbers are exact to a few
+// ulps; 1e-12 leaves a margin of ~1e3 while any wrong mode or impulse is off
+// by O(1).
+#include <gtest/gtest.h>
+
+#include "lcs/lcs.hpp"
+
+namespace lcsim::lcs {
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::Vector4d;
+using Eigen::VectorXd;
+
+Lcs two_carts() {  // eq. (3.1)
+  Lcs s;
+  s.A.resize(4, 4);
+  s.A << 0, 0, 1, 0, 0, 0, 0, 1, -2, 1, 0, 0, 1, -1, 0, 0;
+  s.B = MatrixXd::Zero(4, 1);
+  s.B(2, 0) = 1;
+  s.C = MatrixXd::Zero(1, 4);
+  s.C(0, 0) = 1;
+  s.D = MatrixXd::Zero(1, 1);
+  return s;
+}
+
+Lcs hook() {  // Example 3.8.3
+  Lcs s;
+  s.A.resize(4, 4);
+  s.A << 0, 0, 1, 0, 0, 0, 0, 1, -2, 1, 0, 0, 1, -1, 0, 0;
+  s.B.resize(4, 2);
+  s.B << 0, 0, 0, 0, 1, 1, 0, -1;
+  s.C.resize(2, 4);
+  s.C << 1, 0, 0, 0, 1, -1, 0, 0;
+  s.D = MatrixXd::Zero(2, 2);
+  return s;
+}
+
+// §3.7 step one at (0,-1,-1,0): u(s) = 1 + s/(s^2+1), so u^0 = 1 (a Dirac of
+// weight 1), the constrained mode, and the jump to (0,-1,0,0).
+TEST(Ldcp, TwoCartsImpact) {
+  const auto sel = select_mode(two_carts(), Vector4d(0, -1, -1, 0));
+  ASSERT_TRUE(sel.ok) << sel.message;
+  EXPECT_EQ(sel.mode, (IndexSet{0}));
+  EXPECT_NEAR(sel.impulse[0](0), 1.0, 1e-12);
+  for (size_t j = 1; j < sel.impulse.size(); ++j) EXPECT_EQ(sel.impulse[j](0), 0.0);
+  EXPECT_LE((sel.x_plus - Vector4d(0, -1, 0, 0)).norm(), 1e-12);
+}
+
+// §3.7 at (0,0,0,1): LDCP_4 selects the unconstrained mode (y^4 = 1 > 0).
+TEST(Ldcp, TwoCartsReleaseSelectsUnconstrained) {
+  const auto sel = select_mode(two_carts(), Vector4d(0, 0, 0, 1));
+  ASSERT_TRUE(sel.ok) << sel.message;
+  EXPECT_TRUE(sel.mode.empty());
+  EXPECT_TRUE(sel.undetermined.empty());
+  EXPECT_LE((sel.x_plus - Vector4d(0, 0, 0, 1)).norm(), 0.0);
+}
+
+// Example 3.4.4: (0,-1,0,0) is regular and continues constrained (u = cos t).
+TEST(Ldcp, RegularConstrainedState) {
+  LdcpOptions o;
+  o.regular_only = true;
+  const auto sel = select_mode(two_carts(), Vector4d(0, -1, 0, 0), o);
+  ASSERT_TRUE(sel.ok) << sel.message;
+  EXPECT_EQ(sel.mode, (IndexSet{0}));
+  // regular_only refuses the irregular (0,-1,-1,0) with a message, no guess.
+  const auto bad = select_mode(two_carts(), Vector4d(0, -1, -1, 0), o);
+  EXPECT_FALSE(bad.ok);
+  EXPECT_NE(bad.message.find("not regular"), std::string::npos);
+}
+
+// Example 3.8.3 at (0,0,-1,2): the hook alone, jump to (0,0,½,½).
+TEST(Ldcp, HookOnlyMode) {
+  const auto sel = select_mode(hook(), Vector4d(0, 0, -1, 2));
+  ASSERT_TRUE(sel.ok) << sel.message;
+  EXPECT_EQ(sel.mode, (IndexSet{1}));
+  EXPECT_LE((sel.x_plus - Vector4d(0, 0, 0.5, 0.5)).norm(), 1e-12);
+  // The same jump as the projection onto V_{hook} along T_{hook} (§3.4.2).
+  const auto P = projection(hook(), IndexSet{1});
+  ASSERT_TRUE(P.ok) << P.message;
+  EXPECT_LE((P.P * Vector4d(0, 0, -1, 2) - sel.x_plus).norm(), 1e-12);
+}
+
+// Example 7.3.3: the triple integrator from (0,-1,0) needs u = delta'
+// (impulse[1] = 1): the jump goes to V = {0}.
+TEST(Ldcp, TripleIntegratorDeltaPrime) {
+  Lcs s;
+  s.A = MatrixXd::Zero(3, 3);
+  s.A(0, 1) = 1;
+  s.A(1, 2) = 1;
+  s.B = MatrixXd::Zero(3, 1);
+  s.B(2, 0) = 1;
+  s.C = MatrixXd::Zero(1, 3);
+  s.C(0, 0) = 1;
+  s.D = MatrixXd::Zero(1, 1);
+  const auto sel = select_mode(s, Eigen::Vector3d(0, -1, 0));
+  ASSERT_TRUE(sel.ok) << sel.message;
+  EXPECT_EQ(sel.mode, (IndexSet{0}));
+  EXPECT_NEAR(sel.impulse[1](0), 1.0, 1e-12);  // coefficient of delta'
+  EXPECT_NEAR(sel.impulse[0](0), 0.0, 1e-12);
+  EXPECT_LE(sel.x_plus.norm(), 1e-12);
+}
+
+}  // namespace
+}  // namespace lcsim::lcs
