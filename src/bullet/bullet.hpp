@@ -13,3 +13,101 @@ namespace lcsim::bullet {
 std::string version_string();
 
 }  // namespace lcsim::bullet
+
+// ---------------------------------------------------------------------------
+// Side-by-side runs (src/bullet/world.cpp), comparison (compare.cpp), MLCP
+// back-ends (mlcp.cpp). See docs/bullet-comparison.md for what was measured.
+#include <Eigen/Dense>
+#include <vector>
+
+#include "lcp/lcp.hpp"
+#include "mech/mech.hpp"
+#include "sim/sim.hpp"
+
+namespace lcsim::bullet {
+
+// Every Bullet setting that affects accuracy, pinned (Bullet's defaults are
+// stated where they differ). The scene is "rb6" of ../shared/notes/bullet.md:
+// one btRigidBody per coordinate, constraints as btGeneric6DofSpring2Constraint
+// linear limits, springs/dampers/f as forces applied before every step.
+struct WorldSettings {
+  // btSequentialImpulseConstraintSolver sweeps per step (Bullet default 10).
+  // Two coupled rows (stop and hook on one cart) need more than 3 sweeps to
+  // converge; 100 sweeps of 1-2 rows cost little.
+  int solver_iterations = 100;
+  // Per-limit BT_CONSTRAINT_STOP_ERP / _STOP_CFM of the 6DOF2 limits (Bullet's
+  // defaults 0.2 and 0). 6DOF2 keeps a limit row in the solver at every step
+  // (m_currentLimit = 4) whose target velocity is stop_erp * gap / h, so a
+  // limit is approached without ever being crossed (speculative), and a
+  // penetration is corrected by stop_erp of it per step.
+  double stop_erp = 0.2;
+  double stop_cfm = 0.0;
+  // The "infinite" side of a one-sided limit (m): a stop x >= a is the range
+  // [a, a + limit_range]. Valid while |q| stays well below it.
+  double limit_range = 1e6;
+};
+
+// "btSequentialImpulseConstraintSolver (100 iterations)": what ran.
+std::string solver_description(const WorldSettings& s = {});
+
+// Throws std::invalid_argument naming the first part of the model Bullet
+// cannot express with this scene: a general LCS, a non-diagonal M, a row of E
+// that is neither a stop (c e_j) nor a hook (c (e_a - e_b)).
+void check_expressible(const mech::Model& model);
+
+// The model run in Bullet with fixed step opt.h (the last step shortened to
+// land on opt.t_end), filling the same Trajectory as the time-stepping
+// methods: samples (every step, or on the opt.dt_out grid), u = constraint
+// impulse / h reconstructed from the momentum balance, mode = constraints with
+// a nonzero impulse in the step, events at every mode change, energy,
+// max_violation. Never throws: an inexpressible model gives kFailed.
+sim::Trajectory simulate_bullet(const mech::Model& model, const Eigen::VectorXd& x0,
+                                const sim::Options& opt, const WorldSettings& s = {});
+
+// One constraint switching on (activation) or off, matched between the exact
+// run and another run.
+struct EventShift {
+  int constraint = 0;
+  bool activation = true;
+  double t_exact = 0.0;
+  double t_other = 0.0;  // NaN when the other run has no matching switch
+  double shift = 0.0;    // t_other - t_exact (NaN when unmatched)
+};
+
+struct Comparison {
+  double deviation_max = 0.0;  // max over common sample times of max-abs state difference
+  double deviation_t = 0.0;    // where it occurs (s)
+  double error_final = 0.0;    // max-abs difference of the final states
+  std::vector<EventShift> event_shifts;  // one per switch of the exact run, in time order
+  int unmatched_other = 0;     // switches of the other run that match no exact switch
+  double energy_drift = 0.0;   // (E_f - E_0) of the other run minus that of the exact run (J)
+  double max_violation = 0.0;  // the other run's most negative gap
+  long samples_compared = 0;   // samples of `other` with an exact sample at the same time
+};
+
+// Compares `other` with `exact` (the event-driven run sampled on the same time
+// grid: samples closer than time_tol in time are paired; at a jump the exact
+// run has two samples and the nearer state counts). Switches are taken from
+// the mode sets (the first sample's mode, then each event's mode_after); each
+// exact switch is matched with the other run's switch of the same constraint
+// and direction nearest in time, in order (never before the previous match).
+Comparison compare_trajectories(const sim::Trajectory& exact, const sim::Trajectory& other,
+                                double time_tol = 1e-9);
+
+// Bullet's MLCP solvers on the LCP w = M z + q, 0 <= z ⟂ w >= 0, through
+// btMLCPSolverInterface::solveMLCP with A = M, b = -q, lo = 0, hi = BT_INFINITY.
+// Every answer passes lcsim's residual check (opt.tolerance, as the built-in
+// solvers): Bullet's Dantzig reports success on wrong answers for
+// nonsymmetric matrices; a failed check gives kNumericalFailure with a message.
+enum class MlcpSolver { kDantzig, kLemke, kPgs };
+lcp::Result solve_bullet_mlcp(MlcpSolver which, const Eigen::MatrixXd& M, const Eigen::VectorXd& q,
+                              const lcp::Options& opt = {});
+
+// Registers the "bullet" integrator (sim::register_integrator) and the LCP
+// back-ends bullet-dantzig, bullet-lemke, bullet-pgs (lcp::register_solver).
+// Called explicitly from lcsim's main: a static registrar in a static library
+// is dropped by the linker when nothing references its object file.
+// Idempotent.
+void register_backends();
+
+}  // namespace lcsim::bullet

@@ -106,3 +106,12 @@ std::unique_ptr<Solver> make_solver(std::string_view name);
 std::vector<std::string> solver_names();
 
 }  // namespace lcsim::lcp
+
+// Registration hook for LCP back-ends that live in later layers (the Bullet
+// layer registers bullet-dantzig, bullet-lemke, bullet-pgs). make_solver and
+// solver_names consult it after the built-in solvers; registering a name again
+// replaces the earlier factory. Not thread-safe: register at start-up.
+#include <functional>
+namespace lcsim::lcp {
+void register_solver(std::string name, std::function<std::unique_ptr<Solver>()> factory);
+}  // namespace lcsim::lcp

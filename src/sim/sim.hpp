@@ -97,3 +97,13 @@ Trajectory simulate_event_driven(const mech::Model& model, const VectorXd& x0,
                                  const Options& opt);
 
 }  // namespace lcsim::sim
+
+// Registration hook for integrators that live in later layers (the Bullet
+// layer registers "bullet"; layering forbids sim from naming them). A
+// registered name is found by make_integrator and listed by integrator_names;
+// registering a name again replaces the earlier factory. Not thread-safe:
+// register at start-up (lcsim's main calls bullet::register_backends()).
+#include <functional>
+namespace lcsim::sim {
+void register_integrator(std::string name, std::function<std::unique_ptr<Integrator>()> factory);
+}  // namespace lcsim::sim

@@ -1,0 +1,401 @@
+// The lcsim mechanical model built in Bullet ("rb6" of ../shared/notes/bullet.md)
+// and run with Bullet's fixed step.
+//
+// Scene. One btRigidBody per coordinate q_j, mass M_jj, linear factor (1,0,0),
+// angular factor 0, placed at x = q_j; bodies never collide (broadphase mask 0),
+// so only the constraints below act. A stop c q_j + g >= 0 is a 6DOF2 linear
+// limit between btTypedConstraint::getFixedBody() (at the world origin) and body
+// j on q_j; a hook c (q_a - q_b) + g >= 0 (c > 0) is a 6DOF2 limit between
+// bodies a and b on q_b - q_a <= g / c. The other five axes are free (lower >
+// upper).
+//
+// Forces. Before every step each body j gets the force
+//   F_j = (f - K q - D v)_j,
+// the generalised force of the model. Since each body moves only along x and
+// body j's position is q_j, the virtual work of a force F on body j is F δq_j:
+// the generalised force of coordinate j is the x-force on body j. A spring of
+// stiffness k between coordinates a and b (or a and the wall) has potential
+// ½ k (q_a - q_b)^2, and the sum of these potentials is ½ q'Kq for the
+// assembled K; its forces are -∂V/∂q = -K q, entry j being the sum of the
+// spring forces on body j. So -K q applied to the bodies is exactly the spring
+// network (and for a general symmetric K, the force of the potential ½ q'Kq),
+// -D v the dampers, f the constant forces (gravity included: the world's
+// gravity is set to zero before any body is added, since bodies copy it).
+//
+// Step. Bullet's btDiscreteDynamicsWorld step is semi-implicit Euler:
+// v+ = v + h M^{-1} F(q, v) + constraint impulse / m, q+ = q + h v+; forces are
+// explicit, hence first order in h (notes: S1 2.09e-4 at h = 1e-3).
+//
+// Settings pinned (WorldSettings and below): solver
+// btSequentialImpulseConstraintSolver, iterations, stop ERP/CFM per limit,
+// global ERP 0.2 and CFM 0 (the 6DOF2 limits use their own stop ERP/CFM),
+// split impulse off, restitution threshold 0, contact processing threshold 0
+// (speculative contacts off), least-squares early exit off, no sleeping, no
+// damping. The last four only matter for contacts, of which there are none:
+// they are pinned so that the scene does not depend on Bullet's defaults.
+// Restitution: a limit's bounce is the model's coefficient e_i (6DOF2 bounce is
+// applied without velocity threshold).
+#include <BulletDynamics/ConstraintSolver/btGeneric6DofSpring2Constraint.h>
+#include <BulletDynamics/ConstraintSolver/btSequentialImpulseConstraintSolver.h>
+#include <btBulletDynamicsCommon.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+#include "bullet/bullet.hpp"
+
+namespace lcsim::bullet {
+
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+std::string fmt(double x) {
+  std::ostringstream s;
+  s.precision(6);
+  s << x;
+  return s.str();
+}
+
+// One row of E as Bullet sees it.
+struct Limit {
+  int a = -1, b = -1;         // stop: body b against the world (a = -1); hook: bodies a, b
+  double lo = 0.0, hi = 0.0;  // range of (x_b - x_a) (stop: x_b)
+};
+
+Limit classify(const mech::MechanicalModel& m, int i, double range) {
+  const int N = m.dofs();
+  std::vector<int> nz;
+  double scale = m.E.row(i).cwiseAbs().maxCoeff();
+  for (int j = 0; j < N; ++j)
+    if (m.E(i, j) != 0.0) nz.push_back(j);
+  const std::string who =
+      "constraint '" + m.constraints[i] + "' (row " + std::to_string(i + 1) + " of E)";
+  Limit L;
+  if (nz.size() == 1) {
+    const int j = nz[0];
+    const double c = m.E(i, j), bound = -m.g(i) / c;
+    L.b = j;
+    if (c > 0) {  // q_j >= -g/c
+      L.lo = bound;
+      L.hi = bound + range;
+    } else {  // q_j <= -g/c
+      L.lo = bound - range;
+      L.hi = bound;
+    }
+    return L;
+  }
+  if (nz.size() == 2) {
+    const double c0 = m.E(i, nz[0]), c1 = m.E(i, nz[1]);
+    if (std::abs(c0 + c1) <= 1e-12 * scale) {
+      // c (q_a - q_b) + g >= 0 with c > 0  <=>  q_b - q_a <= g / c.
+      const int a = c0 > 0 ? nz[0] : nz[1], b = c0 > 0 ? nz[1] : nz[0];
+      const double c = std::abs(c0);
+      L.a = a;
+      L.b = b;
+      L.hi = m.g(i) / c;
+      L.lo = L.hi - range;
+      return L;
+    }
+    throw std::invalid_argument(
+        "bullet: " + who + " has coefficients " + fmt(c0) + " and " + fmt(c1) +
+        ": a Bullet limit needs opposite coefficients (a hook c (q_a - q_b) + g >= 0)");
+  }
+  throw std::invalid_argument("bullet: " + who + " involves " + std::to_string(nz.size()) +
+                              " coordinates: a Bullet limit takes one (a stop) or two (a hook)");
+}
+
+std::vector<Limit> limits_of(const mech::Model& model, double range) {
+  if (!model.is_mechanical())
+    throw std::invalid_argument("bullet: '" + model.name +
+                                "' is a general LCS: the Bullet scene needs a mechanical model");
+  const mech::MechanicalModel& m = *model.mechanical;
+  const int N = m.dofs();
+  const double mscale = m.M.cwiseAbs().maxCoeff();
+  for (int r = 0; r < N; ++r)
+    for (int c = 0; c < N; ++c)
+      if (r != c && std::abs(m.M(r, c)) > 1e-14 * mscale)
+        throw std::invalid_argument("bullet: M(" + std::to_string(r + 1) + "," +
+                                    std::to_string(c + 1) + ") = " + fmt(m.M(r, c)) +
+                                    ": one rigid body per coordinate needs a diagonal M");
+  std::vector<Limit> out;
+  for (int i = 0; i < m.num_constraints(); ++i) out.push_back(classify(m, i, range));
+  return out;
+}
+
+void warn(sim::Trajectory& tr, const std::string& w) {
+  ++tr.warnings;
+  if (tr.warning_messages.size() < 10) tr.warning_messages.push_back(w);
+}
+
+// The Bullet world; members in construction order so that destruction runs
+// constraints -> bodies -> world -> solver -> ... .
+struct World {
+  std::unique_ptr<btDefaultCollisionConfiguration> config;
+  std::unique_ptr<btCollisionDispatcher> dispatcher;
+  std::unique_ptr<btDbvtBroadphase> broadphase;
+  std::unique_ptr<btSequentialImpulseConstraintSolver> solver;
+  std::unique_ptr<btDiscreteDynamicsWorld> world;
+  std::unique_ptr<btSphereShape> shape;
+  std::vector<std::unique_ptr<btRigidBody>> bodies;
+  std::vector<std::unique_ptr<btGeneric6DofSpring2Constraint>> constraints;
+  ~World() {
+    for (auto& c : constraints) world->removeConstraint(c.get());
+    for (auto& b : bodies) world->removeRigidBody(b.get());
+  }
+};
+
+std::unique_ptr<World> build(const mech::MechanicalModel& m, const std::vector<Limit>& limits,
+                             const VectorXd& q0, const VectorXd& v0, const WorldSettings& s) {
+  auto w = std::make_unique<World>();
+  w->config = std::make_unique<btDefaultCollisionConfiguration>();
+  w->dispatcher = std::make_unique<btCollisionDispatcher>(w->config.get());
+  w->broadphase = std::make_unique<btDbvtBroadphase>();
+  w->solver = std::make_unique<btSequentialImpulseConstraintSolver>();
+  w->world = std::make_unique<btDiscreteDynamicsWorld>(w->dispatcher.get(), w->broadphase.get(),
+                                                       w->solver.get(), w->config.get());
+  // Gravity first: bodies copy the world's gravity when added (default -10 y).
+  w->world->setGravity(btVector3(0, 0, 0));
+  btContactSolverInfo& info = w->world->getSolverInfo();
+  info.m_numIterations = s.solver_iterations;
+  info.m_erp = 0.2;
+  info.m_erp2 = 0.2;
+  info.m_globalCfm = 0.0;
+  info.m_sor = 1.0;
+  info.m_splitImpulse = 0;
+  info.m_restitutionVelocityThreshold = 0.0;
+  info.m_leastSquaresResidualThreshold = 0.0;
+  info.m_solverMode = SOLVER_USE_WARMSTARTING | SOLVER_SIMD;
+  w->shape = std::make_unique<btSphereShape>(0.05);
+  w->shape->setMargin(0.0);
+  for (int j = 0; j < m.dofs(); ++j) {
+    btTransform tf;
+    tf.setIdentity();
+    tf.setOrigin(btVector3(q0(j), 0, 0));
+    btRigidBody::btRigidBodyConstructionInfo ci(m.M(j, j), nullptr, w->shape.get(),
+                                                btVector3(1, 1, 1));
+    ci.m_startWorldTransform = tf;
+    ci.m_linearDamping = 0.0;
+    ci.m_angularDamping = 0.0;
+    ci.m_friction = 0.0;
+    ci.m_restitution = 0.0;
+    auto body = std::make_unique<btRigidBody>(ci);
+    body->setLinearFactor(btVector3(1, 0, 0));
+    body->setAngularFactor(btVector3(0, 0, 0));
+    body->setLinearVelocity(btVector3(v0(j), 0, 0));
+    body->setActivationState(DISABLE_DEACTIVATION);
+    body->setSleepingThresholds(0.0, 0.0);
+    body->setContactProcessingThreshold(0.0);
+    // Mask 0: the broadphase pairs this body with nothing.
+    w->world->addRigidBody(body.get(), btBroadphaseProxy::DefaultFilter, 0);
+    w->bodies.push_back(std::move(body));
+  }
+  const int k = static_cast<int>(limits.size());
+  for (int i = 0; i < k; ++i) {
+    const Limit& L = limits[i];
+    btTransform id;
+    id.setIdentity();
+    btRigidBody& A = L.a < 0 ? btTypedConstraint::getFixedBody() : *w->bodies[L.a];
+    auto c = std::make_unique<btGeneric6DofSpring2Constraint>(A, *w->bodies[L.b], id, id);
+    c->setLinearLowerLimit(btVector3(L.lo, 1, 1));  // y, z free (lower > upper)
+    c->setLinearUpperLimit(btVector3(L.hi, 0, 0));
+    c->setAngularLowerLimit(btVector3(1, 1, 1));  // rotations free
+    c->setAngularUpperLimit(btVector3(0, 0, 0));
+    c->setParam(BT_CONSTRAINT_STOP_ERP, s.stop_erp, 0);
+    c->setParam(BT_CONSTRAINT_STOP_CFM, s.stop_cfm, 0);
+    const double e = m.restitution.size() == k ? m.restitution(i) : 0.0;
+    c->setBounce(0, e);
+    w->world->addConstraint(c.get(), true);
+    w->constraints.push_back(std::move(c));
+  }
+  return w;
+}
+
+// Output sampling, as in src/sim/time_stepping.cpp.
+class Sampler {
+ public:
+  explicit Sampler(double dt_out) : dt_out_(dt_out), next_(dt_out) {}
+  bool want(double t, double h, bool last) {
+    if (last || dt_out_ <= 0.0) return true;
+    if (t < next_ - 1e-9 * h) return false;
+    while (next_ <= t + 1e-9 * h) next_ += dt_out_;
+    return true;
+  }
+
+ private:
+  double dt_out_;
+  double next_;
+};
+
+}  // namespace
+
+std::string solver_description(const WorldSettings& s) {
+  return "btSequentialImpulseConstraintSolver (" + std::to_string(s.solver_iterations) +
+         " iterations)";
+}
+
+void check_expressible(const mech::Model& model) { (void)limits_of(model, 1e6); }
+
+sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
+                                const sim::Options& opt, const WorldSettings& s) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  sim::Trajectory tr;
+  tr.method = "bullet " + solver_description(s);
+  tr.t_end = opt.t_end;
+  tr.final_state = x0;
+  auto fail = [&](const std::string& msg) {
+    tr.status = sim::RunStatus::kFailed;
+    tr.message = msg;
+    tr.wall_time_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    return tr;
+  };
+  std::vector<Limit> limits;
+  try {
+    limits = limits_of(model, s.limit_range);
+  } catch (const std::exception& e) {
+    return fail(e.what());
+  }
+  const mech::MechanicalModel& m = *model.mechanical;
+  const int N = m.dofs(), k = m.num_constraints();
+  if (x0.size() != 2 * N)
+    return fail("bullet: initial state has " + std::to_string(x0.size()) +
+                " entries, the model needs " + std::to_string(2 * N));
+  if (!(opt.t_end > 0.0) || !std::isfinite(opt.t_end))
+    return fail("bullet: t_end must be a finite number > 0 (got " + fmt(opt.t_end) + ")");
+  if (!(opt.h > 0.0) || !std::isfinite(opt.h) || opt.t_end / opt.h > 1e9)
+    return fail("bullet: step h must be finite, > 0 and give at most 1e9 steps (got " + fmt(opt.h) +
+                ")");
+  VectorXd q = x0.head(N), v = x0.tail(N);
+  tr.energy_initial = mech::total_energy(m, q, v);
+  if (m.D.size() > 0 && !m.D.isZero(0.0))
+    warn(tr, "bullet: dampers are explicit forces -D v (stable only for h small against M/D)");
+
+  // Grid as the time-stepping methods: n steps of h, the last shortened.
+  long n;
+  double h_last;
+  {
+    const double r = opt.t_end / opt.h, rn = std::round(r);
+    if (rn >= 1.0 && std::abs(r - rn) <= 1e-9 * rn) {
+      n = static_cast<long>(rn);
+      h_last = opt.h;
+    } else {
+      n = static_cast<long>(std::floor(r)) + 1;
+      h_last = opt.t_end - std::floor(r) * opt.h;
+    }
+  }
+
+  std::unique_ptr<World> w = build(m, limits, q, v, s);
+  // Multipliers from the momentum balance M (v+ - v) = h F + E' (h u):
+  // h u = (E')^+ (M (v+ - v) - h F), exact when E has full row rank.
+  Eigen::CompleteOrthogonalDecomposition<MatrixXd> Et;
+  if (k > 0) Et.compute(m.E.transpose());
+
+  VectorXd y = m.E * q + m.g;
+  if (k > 0) tr.max_violation = std::min(0.0, y.minCoeff());
+  Sampler sampler(opt.dt_out);
+  auto record = [&](double t, const VectorXd& u, const sim::IndexSet& mode) {
+    if (!opt.record_samples) return;
+    sim::Sample smp;
+    smp.t = t;
+    smp.x.resize(2 * N);
+    smp.x << q, v;
+    smp.u = u;
+    smp.y = y;
+    smp.mode = mode;
+    tr.samples.push_back(std::move(smp));
+  };
+  sim::IndexSet mode;
+  record(0.0, VectorXd::Zero(k), mode);
+
+  VectorXd F(N), q_next(N), v_next(N), u(k);
+  for (long j = 1; j <= n; ++j) {
+    const bool last = j == n;
+    const double h = last ? h_last : opt.h;
+    F = m.f - m.K * q - m.D * v;
+    for (int i = 0; i < N; ++i) w->bodies[i]->applyCentralForce(btVector3(F(i), 0, 0));
+    // maxSubSteps = 0: exactly one step of length h (no interpolation).
+    w->world->stepSimulation(h, 0, h);
+    for (int i = 0; i < N; ++i) {
+      q_next(i) = w->bodies[i]->getCenterOfMassPosition().x();
+      v_next(i) = w->bodies[i]->getLinearVelocity().x();
+    }
+    if (!q_next.allFinite() || !v_next.allFinite())
+      return fail("bullet: non-finite state at t = " + fmt(j * opt.h));
+    sim::IndexSet new_mode;
+    VectorXd impulse = VectorXd::Zero(k);
+    if (k > 0) {
+      const VectorXd r = m.M * (v_next - v) - h * F;
+      impulse = Et.solve(r);
+      // Round-off in r is ~1e-16 |M v|; impulses of real contacts are O(h).
+      const double tiny =
+          1e-10 * (1.0 + (m.M * v).cwiseAbs().maxCoeff() + h * F.cwiseAbs().maxCoeff());
+      for (int i = 0; i < k; ++i)
+        if (impulse(i) > tiny) new_mode.push_back(i);
+      u = impulse / h;
+    }
+    const double t = last ? opt.t_end : j * opt.h;
+    if (new_mode != mode) {
+      sim::Event e;
+      e.t = t;
+      e.state_before.resize(2 * N);
+      e.state_before << q, v;
+      e.state_after.resize(2 * N);
+      e.state_after << q_next, v_next;
+      e.mode_after = new_mode;
+      e.impulse = impulse;
+      bool gained = false, lost = false, approaching = false;
+      for (int i : new_mode)
+        if (std::find(mode.begin(), mode.end(), i) == mode.end()) {
+          gained = true;
+          if (m.E.row(i).dot(v) < 0.0) approaching = true;
+        }
+      for (int i : mode)
+        if (std::find(new_mode.begin(), new_mode.end(), i) == new_mode.end()) lost = true;
+      e.type = approaching       ? sim::EventType::kImpact
+               : lost && !gained ? sim::EventType::kRelease
+                                 : sim::EventType::kContact;
+      tr.events.push_back(std::move(e));
+      mode = new_mode;
+    }
+    q = q_next;
+    v = v_next;
+    ++tr.steps;
+    if (k > 0) ++tr.lcp_solves;  // the constraint solver runs every step
+    y = m.E * q + m.g;
+    if (k > 0) tr.max_violation = std::min(tr.max_violation, std::min(0.0, y.minCoeff()));
+    if (sampler.want(t, opt.h, last)) record(t, k > 0 ? u : VectorXd(), mode);
+  }
+  tr.final_state.resize(2 * N);
+  tr.final_state << q, v;
+  tr.energy_final = mech::total_energy(m, q, v);
+  tr.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return tr;
+}
+
+namespace {
+
+class BulletIntegrator : public sim::Integrator {
+ public:
+  std::string name() const override { return "bullet"; }
+  sim::Trajectory run(const mech::Model& model, const VectorXd& x0,
+                      const sim::Options& opt) const override {
+    return simulate_bullet(model, x0, opt);
+  }
+};
+
+}  // namespace
+
+void register_mlcp_backends();  // src/bullet/mlcp.cpp
+
+void register_backends() {
+  sim::register_integrator("bullet", [] { return std::make_unique<BulletIntegrator>(); });
+  register_mlcp_backends();
+}
+
+}  // namespace lcsim::bullet

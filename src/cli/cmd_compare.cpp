@@ -1,0 +1,141 @@
+// `lcsim compare MODEL --h H`: the model run in Bullet beside lcsim's exact
+// event-driven solution (bullet::compare_trajectories):
+//   deviation_max  largest max-abs state difference over the Bullet samples
+//                  (on a grid that is a multiple of h, at most ~2000 points;
+//                  the exact run is sampled on the same grid),
+//   error_final    max-abs difference of the final states,
+//   event_shifts   Bullet's constraint switches (first step with a nonzero
+//                  impulse, first step without) matched in order with the
+//                  exact switches: t_bullet - t_exact,
+//   energy_drift   Bullet's (E_final - E_initial) minus the exact run's (J),
+//   max_violation  Bullet's most negative gap,
+//   bullet_solver  which Bullet constraint solver ran.
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "bullet/bullet.hpp"
+#include "cli/command.hpp"
+#include "io/io.hpp"
+#include "sim/sim.hpp"
+
+namespace lcsim::cli {
+namespace {
+
+struct CompareArgs {
+  std::string model;
+  std::string x0;
+  double t_end = std::nan("");
+  double h = 1e-3;
+  bool json = false;
+  double stop_erp = bullet::WorldSettings{}.stop_erp;
+  int iterations = bullet::WorldSettings{}.solver_iterations;
+};
+
+nlohmann::json num(double x) {
+  return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
+}
+
+void run_compare(const CompareArgs& a) {
+  const mech::Model model = io::load_model(a.model);
+  bullet::check_expressible(model);  // std::invalid_argument naming the constraint: exit 2
+  Eigen::VectorXd x0 = model.initial;
+  if (!a.x0.empty()) x0 = io::parse_vector(a.x0, "--x0");
+  if (x0.size() == 0)
+    throw io::InputError(a.model + ": no initial state: give --x0 or `initial` in the model");
+  if (x0.size() != model.state_size())
+    throw io::InputError("--x0: has " + std::to_string(x0.size()) + " entries, the model '" +
+                         model.name + "' has a state of size " +
+                         std::to_string(model.state_size()) + " (q then v)");
+  sim::Options opt;
+  opt.t_end = std::isnan(a.t_end) ? model.t_end : a.t_end;
+  if (std::isnan(opt.t_end))
+    throw io::InputError(a.model + ": no horizon: give --t-end or `t_end` in the model");
+  if (!(opt.t_end > 0.0) || !std::isfinite(opt.t_end))
+    throw io::InputError("--t-end: must be a finite number > 0 (got " + std::to_string(opt.t_end) +
+                         ")");
+  if (!(a.h > 0.0) || !std::isfinite(a.h) || a.h > opt.t_end)
+    throw io::InputError("--h: must be a finite number > 0 and <= the horizon (got " +
+                         std::to_string(a.h) + ")");
+  opt.h = a.h;
+  // Comparison grid: a multiple of h, at most ~2000 points (as lcsim sweep).
+  opt.dt_out = std::max(1.0, std::round(opt.t_end / (2000.0 * a.h))) * a.h;
+
+  const sim::Trajectory exact = sim::make_integrator("event")->run(model, x0, opt);
+  if (exact.status != sim::RunStatus::kCompleted)
+    throw NumericalError("compare: the exact event-driven run failed: " + exact.message);
+  if (!(a.stop_erp > 0.0 && a.stop_erp <= 1.0))
+    throw io::InputError("--stop-erp: must lie in (0, 1] (got " + std::to_string(a.stop_erp) + ")");
+  if (a.iterations < 1) throw io::InputError("--iterations: must be >= 1");
+  bullet::WorldSettings ws;
+  ws.stop_erp = a.stop_erp;
+  ws.solver_iterations = a.iterations;
+  const sim::Trajectory bt = bullet::simulate_bullet(model, x0, opt, ws);
+  if (bt.status != sim::RunStatus::kCompleted)
+    throw NumericalError("compare: the Bullet run failed: " + bt.message);
+  const bullet::Comparison c = bullet::compare_trajectories(exact, bt, 1e-9 * a.h);
+  const double per_step = bt.steps ? bt.wall_time_s / bt.steps : 0.0;
+
+  if (a.json) {
+    nlohmann::json j;
+    j["model"] = model.name;
+    j["h"] = a.h;
+    j["t_end"] = opt.t_end;
+    j["deviation_max"] = num(c.deviation_max);
+    j["deviation_t"] = c.deviation_t;
+    j["error_final"] = num(c.error_final);
+    nlohmann::json shifts = nlohmann::json::array();
+    for (const auto& s : c.event_shifts)
+      shifts.push_back({{"constraint", model.mechanical->constraints[s.constraint]},
+                        {"kind", s.activation ? "activation" : "release"},
+                        {"t_exact", s.t_exact},
+                        {"t_bullet", num(s.t_other)},
+                        {"shift", num(s.shift)}});
+    j["event_shifts"] = std::move(shifts);
+    j["unmatched_bullet_switches"] = c.unmatched_other;
+    j["energy_drift"] = c.energy_drift;
+    j["max_violation"] = c.max_violation;
+    j["bullet_solver"] = bullet::solver_description(ws);
+    j["stop_erp"] = ws.stop_erp;
+    j["bullet_version"] = bullet::version_string();
+    j["steps"] = bt.steps;
+    j["wall_time_per_step_s"] = per_step;
+    std::printf("%s\n", j.dump(2).c_str());
+    return;
+  }
+  std::printf("model %s, t_end %g, h %g: %s, %s, stop ERP %g\n", model.name.c_str(), opt.t_end, a.h,
+              bullet::version_string().c_str(), bullet::solver_description(ws).c_str(),
+              ws.stop_erp);
+  std::printf("deviation max  %.3e (at t = %.6g)\n", c.deviation_max, c.deviation_t);
+  std::printf("error final    %.3e\n", c.error_final);
+  std::printf("energy drift   %.3e J (Bullet's change minus the exact change)\n", c.energy_drift);
+  std::printf("max violation  %.3e\n", c.max_violation);
+  std::printf("time per step  %.3g s (%ld steps)\n", per_step, bt.steps);
+  std::printf("event shifts (t_bullet - t_exact):\n");
+  for (const auto& s : c.event_shifts)
+    std::printf("  %-10s %-10s t_exact %-14.9g t_bullet %-14.9g shift %.3e\n",
+                model.mechanical->constraints[s.constraint].c_str(),
+                s.activation ? "activation" : "release", s.t_exact, s.t_other, s.shift);
+  if (c.unmatched_other)
+    std::printf("  (%d Bullet switches match no exact switch)\n", c.unmatched_other);
+}
+
+void setup(CLI::App& app) {
+  auto a = std::make_shared<CompareArgs>();
+  auto* cmd = app.add_subcommand(
+      "compare", "Run a model in Bullet beside the exact event-driven solution and compare");
+  cmd->add_option("model", a->model, "Model file (YAML)")->required();
+  cmd->add_option("--x0", a->x0, "Initial state a,b,... (q then v); default: the model's");
+  cmd->add_option("--t-end", a->t_end, "Horizon (s); default: the model's t_end");
+  cmd->add_option("--h", a->h, "Bullet's time step (s); default 1e-3");
+  cmd->add_option("--stop-erp", a->stop_erp, "ERP of Bullet's 6DOF2 limits in (0, 1]; default 0.2");
+  cmd->add_option("--iterations", a->iterations, "Bullet solver iterations; default 100");
+  cmd->add_flag("--json", a->json, "Print the comparison as JSON");
+  cmd->callback([a] { run_compare(*a); });
+}
+
+LCSIM_REGISTER_COMMAND(setup);
+
+}  // namespace
+}  // namespace lcsim::cli
