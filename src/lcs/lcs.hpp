@@ -114,6 +114,16 @@ struct ModeSelection {
   VectorXd x_plus;  // re-initialised state x0 + sum_j A^j B u^{-j} (eq. (3.10))
   int lcp_solves = 0;
 };
+// What the LDCP needs of the system alone (leading row indices, script M,
+// Markov parameters H^0..H^{3n}): compute once per system and pass it in
+// LdcpOptions::data when selecting modes repeatedly (event-driven runs).
+struct LdcpData {
+  std::vector<int> rho;
+  MatrixXd Mlead;
+  std::vector<MatrixXd> H;
+};
+LdcpData ldcp_data(const Lcs& sys);
+
 struct LdcpOptions {
   // A coefficient is treated as zero when |value| <= tol_rel * (sum of the
   // absolute values of the terms that formed it) + tol_abs.
@@ -123,6 +133,7 @@ struct LdcpOptions {
   // (u = 0 there) and a negative free coefficient is reported (Theorem 3.6.7).
   bool regular_only = false;
   const lcp::Solver* solver = nullptr;  // nullptr = principal pivoting
+  const LdcpData* data = nullptr;        // nullptr = computed here
 };
 ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions& opt = {});
 

@@ -48,6 +48,15 @@ VectorXd sub(const VectorXd& v, const std::vector<int>& r) {
 
 }  // namespace
 
+LdcpData ldcp_data(const Lcs& sys) {
+  LdcpData d;
+  d.rho = leading_row_indices(sys);
+  d.Mlead = leading_row_coefficients(sys);
+  // Markov parameters up to the largest order used: rho + p - j <= 3n.
+  d.H = markov_parameters(sys, 3 * sys.n() + 1);
+  return d;
+}
+
 ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions& opt) {
   ModeSelection out;
   const int n = sys.n();
@@ -64,7 +73,10 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
     return out;
   }
 
-  const std::vector<int> rho = leading_row_indices(sys);
+  LdcpData own_data;
+  if (!opt.data) own_data = ldcp_data(sys);
+  const LdcpData& data = opt.data ? *opt.data : own_data;
+  const std::vector<int>& rho = data.rho;
   for (int r = 0; r < k; ++r) {
     if (rho[r] == kInfiniteIndex) {
       out.message = "constraint " + std::to_string(r) +
@@ -73,11 +85,10 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
       return out;
     }
   }
-  const MatrixXd Mlead = leading_row_coefficients(sys);
+  const MatrixXd& Mlead = data.Mlead;
   const int first = -n + 1;
   const int last = n;
-  // Markov parameters up to the largest order used: rho + p - j <= 3n.
-  const std::vector<MatrixXd> H = markov_parameters(sys, 3 * n + 1);
+  const std::vector<MatrixXd>& H = data.H;
   // Free response coefficients C A^m x0, m = 0..2n, and their term scales.
   std::vector<VectorXd> CAx(2 * n + 1), CAx_scale(2 * n + 1);
   {

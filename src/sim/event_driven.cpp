@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <sstream>
 #include <unsupported/Eigen/MatrixFunctions>
 
@@ -88,6 +89,16 @@ double brent_root(F&& f, double a, double b, double fa, double fb, double tol) {
   return b;
 }
 
+// An upper bound on the spectral radius, ||B^16||^(1/16) ||A|| with
+// B = A/||A|| (Gelfand's formula; 4 squarings, no eigen-decomposition).
+double spectral_radius_bound(const MatrixXd& A) {
+  const double a = A.cwiseAbs().rowwise().sum().maxCoeff();
+  if (a == 0.0) return 0.0;
+  MatrixXd B = A / a;
+  for (int i = 0; i < 4; ++i) B = (B * B).eval();
+  return std::pow(B.cwiseAbs().rowwise().sum().maxCoeff(), 1.0 / 16.0) * a;
+}
+
 struct Monitor {
   RowVectorXd w;    // phi(t) = w x(t)
   RowVectorXd wA;   // phi'(t) = w Acl x(t)
@@ -129,6 +140,8 @@ class EventDriven {
     impact_ = impact::make_impact_law(opt.impact);
     impact_times_.assign(k_, {});
     ldcp_.solver = solver_.get();
+    ldcp_data_ = lcs::ldcp_data(sys_);
+    ldcp_.data = &ldcp_data_;
   }
 
   Trajectory run(const VectorXd& x0_user);
@@ -186,6 +199,8 @@ class EventDriven {
   lcs::LdcpOptions ldcp_;
   std::vector<std::vector<double>> impact_times_;  // last few impacts per contact
   lcs::IndexSet ldcp_undetermined_;  // K of the last mode selection
+  lcs::LdcpData ldcp_data_;
+  mutable std::map<lcs::IndexSet, lcs::ModeFeedback> feedback_cache_;
 };
 
 Phase EventDriven::make_phase(const lcs::IndexSet& mode, const lcs::IndexSet& undetermined,
@@ -195,7 +210,10 @@ Phase EventDriven::make_phase(const lcs::IndexSet& mode, const lcs::IndexSet& un
   ph.Acl = sys_.A;
   ph.F = MatrixXd::Zero(mode.size(), n_);
   if (!mode.empty()) {
-    const lcs::ModeFeedback fb = lcs::mode_feedback(sys_, mode);
+    auto it = feedback_cache_.find(mode);
+    if (it == feedback_cache_.end())
+      it = feedback_cache_.emplace(mode, lcs::mode_feedback(sys_, mode)).first;
+    const lcs::ModeFeedback& fb = it->second;
     if (!fb.ok) {
       err = "mode feedback F_I unavailable: " + fb.message;
       return ph;
@@ -436,8 +454,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     // Sampling step: a quarter of the fastest time scale of the closed loop,
     // so a Bohl function changes the sign of its derivative at most once
     // between samples; first steps shorter where a monitor starts at zero.
-    Eigen::EigenSolver<MatrixXd> es(phase.Acl, false);
-    const double rho = es.eigenvalues().cwiseAbs().maxCoeff();
+    const double rho = spectral_radius_bound(phase.Acl);
     double h_max = t_end - t;
     if (rho > 0.0) h_max = std::min(h_max, 0.5 / rho);
     h_max = std::min(h_max, (t_end - t) / 4.0 + 1e-300);
@@ -504,6 +521,8 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
       armed[j] = phase.monitors[j].w.dot(xstart) > noise[j];
     double ta = t;
     VectorXd xa_a = xstart;
+    MatrixXd Phi;
+    double h_phi = -1.0;
     double h = h_first;
     double t_event = std::numeric_limits<double>::infinity();
     bool event_found = false;
@@ -514,15 +533,57 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     };
     while (ta < t_end && !event_found) {
       const double tb = std::min(ta + h, t_end);
-      const MatrixXd Phi = (phase.Acl * (tb - ta)).exp();
+      if (tb - ta != h_phi) {
+        h_phi = tb - ta;
+        Phi = (phase.Acl * h_phi).exp();
+      }
       const VectorXd xa_b = Phi * xa_a;
+      // Taylor terms A^k x_a / k! on this interval, built on first need:
+      // root refinement then evaluates polynomials instead of exponentials.
+      std::vector<VectorXd> taylor;
+      bool taylor_ok = false, taylor_built = false;
+      auto build_taylor = [&] {
+        taylor_built = true;
+        const double tau = tb - ta;
+        const double xnorm = xa_a.cwiseAbs().maxCoeff();
+        taylor.push_back(xa_a);
+        double factor = 1.0;  // tau^k
+        for (int k = 1; k <= 80; ++k) {
+          taylor.push_back(phase.Acl * taylor.back() / static_cast<double>(k));
+          factor *= tau;
+          if (k >= 4 && taylor.back().cwiseAbs().maxCoeff() * factor <= 1e-18 * xnorm &&
+              taylor[k - 1].cwiseAbs().maxCoeff() * factor / tau <= 1e-17 * xnorm) {
+            taylor_ok = true;
+            return;
+          }
+        }
+      };
+      auto series = [&](const Eigen::RowVectorXd& w, double s, bool derivative) {
+        double acc = 0.0;
+        if (!derivative) {
+          for (int k = static_cast<int>(taylor.size()) - 1; k >= 0; --k)
+            acc = acc * s + w.dot(taylor[k]);
+        } else {
+          for (int k = static_cast<int>(taylor.size()) - 1; k >= 1; --k)
+            acc = acc * s + k * w.dot(taylor[k]);
+        }
+        return acc;
+      };
       for (size_t j = 0; j < phase.monitors.size(); ++j) {
         const Monitor& mon = phase.monitors[j];
         const double fa = mon.w * xa_a;
         const double fb = mon.w * xa_b;
         const double tol_f = 1e-12 * mon.scale;
-        auto phi = [&](double tt) -> double { return mon.w * ((phase.Acl * (tt - ta)).exp() * xa_a); };
-        auto dphi = [&](double tt) -> double { return mon.wA * ((phase.Acl * (tt - ta)).exp() * xa_a); };
+        auto phi = [&](double tt) -> double {
+          if (!taylor_built) build_taylor();
+          if (taylor_ok) return series(mon.w, tt - ta, false);
+          return mon.w * ((phase.Acl * (tt - ta)).exp() * xa_a);
+        };
+        auto dphi = [&](double tt) -> double {
+          if (!taylor_built) build_taylor();
+          if (taylor_ok) return series(mon.w, tt - ta, true);
+          return mon.wA * ((phase.Acl * (tt - ta)).exp() * xa_a);
+        };
         double root = std::numeric_limits<double>::infinity();
         if (!armed[j]) {
           // Started within rounding of zero: positive by mode selection, but
