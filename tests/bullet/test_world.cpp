@@ -81,8 +81,8 @@ TEST(BulletWorld, HookRunAgreesWithExactToFirstOrder) {
     // too (measured 1.768e-4 and 1.768e-5).
     EXPECT_LE(c.deviation_max, 3 * 0.177 * h) << "h = " << h;
     EXPECT_GE(c.max_violation, -1e-12);
-    // The hook engages at t = 0 (Example 3.8.3: velocities (1/2... ) after the
-    // impact keep x1 = x2); Bullet reports it at the end of its first step.
+    // The hook engages at t = 0 (the impact of Example 3.8.3 leaves x1 = x2
+    // with the hook active); Bullet reports it at the end of its first step.
     ASSERT_FALSE(c.event_shifts.empty());
     for (const auto& s : c.event_shifts) EXPECT_LE(std::abs(s.shift), 1.5 * h);
   }
