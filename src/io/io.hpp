@@ -7,6 +7,8 @@
 
 #include <Eigen/Dense>
 #include <filesystem>
+#include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
@@ -62,5 +64,48 @@ nlohmann::json trajectory_json(const mech::Model& model, const sim::Trajectory& 
 
 nlohmann::json to_json(const VectorXd& v);
 nlohmann::json to_json(const Eigen::MatrixXd& m);
+
+}  // namespace lcsim::io
+
+// ---- URDF models and scenes (docs/model-format.md, section "Scenes") ----
+
+namespace urdf {
+class ModelInterface;
+}
+
+namespace lcsim::io {
+
+// Parses a URDF file with urdfdom and checks what lcsim relies on: finite
+// numbers in every <origin>, <axis>, <inertial>, <limit> and <dynamics>;
+// masses >= 0; non-zero axes on revolute and prismatic joints; lower <= upper.
+// InputError names the file, the element and the value.
+std::shared_ptr<urdf::ModelInterface> load_urdf(const std::filesystem::path& path);
+// The same from URDF text; `source` names it in messages.
+std::shared_ptr<urdf::ModelInterface> parse_urdf(const std::string& xml, const std::string& source);
+
+// The rigid-body part of a scene linearised about a reference configuration.
+// Coordinates are the joint positions themselves (rad for revolute, m for
+// prismatic joints), in the order of `joints`.
+struct UrdfLinearisation {
+  std::vector<std::string> joints;  // the simulated joints
+  MatrixXd M;        // joint-space mass matrix at q0 (composite-rigid-body algorithm)
+  VectorXd tau_g;    // gravity generalised force at q0 (N or N m)
+  MatrixXd K_g;      // gravity stiffness -d tau_g / dq at q0 (symmetric)
+  VectorXd damping;  // <dynamics damping> of each simulated joint (N s/m or N m s/rad)
+};
+
+// Linearises `model` about q0 (positions by joint name; joints not named sit
+// at 0). Every joint not in `joints` is frozen at its q0; fixed joints are
+// merged. `gravity` in the URDF root frame (m/s^2). `source` names the URDF in
+// messages. K_g by central differences of tau_g, step 6e-6 (see urdf_model.cpp).
+UrdfLinearisation linearise_urdf(const urdf::ModelInterface& model,
+                                 const std::vector<std::string>& joints,
+                                 const std::map<std::string, double>& q0,
+                                 const Eigen::Vector3d& gravity, const std::string& source);
+
+// Scenes: a YAML file with a top-level `urdf:` key. `load_model` and
+// `parse_model` dispatch to these, so every command accepts a scene.
+mech::Model load_scene(const std::filesystem::path& path);
+mech::Model parse_scene(const std::string& yaml_text, const std::string& source);
 
 }  // namespace lcsim::io

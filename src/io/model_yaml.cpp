@@ -305,6 +305,8 @@ mech::Model parse_model(const std::string& yaml_text, const std::string& source)
   if (root.IsNull() || !root.IsDefined())
     throw InputError(source +
                      ": empty file (expected `name` and a `mechanical:` or `lcs:` section)");
+  // A top-level `urdf:` key makes the file a scene (scene.cpp).
+  if (root.IsMap() && root["urdf"]) return parse_scene(yaml_text, source);
   const Keys keys = mapping(root, source, "", {"name", "mechanical", "lcs", "initial", "t_end"});
   mech::Model model;
   model.source = source;

@@ -1,0 +1,380 @@
+// Scenes: a URDF plus the joints to simulate, springs, extra unilateral
+// constraints, the reference configuration, gravity, restitution, the initial
+// state and the horizon (docs/model-format.md, "Scenes"). The scene becomes a
+// mechanical model linearised about q0 (urdf_model.cpp).
+//
+// Coordinates are the joint positions themselves (not deviations from q0):
+//   M q'' + D q' + K q = f + E' u,   E q + g >= 0,
+//   K = K_springs + K_g,  f = tau_g(q0) + K_g q0 + sum_s k_s rest_s c_s,
+// from tau_g(q) ~ tau_g(q0) - K_g (q - q0) and a spring force
+// -k (c'q - rest) c on the coordinates (c = e_a or e_a - e_b).
+#include <urdf_model/model.h>
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include "io/detail.hpp"
+#include "io/io.hpp"
+
+namespace lcsim::io {
+
+namespace {
+
+using Keys = std::map<std::string, YAML::Node>;
+
+[[noreturn]] void fail(const std::string& source, const std::string& key, const std::string& what) {
+  throw InputError(source + ": " + key + ": " + what);
+}
+
+std::string describe(const YAML::Node& n) {
+  switch (n.Type()) {
+    case YAML::NodeType::Scalar:
+      return "'" + n.Scalar() + "'";
+    case YAML::NodeType::Sequence:
+      return "a list of " + std::to_string(n.size()) + " entries";
+    case YAML::NodeType::Map:
+      return "a mapping";
+    case YAML::NodeType::Null:
+      return "nothing";
+    default:
+      return "an undefined value";
+  }
+}
+
+std::string join(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+Keys mapping(const YAML::Node& node, const std::string& source, const std::string& key,
+             const std::vector<std::string>& allowed) {
+  const std::string where = key.empty() ? "top level" : key;
+  if (!node.IsMap()) fail(source, where, "expected a mapping of keys (got " + describe(node) + ")");
+  Keys out;
+  for (const auto& kv : node) {
+    if (!kv.first.IsScalar())
+      fail(source, where, "keys must be plain names (got " + describe(kv.first) + ")");
+    const std::string name = kv.first.Scalar();
+    const std::string full = key.empty() ? name : key + "." + name;
+    if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), name) == allowed.end())
+      fail(source, full, "unknown key (expected one of " + join(allowed) + ")");
+    if (out.count(name)) fail(source, full, "duplicate key");
+    out.emplace(name, kv.second);
+  }
+  return out;
+}
+
+double number(const YAML::Node& n, const std::string& source, const std::string& key) {
+  if (!n.IsScalar()) fail(source, key, "expected a number (got " + describe(n) + ")");
+  double x = 0.0;
+  try {
+    x = n.as<double>();
+  } catch (const YAML::Exception&) {
+    fail(source, key, "not a number (got '" + n.Scalar() + "')");
+  }
+  if (!std::isfinite(x)) fail(source, key, "not finite (got '" + n.Scalar() + "')");
+  return x;
+}
+
+std::string name_of(const YAML::Node& n, const std::string& source, const std::string& key) {
+  if (!n.IsScalar() || n.Scalar().empty())
+    fail(source, key, "expected a non-empty name (got " + describe(n) + ")");
+  return n.Scalar();
+}
+
+// {joint: value} with every joint named in `allowed_joints` (a joint of the URDF
+// for q0, a simulated joint otherwise); `what` explains the restriction.
+std::map<std::string, double> by_joint(
+    const YAML::Node& n, const std::string& source, const std::string& key,
+    const std::function<std::string(const std::string&)>& check) {
+  std::map<std::string, double> out;
+  for (const auto& [name, value] : mapping(n, source, key, {})) {
+    const std::string why = check(name);
+    if (!why.empty()) fail(source, key + "." + name, why);
+    out[name] = number(value, source, key + "." + name);
+  }
+  return out;
+}
+
+}  // namespace
+
+mech::Model parse_scene(const std::string& yaml_text, const std::string& source) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw InputError(source + ": malformed YAML at line " + std::to_string(e.mark.line + 1) +
+                     ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
+  }
+  const Keys keys = mapping(root, source, "",
+                            {"name", "urdf", "joints", "q0", "gravity", "springs", "constraints",
+                             "restitution", "initial", "t_end"});
+  mech::Model model;
+  model.source = source;
+  model.name = std::filesystem::path(source).stem().string();
+  if (keys.count("name")) model.name = name_of(keys.at("name"), source, "name");
+
+  // The URDF, relative to the scene's directory.
+  if (!keys.count("urdf")) fail(source, "urdf", "missing (a scene names its URDF file)");
+  const std::string urdf_name = name_of(keys.at("urdf"), source, "urdf");
+  const std::filesystem::path urdf_path =
+      std::filesystem::path(source).parent_path() / std::filesystem::path(urdf_name);
+  std::shared_ptr<urdf::ModelInterface> urdf_model;
+  {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(urdf_path, ec))
+      fail(source, "urdf",
+           "no such file (got '" + urdf_name + "', looked for '" + urdf_path.string() + "')");
+    urdf_model = load_urdf(urdf_path);
+  }
+  const urdf::ModelInterface& um = *urdf_model;
+  const std::string us = urdf_path.string();
+
+  // Simulated joints and their stops.
+  if (!keys.count("joints")) fail(source, "joints", "missing (name the joints to simulate)");
+  const YAML::Node& jn = keys.at("joints");
+  if (!jn.IsSequence() || jn.size() == 0)
+    fail(source, "joints", "expected a non-empty list of joint names (got " + describe(jn) + ")");
+  std::vector<std::string> joints;
+  std::vector<std::vector<std::string>> stops;
+  for (std::size_t i = 0; i < jn.size(); ++i) {
+    const std::string k = "joints[" + std::to_string(i) + "]";
+    std::string name;
+    std::vector<std::string> st{"lower", "upper"};
+    if (jn[i].IsMap()) {
+      const Keys jk = mapping(jn[i], source, k, {"name", "stops"});
+      if (!jk.count("name")) fail(source, k + ".name", "missing");
+      name = name_of(jk.at("name"), source, k + ".name");
+      if (jk.count("stops")) {
+        const YAML::Node& s = jk.at("stops");
+        if (!s.IsSequence())
+          fail(source, k + ".stops", "expected a list of lower/upper (got " + describe(s) + ")");
+        st.clear();
+        for (std::size_t m = 0; m < s.size(); ++m) {
+          const std::string sk = k + ".stops[" + std::to_string(m) + "]";
+          const std::string v = name_of(s[m], source, sk);
+          if (v != "lower" && v != "upper")
+            fail(source, sk, "expected lower or upper (got '" + v + "')");
+          if (std::count(st.begin(), st.end(), v)) fail(source, sk, "duplicate '" + v + "'");
+          st.push_back(v);
+        }
+      }
+    } else {
+      name = name_of(jn[i], source, k);
+    }
+    const auto j = um.getJoint(name);
+    if (!j) fail(source, k, "no joint '" + name + "' in " + us);
+    if (j->type != urdf::Joint::REVOLUTE && j->type != urdf::Joint::PRISMATIC)
+      fail(source, k,
+           "joint '" + name +
+               "' is not revolute or prismatic (only those can be simulated; leave it out to "
+               "freeze it)");
+    if (std::count(joints.begin(), joints.end(), name))
+      fail(source, k, "duplicate joint '" + name + "'");
+    if (!st.empty() && !j->limits)
+      fail(source, k, "joint '" + name + "' has no <limit> in " + us + " (write stops: [])");
+    joints.push_back(name);
+    stops.push_back(st);
+  }
+  const auto N = static_cast<Eigen::Index>(joints.size());
+  const auto coord = [&](const std::string& n) -> Eigen::Index {
+    return std::find(joints.begin(), joints.end(), n) - joints.begin();
+  };
+  const auto simulated = [&](const std::string& n) -> std::string {
+    if (!um.getJoint(n)) return "no joint '" + n + "' in " + us;
+    if (coord(n) == N)
+      return "joint '" + n +
+             "' is frozen (not in joints:); only simulated joints can carry springs, constraints "
+             "and initial values";
+    return "";
+  };
+
+  std::map<std::string, double> q0;
+  if (keys.count("q0"))
+    q0 = by_joint(keys.at("q0"), source, "q0", [&](const std::string& n) -> std::string {
+      const auto j = um.getJoint(n);
+      if (!j) return "no joint '" + n + "' in " + us;
+      if (j->type != urdf::Joint::REVOLUTE && j->type != urdf::Joint::PRISMATIC &&
+          j->type != urdf::Joint::CONTINUOUS)
+        return "joint '" + n + "' has no position (not revolute, continuous or prismatic)";
+      return "";
+    });
+
+  Eigen::Vector3d gravity(0.0, 0.0, -9.81);
+  if (keys.count("gravity")) {
+    const YAML::Node& g = keys.at("gravity");
+    if (!g.IsSequence() || g.size() != 3)
+      fail(source, "gravity", "expected a vector of 3 numbers in m/s^2 (got " + describe(g) + ")");
+    for (std::size_t i = 0; i < 3; ++i)
+      gravity(static_cast<Eigen::Index>(i)) =
+          number(g[i], source, "gravity[" + std::to_string(i) + "]");
+  }
+
+  const UrdfLinearisation lin = linearise_urdf(um, joints, q0, gravity, us);
+  VectorXd q0v = VectorXd::Zero(N);
+  for (Eigen::Index i = 0; i < N; ++i)
+    if (q0.count(joints[static_cast<std::size_t>(i)]))
+      q0v(i) = q0.at(joints[static_cast<std::size_t>(i)]);
+
+  mech::MechanicalModel m;
+  m.M = lin.M;
+  m.D = MatrixXd(lin.damping.asDiagonal());
+  m.K = lin.K_g;
+  m.f = lin.tau_g + lin.K_g * q0v;
+  m.coordinates = joints;
+
+  if (keys.count("springs")) {
+    const YAML::Node& sn = keys.at("springs");
+    if (!sn.IsSequence()) fail(source, "springs", "expected a list (got " + describe(sn) + ")");
+    for (std::size_t i = 0; i < sn.size(); ++i) {
+      const std::string k = "springs[" + std::to_string(i) + "]";
+      const Keys sk =
+          mapping(sn[i], source, k, {"name", "joint", "other", "stiffness", "damping", "rest"});
+      if (!sk.count("joint")) fail(source, k + ".joint", "missing");
+      VectorXd c = VectorXd::Zero(N);
+      for (const char* role : {"joint", "other"}) {
+        if (!sk.count(role)) continue;
+        const std::string rk = k + "." + role;
+        const std::string jn2 = name_of(sk.at(role), source, rk);
+        const std::string why = simulated(jn2);
+        if (!why.empty()) fail(source, rk, why);
+        c(coord(jn2)) += std::string(role) == "joint" ? 1.0 : -1.0;
+      }
+      if (c.isZero()) fail(source, k + ".other", "a spring between a joint and itself");
+      double stiffness = 0.0, damping = 0.0, rest = 0.0;
+      if (sk.count("stiffness")) stiffness = number(sk.at("stiffness"), source, k + ".stiffness");
+      if (sk.count("damping")) damping = number(sk.at("damping"), source, k + ".damping");
+      if (sk.count("rest")) rest = number(sk.at("rest"), source, k + ".rest");
+      if (stiffness < 0.0)
+        fail(source, k + ".stiffness", "must be >= 0 (got " + format_number(stiffness) + ")");
+      if (damping < 0.0)
+        fail(source, k + ".damping", "must be >= 0 (got " + format_number(damping) + ")");
+      m.K += stiffness * c * c.transpose();
+      m.D += damping * c * c.transpose();
+      m.f += stiffness * rest * c;
+    }
+  }
+
+  // Constraints: joint stops first (joint order, lower before upper), then
+  // the scene's constraints in file order.
+  std::vector<VectorXd> rows;
+  std::vector<double> gaps;
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    const auto j = um.getJoint(joints[i]);
+    for (const auto& s : stops[i]) {
+      VectorXd r = VectorXd::Zero(N);
+      if (s == "lower") {
+        r(static_cast<Eigen::Index>(i)) = 1.0;  // q - lower >= 0
+        gaps.push_back(-j->limits->lower);
+      } else {
+        r(static_cast<Eigen::Index>(i)) = -1.0;  // upper - q >= 0
+        gaps.push_back(j->limits->upper);
+      }
+      rows.push_back(r);
+      m.constraints.push_back(joints[i] + "_" + s);
+    }
+  }
+  if (keys.count("constraints")) {
+    const YAML::Node& cn = keys.at("constraints");
+    if (!cn.IsSequence()) fail(source, "constraints", "expected a list (got " + describe(cn) + ")");
+    for (std::size_t i = 0; i < cn.size(); ++i) {
+      const std::string k = "constraints[" + std::to_string(i) + "]";
+      const Keys ck = mapping(cn[i], source, k, {"name", "coefficients", "g"});
+      if (!ck.count("name")) fail(source, k + ".name", "missing");
+      if (!ck.count("coefficients")) fail(source, k + ".coefficients", "missing");
+      const std::string name = name_of(ck.at("name"), source, k + ".name");
+      VectorXd r = VectorXd::Zero(N);
+      for (const auto& [jname, c] :
+           by_joint(ck.at("coefficients"), source, k + ".coefficients", simulated))
+        r(coord(jname)) = c;
+      if (r.isZero()) fail(source, k + ".coefficients", "all zero (the constraint says nothing)");
+      rows.push_back(r);
+      gaps.push_back(ck.count("g") ? number(ck.at("g"), source, k + ".g") : 0.0);
+      m.constraints.push_back(name);
+    }
+  }
+  {
+    std::set<std::string> seen;
+    for (const auto& c : m.constraints)
+      if (!seen.insert(c).second)
+        fail(source, "constraints", "duplicate constraint name '" + c + "'");
+  }
+  const auto k = static_cast<Eigen::Index>(rows.size());
+  m.E = MatrixXd::Zero(k, N);
+  m.g = VectorXd::Zero(k);
+  for (Eigen::Index i = 0; i < k; ++i) {
+    m.E.row(i) = rows[static_cast<std::size_t>(i)].transpose();
+    m.g(i) = gaps[static_cast<std::size_t>(i)];
+  }
+  m.restitution = VectorXd::Zero(k);
+  if (keys.count("restitution")) {
+    for (const auto& [name, e] :
+         by_joint(keys.at("restitution"), source, "restitution",
+                  [&](const std::string& n) -> std::string {
+                    if (!std::count(m.constraints.begin(), m.constraints.end(), n))
+                      return "no constraint '" + n + "' (the constraints are " +
+                             join(m.constraints) + ")";
+                    return "";
+                  })) {
+      if (e < 0.0 || e > 1.0)
+        fail(source, "restitution." + name, "outside [0, 1] (got " + format_number(e) + ")");
+      m.restitution(std::find(m.constraints.begin(), m.constraints.end(), name) -
+                    m.constraints.begin()) = e;
+    }
+  }
+
+  // M must be symmetric positive definite (the CRBA makes it symmetric by
+  // construction; a massless subtree makes it singular).
+  {
+    const Eigen::SelfAdjointEigenSolver<MatrixXd> es(m.M);
+    const double eps = std::numeric_limits<double>::epsilon();
+    if (es.eigenvalues().minCoeff() <=
+        static_cast<double>(N) * eps * std::abs(es.eigenvalues().maxCoeff()))
+      fail(source, "joints",
+           "the mass matrix at q0 is not positive definite (smallest eigenvalue " +
+               format_number(es.eigenvalues().minCoeff()) +
+               "); a simulated joint moves no inertia about its axis");
+  }
+
+  if (keys.count("initial")) {
+    const Keys ik = mapping(keys.at("initial"), source, "initial", {"q", "v"});
+    VectorXd x(2 * N);
+    x << q0v, VectorXd::Zero(N);
+    for (const char* part : {"q", "v"}) {
+      if (!ik.count(part)) continue;
+      for (const auto& [jname, val] :
+           by_joint(ik.at(part), source, std::string("initial.") + part, simulated))
+        x(coord(jname) + (std::string(part) == "v" ? N : 0)) = val;
+    }
+    model.initial = x;
+  }
+  if (keys.count("t_end")) {
+    model.t_end = number(keys.at("t_end"), source, "t_end");
+    if (!(model.t_end > 0.0))
+      fail(source, "t_end", "must be > 0 (got " + format_number(model.t_end) + ")");
+  }
+  mech::fill_defaults(m);
+  model.mechanical = m;
+  return model;
+}
+
+mech::Model load_scene(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw InputError(path.string() + ": cannot open: no such file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string() + ": cannot open: unreadable");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse_scene(ss.str(), path.string());
+}
+
+}  // namespace lcsim::io
