@@ -111,3 +111,30 @@ lcp::Result solve_bullet_mlcp(MlcpSolver which, const Eigen::MatrixXd& M, const 
 void register_backends();
 
 }  // namespace lcsim::bullet
+
+// ---- Featherstone multibody from a URDF (multibody.cpp) ----
+
+#include <Eigen/Dense>
+#include <map>
+#include <vector>
+
+namespace urdf {
+class ModelInterface;
+}
+
+namespace lcsim::bullet {
+
+// The joint-space mass matrix of `model` at the configuration q0 (positions
+// by joint name, 0 where not given), computed by Bullet: a btMultiBody with a
+// fixed base is built for the simulated `joints` (revolute or prismatic), every
+// other joint frozen at q0 and its child merged into the parent body (mass,
+// centre of mass and inertia combined, principal axes by Bullet's Jacobi
+// diagonalisation). Column j of M^{-1} is the joint acceleration that Bullet's
+// articulated-body algorithm (calcAccelerationDeltasMultiDof) gives for a unit
+// force on joint j at zero velocity without gravity; M is its inverse. The
+// model must be valid (io::load_urdf) with mass on every simulated body.
+Eigen::MatrixXd multibody_mass_matrix(const urdf::ModelInterface& model,
+                                      const std::vector<std::string>& joints,
+                                      const std::map<std::string, double>& q0);
+
+}  // namespace lcsim::bullet

@@ -1,0 +1,183 @@
+// A Bullet Featherstone btMultiBody built from a URDF, used to cross-check the
+// composite-rigid-body mass matrix of src/io. Deliberately independent of
+// src/io's kinematics: link poses, the merging of frozen links and the
+// principal axes are computed here with Bullet's own types.
+#include <BulletDynamics/Featherstone/btMultiBody.h>
+#include <BulletDynamics/Featherstone/btMultiBodyLink.h>
+#include <urdf_model/model.h>
+
+#include <functional>
+#include <stdexcept>
+
+#include "bullet/bullet.hpp"
+
+namespace lcsim::bullet {
+
+namespace {
+
+btTransform to_bt(const urdf::Pose& p) {
+  return btTransform(btQuaternion(p.rotation.x, p.rotation.y, p.rotation.z, p.rotation.w),
+                     btVector3(p.position.x, p.position.y, p.position.z));
+}
+
+btVector3 to_bt(const urdf::Vector3& v) { return btVector3(v.x, v.y, v.z); }
+
+// The joint's own motion at q; frozen joints only (simulated ones are built
+// at q = 0 and then set by btMultiBody::setJointPos).
+btTransform frozen_motion(const urdf::Joint& j, double q) {
+  const btVector3 a = to_bt(j.axis).normalized();
+  if (j.type == urdf::Joint::REVOLUTE || j.type == urdf::Joint::CONTINUOUS)
+    return btTransform(btQuaternion(a, q), btVector3(0, 0, 0));
+  if (j.type == urdf::Joint::PRISMATIC) return btTransform(btQuaternion::getIdentity(), q * a);
+  return btTransform::getIdentity();
+}
+
+struct Body {
+  std::string joint;  // simulated joint whose child this body is
+  int parent = -1;    // Bullet link index of the parent body (-1: the base)
+  double mass = 0.0;
+  btVector3 com{0, 0, 0};  // world, at the build configuration
+  btMatrix3x3 inertia;     // about com, world axes
+  btTransform com_frame;   // world pose of the principal-axes frame at com
+  btVector3 principal{0, 0, 0};
+};
+
+}  // namespace
+
+Eigen::MatrixXd multibody_mass_matrix(const urdf::ModelInterface& model,
+                                      const std::vector<std::string>& joints,
+                                      const std::map<std::string, double>& q0) {
+  const auto q_of = [&](const std::string& name) {
+    const auto it = q0.find(name);
+    return it == q0.end() ? 0.0 : it->second;
+  };
+  const auto simulated_index = [&](const std::string& name) {
+    for (std::size_t i = 0; i < joints.size(); ++i)
+      if (joints[i] == name) return static_cast<int>(i);
+    return -1;
+  };
+
+  // World poses with simulated joints at 0, frozen joints at q0; bodies in
+  // depth-first order (Bullet wants parents before children).
+  std::map<std::string, btTransform> X;
+  std::map<std::string, int> owner;  // link -> Bullet link index (-1: base)
+  std::vector<Body> bodies;
+  std::function<void(const urdf::Link&, int)> walk = [&](const urdf::Link& link, int own) {
+    owner[link.name] = own;
+    for (const auto& cj : link.child_joints) {
+      btTransform Xc = X[link.name] * to_bt(cj->parent_to_joint_origin_transform);
+      int child_owner = own;
+      if (simulated_index(cj->name) >= 0) {
+        Body b;
+        b.joint = cj->name;
+        b.parent = own;
+        bodies.push_back(b);
+        child_owner = static_cast<int>(bodies.size()) - 1;
+      } else {
+        Xc = Xc * frozen_motion(*cj, q_of(cj->name));
+      }
+      X[cj->child_link_name] = Xc;
+      walk(*model.getLink(cj->child_link_name), child_owner);
+    }
+  };
+  X[model.getRoot()->name] = btTransform::getIdentity();
+  walk(*model.getRoot(), -1);
+  if (bodies.size() != joints.size())
+    throw std::invalid_argument("multibody_mass_matrix: a simulated joint is not in the URDF tree");
+
+  // Merge every link into its body: total mass, centre of mass, then the
+  // inertia about that centre (parallel-axis theorem), then principal axes.
+  for (const auto& [name, own] : owner) {
+    const auto link = model.getLink(name);
+    if (own < 0 || !link->inertial) continue;
+    Body& b = bodies[static_cast<std::size_t>(own)];
+    const btTransform Xi = X[name] * to_bt(link->inertial->origin);
+    b.com += link->inertial->mass * Xi.getOrigin();
+    b.mass += link->inertial->mass;
+  }
+  for (auto& b : bodies) {
+    b.com /= b.mass;
+    b.inertia.setValue(0, 0, 0, 0, 0, 0, 0, 0, 0);
+  }
+  for (const auto& [name, own] : owner) {
+    const auto link = model.getLink(name);
+    if (own < 0 || !link->inertial) continue;
+    Body& b = bodies[static_cast<std::size_t>(own)];
+    const urdf::Inertial& in = *link->inertial;
+    const btTransform Xi = X[name] * to_bt(in.origin);
+    const btMatrix3x3 I(in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz);
+    const btMatrix3x3& R = Xi.getBasis();
+    const btVector3 d = Xi.getOrigin() - b.com;
+    const btMatrix3x3 parallel(d.dot(d) - d.x() * d.x(), -d.x() * d.y(), -d.x() * d.z(),
+                               -d.y() * d.x(), d.dot(d) - d.y() * d.y(), -d.y() * d.z(),
+                               -d.z() * d.x(), -d.z() * d.y(), d.dot(d) - d.z() * d.z());
+    b.inertia = b.inertia + R * I * R.transpose() + parallel * in.mass;
+  }
+  for (auto& b : bodies) {
+    btMatrix3x3 rot;
+    btMatrix3x3 diag = b.inertia;
+    diag.diagonalize(rot, 1e-15, 200);  // inertia = rot * diag * rot^T
+    b.principal = btVector3(diag[0][0], diag[1][1], diag[2][2]);
+    b.com_frame = btTransform(rot, b.com);
+  }
+
+  const int n = static_cast<int>(bodies.size());
+  btMultiBody mb(n, 1.0, btVector3(1, 1, 1), /*fixedBase=*/true, /*canSleep=*/false);
+  mb.setBaseWorldTransform(btTransform::getIdentity());
+  for (int i = 0; i < n; ++i) {
+    const Body& b = bodies[static_cast<std::size_t>(i)];
+    const auto j = model.getJoint(b.joint);
+    const btTransform parent_frame = b.parent < 0
+                                         ? btTransform::getIdentity()
+                                         : bodies[static_cast<std::size_t>(b.parent)].com_frame;
+    const btMatrix3x3& Rp = parent_frame.getBasis();
+    const btMatrix3x3& Rc = b.com_frame.getBasis();
+    const btTransform& Xj = X[j->child_link_name];  // joint frame at q = 0
+    const btVector3 pivot = Xj.getOrigin();
+    const btVector3 axis = Rc.transpose() * (Xj.getBasis() * to_bt(j->axis).normalized());
+    btQuaternion rot_parent_to_this;
+    (Rc.transpose() * Rp).getRotation(rot_parent_to_this);
+    const btVector3 parent_com_to_pivot = Rp.transpose() * (pivot - parent_frame.getOrigin());
+    const btVector3 pivot_to_com = Rc.transpose() * (b.com - pivot);
+    if (j->type == urdf::Joint::PRISMATIC)
+      mb.setupPrismatic(i, b.mass, b.principal, b.parent, rot_parent_to_this, axis,
+                        parent_com_to_pivot, pivot_to_com, true);
+    else
+      mb.setupRevolute(i, b.mass, b.principal, b.parent, rot_parent_to_this, axis,
+                       parent_com_to_pivot, pivot_to_com, true);
+  }
+  mb.finalizeMultiDof();
+  // Pitfalls (shared/notes/bullet.md): default damping 0.04; no gyroscopic
+  // terms at zero velocity anyway. No gravity: a btMultiBody outside a world
+  // feels only the forces added to it.
+  mb.setLinearDamping(0);
+  mb.setAngularDamping(0);
+  mb.setUseGyroTerm(false);
+  for (int i = 0; i < n; ++i) mb.setJointPos(i, q_of(bodies[static_cast<std::size_t>(i)].joint));
+  mb.clearForcesAndTorques();
+  mb.clearVelocities();
+
+  btAlignedObjectArray<btScalar> scratch_r;
+  btAlignedObjectArray<btVector3> scratch_v;
+  btAlignedObjectArray<btMatrix3x3> scratch_m;
+  mb.computeAccelerationsArticulatedBodyAlgorithmMultiDof(1e-3, scratch_r, scratch_v, scratch_m,
+                                                          false, false, false);
+  // Bullet link order -> the caller's joint order.
+  std::vector<int> coord(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i)
+    coord[static_cast<std::size_t>(i)] = simulated_index(bodies[static_cast<std::size_t>(i)].joint);
+  Eigen::MatrixXd Minv(n, n);
+  std::vector<btScalar> force(static_cast<std::size_t>(6 + n)),
+      out(static_cast<std::size_t>(6 + n));
+  for (int c = 0; c < n; ++c) {
+    std::fill(force.begin(), force.end(), 0.0);
+    force[static_cast<std::size_t>(6 + c)] = 1.0;
+    mb.calcAccelerationDeltasMultiDof(force.data(), out.data(), scratch_r, scratch_v);
+    for (int r = 0; r < n; ++r)
+      Minv(coord[static_cast<std::size_t>(r)], coord[static_cast<std::size_t>(c)]) =
+          out[static_cast<std::size_t>(6 + r)];
+  }
+  return Minv.inverse();
+}
+
+}  // namespace lcsim::bullet
