@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <random>
 
@@ -152,6 +153,8 @@ TEST(Scene, DoublePendulumAwayFromEquilibrium) {
   const double t1 = 0.3, t2 = -0.2;
   EXPECT_LE((m.M - p.M(t2)).cwiseAbs().maxCoeff(), 1e-13) << m.M;
   EXPECT_LE((m.K - p.K(t1, t2)).cwiseAbs().maxCoeff(), 1e-8) << m.K;
+  std::printf("[ K_g check] double pendulum q0 = (0.3, -0.2): max|K - K_hand| = %.3g N m/rad\n",
+              (m.K - p.K(t1, t2)).cwiseAbs().maxCoeff());
   const VectorXd q0 = (VectorXd(2) << t1, t2).finished();
   const VectorXd f = p.tau(t1, t2) + p.K(t1, t2) * q0;
   EXPECT_LE((m.f - f).cwiseAbs().maxCoeff(), 1e-8) << m.f.transpose();
