@@ -44,18 +44,38 @@ double markov_zero_tol(const std::vector<MatrixXd>& H, const Lcs& sys, int i) {
   return 1e-12 * scale;
 }
 
-std::vector<int> leading_indices(const Lcs& sys, bool rows) {
+// Markov parameters are computed one order at a time and the search stops
+// once every row (column) has found its leading index: mechanical models need
+// H^0..H^2 only, whatever n.
+std::vector<int> leading_indices(const Lcs& sys, bool rows, MatrixXd* coefficients) {
   const int n = sys.n();
   const int k = sys.k();
-  const auto H = markov_parameters(sys, n + 1);
   std::vector<int> idx(k, kInfiniteIndex);
-  for (int j = 0; j < k; ++j) {
-    for (int i = 0; i <= n; ++i) {
-      if (H[i].size() == 0) continue;
+  if (coefficients) *coefficients = MatrixXd::Zero(k, k);
+  int found = 0;
+  std::vector<MatrixXd> H;  // H^0..H^i so far (markov_zero_tol reads H[i])
+  MatrixXd AiB = sys.B;
+  for (int i = 0; i <= n && found < k; ++i) {
+    if (i == 0) {
+      H.push_back(sys.D);
+    } else {
+      H.push_back(sys.C * AiB);
+      AiB = sys.A * AiB;
+    }
+    if (H[i].size() == 0) continue;
+    const double tol = markov_zero_tol(H, sys, i);
+    for (int j = 0; j < k; ++j) {
+      if (idx[j] != kInfiniteIndex) continue;
       const double v = rows ? H[i].row(j).cwiseAbs().maxCoeff() : H[i].col(j).cwiseAbs().maxCoeff();
-      if (v > markov_zero_tol(H, sys, i)) {
+      if (v > tol) {
         idx[j] = i;
-        break;
+        ++found;
+        if (coefficients) {
+          if (rows)
+            coefficients->row(j) = H[i].row(j);
+          else
+            coefficients->col(j) = H[i].col(j);
+        }
       }
     }
   }
@@ -64,24 +84,20 @@ std::vector<int> leading_indices(const Lcs& sys, bool rows) {
 
 }  // namespace
 
-std::vector<int> leading_row_indices(const Lcs& sys) { return leading_indices(sys, true); }
-std::vector<int> leading_column_indices(const Lcs& sys) { return leading_indices(sys, false); }
+std::vector<int> leading_row_indices(const Lcs& sys) { return leading_indices(sys, true, nullptr); }
+std::vector<int> leading_column_indices(const Lcs& sys) {
+  return leading_indices(sys, false, nullptr);
+}
 
 MatrixXd leading_row_coefficients(const Lcs& sys) {
-  const auto rho = leading_row_indices(sys);
-  const auto H = markov_parameters(sys, sys.n() + 1);
-  MatrixXd M = MatrixXd::Zero(sys.k(), sys.k());
-  for (int i = 0; i < sys.k(); ++i)
-    if (rho[i] != kInfiniteIndex) M.row(i) = H[rho[i]].row(i);
+  MatrixXd M;
+  leading_indices(sys, true, &M);
   return M;
 }
 
 MatrixXd leading_column_coefficients(const Lcs& sys) {
-  const auto eta = leading_column_indices(sys);
-  const auto H = markov_parameters(sys, sys.n() + 1);
-  MatrixXd N = MatrixXd::Zero(sys.k(), sys.k());
-  for (int j = 0; j < sys.k(); ++j)
-    if (eta[j] != kInfiniteIndex) N.col(j) = H[eta[j]].col(j);
+  MatrixXd N;
+  leading_indices(sys, false, &N);
   return N;
 }
 

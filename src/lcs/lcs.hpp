@@ -114,13 +114,19 @@ struct ModeSelection {
   VectorXd x_plus;  // re-initialised state x0 + sum_j A^j B u^{-j} (eq. (3.10))
   int lcp_solves = 0;
 };
-// What the LDCP needs of the system alone (leading row indices, script M,
-// Markov parameters H^0..H^{3n}): compute once per system and pass it in
-// LdcpOptions::data when selecting modes repeatedly (event-driven runs).
+// What the LDCP needs of the system alone: leading row indices, script M,
+// and the Markov parameters H^i, computed on first use (a mode selection
+// rarely needs more than a few orders; mechanical models with n = 2N+1 would
+// otherwise pay for 3n products). Compute once per system and pass it in
+// LdcpOptions::data when selecting modes repeatedly. Keeps a pointer to sys,
+// which must outlive it.
 struct LdcpData {
   std::vector<int> rho;
   MatrixXd Mlead;
-  std::vector<MatrixXd> H;
+  const MatrixXd& markov(int i) const;  // H^i
+  const Lcs* sys = nullptr;
+  mutable std::vector<MatrixXd> H;
+  mutable MatrixXd AiB;  // A^{i} B for the next order
 };
 LdcpData ldcp_data(const Lcs& sys);
 

@@ -52,9 +52,20 @@ LdcpData ldcp_data(const Lcs& sys) {
   LdcpData d;
   d.rho = leading_row_indices(sys);
   d.Mlead = leading_row_coefficients(sys);
-  // Markov parameters up to the largest order used: rho + p - j <= 3n.
-  d.H = markov_parameters(sys, 3 * sys.n() + 1);
+  d.sys = &sys;
   return d;
+}
+
+const MatrixXd& LdcpData::markov(int i) const {
+  if (H.empty()) {
+    H.push_back(sys->D);
+    AiB = sys->B;
+  }
+  while (static_cast<int>(H.size()) <= i) {
+    H.push_back(sys->C * AiB);
+    AiB = sys->A * AiB;
+  }
+  return H[i];
 }
 
 ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions& opt) {
@@ -88,21 +99,23 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
   const MatrixXd& Mlead = data.Mlead;
   const int first = -n + 1;
   const int last = n;
-  const std::vector<MatrixXd>& H = data.H;
-  // Free response coefficients C A^m x0, m = 0..2n, and their term scales.
-  std::vector<VectorXd> CAx(2 * n + 1), CAx_scale(2 * n + 1);
-  {
-    VectorXd Amx = x0;
-    VectorXd Amx_abs = x0.cwiseAbs();
-    const MatrixXd Aabs = sys.A.cwiseAbs();
-    const MatrixXd Cabs = sys.C.cwiseAbs();
-    for (int m = 0; m <= 2 * n; ++m) {
-      CAx[m] = sys.C * Amx;
-      CAx_scale[m] = Cabs * Amx_abs;
+  // Free response coefficients C A^m x0 and their term scales, on demand.
+  std::vector<VectorXd> CAx, CAx_scale;
+  VectorXd Amx = x0, Amx_abs = x0.cwiseAbs();
+  MatrixXd Aabs, Cabs;
+  auto free_response = [&](int m) -> int {
+    if (CAx.empty()) {
+      Aabs = sys.A.cwiseAbs();
+      Cabs = sys.C.cwiseAbs();
+    }
+    while (static_cast<int>(CAx.size()) <= m) {
+      CAx.push_back(sys.C * Amx);
+      CAx_scale.push_back(Cabs * Amx_abs);
       Amx = sys.A * Amx;
       Amx_abs = Aabs * Amx_abs;
     }
-  }
+    return m;
+  };
 
   std::unique_ptr<lcp::Solver> own_solver;
   const lcp::Solver* solver = opt.solver;
@@ -121,17 +134,18 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
     for (int r = 0; r < k; ++r) {
       const int order = rho[r] + p;
       if (order >= 1) {
-        xi(r) += CAx[order - 1](r);
-        scale(r) += CAx_scale[order - 1](r);
+        const int m = free_response(order - 1);
+        xi(r) += CAx[m](r);
+        scale(r) += CAx_scale[m](r);
       }
       for (int j = first; j < p; ++j) {
         const VectorXd& uj = u[j - first];
         if (uj.isZero(0.0)) continue;
         const int h = order - j;
-        if (h < 0 || h >= static_cast<int>(H.size())) continue;
-        const double term = H[h].row(r).dot(uj);
-        xi(r) += term;
-        scale(r) += H[h].row(r).cwiseAbs().dot(uj.cwiseAbs());
+        if (h < 0 || h > 3 * n) continue;
+        const MatrixXd& Hh = data.markov(h);
+        xi(r) += Hh.row(r).dot(uj);
+        scale(r) += Hh.row(r).cwiseAbs().dot(uj.cwiseAbs());
       }
     }
     auto tol_y = [&](int r) { return opt.tol_rel * scale(r) + opt.tol_abs; };
