@@ -15,6 +15,7 @@
 // for joints on different branches (Featherstone, Rigid Body Dynamics
 // Algorithms, §6.2; expressed in world coordinates no transforms between
 // body frames are needed).
+#include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Geometry>
@@ -265,20 +266,50 @@ VectorXd gravity_force(const Tree& t, const std::map<std::string, double>& q,
   return tau;
 }
 
+// Collects urdfdom's messages (sent through console_bridge) while it
+// parses, so that the InputError can quote its errors: they name the element.
+// Installed for the duration of one parse; console_bridge's handler is
+// process-global, so parsing is not thread-safe (neither is urdfdom's log).
+class CapturedLog : public console_bridge::OutputHandler {
+ public:
+  CapturedLog() { console_bridge::useOutputHandler(this); }
+  ~CapturedLog() override { console_bridge::restorePreviousOutputHandler(); }
+  CapturedLog(const CapturedLog&) = delete;
+  CapturedLog& operator=(const CapturedLog&) = delete;
+  void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
+    if (level < console_bridge::CONSOLE_BRIDGE_LOG_ERROR) return;
+    std::string t = text;
+    while (!t.empty() && (t.back() == '\n' || t.back() == ' ' || t.back() == '.')) t.pop_back();
+    if (!t.empty()) text_ += (text_.empty() ? "" : "; ") + t;
+  }
+  const std::string& text() const { return text_; }
+
+ private:
+  std::string text_;
+};
+
 }  // namespace
 
 std::shared_ptr<urdf::ModelInterface> parse_urdf(const std::string& xml,
                                                  const std::string& source) {
   urdf::ModelInterfaceSharedPtr m;
+  std::string log;
   try {
-    m = urdf::parseURDF(xml);
-  } catch (const std::exception& e) {
-    throw InputError(source + ": not a valid URDF: " + e.what());
+    const CapturedLog capture;
+    try {
+      m = urdf::parseURDF(xml);
+    } catch (const std::exception& e) {
+      throw InputError(source + ": not a valid URDF: " + e.what());
+    }
+    log = capture.text();
+  } catch (const InputError&) {
+    throw;
   }
-  if (!m)
-    throw InputError(source +
-                     ": not a valid URDF (malformed XML, or an element urdfdom refuses; its "
-                     "message on stderr names the element)");
+  // urdfdom reports some bad elements (e.g. a non-numeric <mass value>) as
+  // errors but goes on without them: refuse those as well.
+  if (!m || !log.empty())
+    throw InputError(
+        source + ": not a valid URDF: " + (log.empty() ? std::string("urdfdom refused it") : log));
   check_urdf(*m, source);
   return m;
 }

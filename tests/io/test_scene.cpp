@@ -278,7 +278,18 @@ const std::string kLimit = "<limit lower='-1' upper='1' effort='1' velocity='1'/
 TEST_F(SceneErrors, MalformedXml) {
   const std::string e = error("<robot name='r'><link name='a'>", "urdf: r.urdf\njoints: [j]\n");
   EXPECT_NE(e.find("r.urdf"), std::string::npos) << e;
-  EXPECT_NE(e.find("not a valid URDF"), std::string::npos) << e;
+  EXPECT_NE(e.find("not a valid URDF: "), std::string::npos) << e;
+}
+
+// urdfdom refuses non-finite numbers itself; its message, quoted in the
+// error, names the element.
+TEST_F(SceneErrors, NonFiniteValueInUrdf) {
+  std::string u = urdf_with("type='prismatic'", kLimit);
+  u.replace(u.find("<mass value='1'/>"), 17, "<mass value='nan'/>");
+  const std::string e = error(u, "urdf: r.urdf\njoints: [j]\n");
+  EXPECT_NE(e.find("r.urdf: not a valid URDF: "), std::string::npos) << e;
+  EXPECT_NE(e.find("mass [nan]"), std::string::npos) << e;
+  EXPECT_NE(e.find("Link [b]"), std::string::npos) << e;
 }
 
 // Link b, moved by j, has no <inertial>. (With k frozen, link c would be
