@@ -104,7 +104,10 @@ UrdfLinearisation linearise_urdf(const urdf::ModelInterface& model,
                                  const Eigen::Vector3d& gravity, const std::string& source);
 
 // Scenes: a YAML file with a top-level `urdf:` key. `load_model` and
-// `parse_model` dispatch to these, so every command accepts a scene.
+// `parse_model` dispatch to these, so every command accepts a scene. The URDF
+// path is relative to the directory of `source` (the scene's path). The
+// coordinates are the joint positions (not deviations from q0); format and
+// linearisation in docs/model-format.md, "Scenes".
 mech::Model load_scene(const std::filesystem::path& path);
 mech::Model parse_scene(const std::string& yaml_text, const std::string& source);
 
