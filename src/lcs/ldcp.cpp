@@ -185,8 +185,9 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
     if (!I.empty()) {
       luI.compute(MII);
       if (!luI.isInvertible()) {
-        out.message = "leading row coefficient block of the active set is singular "
-                      "(script M is not a P-matrix); the mode is not autonomous";
+        out.message =
+            "leading row coefficient block of the active set is singular "
+            "(script M is not a P-matrix); the mode is not autonomous";
         return out;
       }
     }
@@ -199,11 +200,28 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
         S -= MKI * luI.solve(sub(Mlead, I, K));
         qK -= MKI * luI.solve(sub(xi, I));
       }
-      const lcp::Result res = solver->solve(S, qK, lcp::Options{});
+      // Rows whose constant term is zero up to rounding of its terms stay
+      // exactly zero: dependent constraints make the Schur complement
+      // singular, and a -1e-17 there would make the LCP infeasible.
+      const VectorXd cancelled =
+          I.empty() ? VectorXd::Zero(K.size())
+                    : VectorXd((sub(Mlead, K, I) * luI.solve(sub(xi, I))).cwiseAbs());
+      for (size_t i = 0; i < K.size(); ++i)
+        if (std::abs(qK(i)) <= opt.tol_rel * (scale(K[i]) + cancelled(i)) + opt.tol_abs)
+          qK(i) = 0.0;
+      lcp::Result res = solver->solve(S, qK, lcp::Options{});
       ++out.lcp_solves;
       if (!res.ok()) {
-        out.message = "LCP at LDCP level " + std::to_string(p) + " failed: " +
-                      std::string(lcp::to_string(res.status)) +
+        // Dependent constraints give a PSD, not P, matrix whose LCP Lemke
+        // still solves (q in its range, Lemma 4.6.1); the motion is unique
+        // even where the multipliers are not (Theorem 4.6.5).
+        static const auto lemke = lcp::make_solver("lemke");
+        res = lemke->solve(S, qK, lcp::Options{});
+        ++out.lcp_solves;
+      }
+      if (!res.ok()) {
+        out.message = "LCP at LDCP level " + std::to_string(p) +
+                      " failed: " + std::string(lcp::to_string(res.status)) +
                       (res.message.empty() ? "" : " (" + res.message + ")");
         return out;
       }

@@ -60,8 +60,8 @@ sim::Trajectory run(const mech::Model& model, const VectorXd& x0, double t_end,
 
 void expect_near(const VectorXd& a, const VectorXd& b, double tol, const char* what) {
   ASSERT_EQ(a.size(), b.size()) << what;
-  EXPECT_LE((a - b).cwiseAbs().maxCoeff(), tol) << what << "\n got " << a.transpose()
-                                                << "\n want " << b.transpose();
+  EXPECT_LE((a - b).cwiseAbs().maxCoeff(), tol)
+      << what << "\n got " << a.transpose() << "\n want " << b.transpose();
 }
 
 // §3.7: impact at t = 1, constrained phase x2 = -cos(t-1), u = cos(t-1),
