@@ -173,6 +173,7 @@ struct EventResult {
   bool accumulation = false;
   double t_star = 0.0;  // extrapolated accumulation time (accumulation only)
   long lcp_solves = 0;
+  std::vector<std::string> warnings;
 };
 
 class EventDriven {
@@ -415,6 +416,10 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
       out.message = "impact at t = " + std::to_string(t) + ": " + ir.message;
       return out;
     }
+    if (!ir.admissible)
+      out.warnings.push_back("impact law '" + impact_->name() + "' at t = " + std::to_string(t) +
+                             " gave a non-admissible jump (negative impulse or E_J v+ < 0)" +
+                             (ir.message.empty() ? "" : ": " + ir.message));
     xa.segment(N_, N_) = ir.v_after;
     out.impulse += ir.impulse;
     out.jumped = true;
@@ -522,6 +527,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
   // Initial mode selection (and jump, if the initial state is not regular).
   EventResult ev = process_event(t, xa);
   tr.lcp_solves += ev.lcp_solves;
+  for (const auto& w : ev.warnings) warn(tr, w);
   std::string err;
   Phase phase;
   if (!ev.ok) {
@@ -767,6 +773,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     }
     ev = process_event(t, x_minus);
     tr.lcp_solves += ev.lcp_solves;
+    for (const auto& w : ev.warnings) warn(tr, w);
     if (!ev.ok) {
       fail(ev.message);
       xa = x_minus;
