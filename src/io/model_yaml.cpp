@@ -25,14 +25,14 @@ namespace {
 using Keys = std::map<std::string, YAML::Node>;
 
 [[noreturn]] void fail(const std::string& source, const std::string& key, const std::string& what) {
-  throw InputError(source + ": " + key + ": " + what);
+  throw InputError(one_line(source + ": " + key + ": " + what));
 }
 
 // What a node holds, for "(got ...)" in messages.
 std::string describe(const YAML::Node& n) {
   switch (n.Type()) {
     case YAML::NodeType::Scalar:
-      return "'" + n.Scalar() + "'";
+      return "'" + one_line(n.Scalar(), 80) + "'";
     case YAML::NodeType::Sequence:
       return "a list of " + std::to_string(n.size()) + " entries";
     case YAML::NodeType::Map:
@@ -55,8 +55,9 @@ YAML::Node load_yaml(const std::string& text, const std::string& source) {
     return YAML::Load(text);
   } catch (const YAML::Exception& e) {
     // yaml-cpp marks are 0-based; editors count from 1.
-    throw InputError(source + ": malformed YAML at line " + std::to_string(e.mark.line + 1) +
-                     ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
+    throw InputError(one_line(source + ": malformed YAML at line " +
+                              std::to_string(e.mark.line + 1) + ", column " +
+                              std::to_string(e.mark.column + 1) + ": " + e.msg));
   }
 }
 
@@ -416,7 +417,7 @@ VectorXd parse_vector(const std::string& text, const std::string& what) {
     if (*first == '+') ++first;  // from_chars refuses a leading '+'
     const auto [ptr, ec] = std::from_chars(first, last, x);
     if (ec != std::errc() || ptr != last)
-      throw InputError(where + ": not a number (got '" + token + "')");
+      throw InputError(one_line(where + ": not a number (got '" + token + "')"));
     if (!std::isfinite(x)) throw InputError(where + ": not finite (got '" + token + "')");
     out.push_back(x);
     ++index;

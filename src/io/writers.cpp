@@ -20,6 +20,28 @@ std::string format_number(double x) {
   return ec == std::errc() ? std::string(buf, end) : std::string("?");
 }
 
+std::string one_line(const std::string& text, std::size_t max_chars) {
+  std::string out;
+  for (const char ch : text) {
+    if (out.size() >= max_chars) return out + "...";
+    const auto c = static_cast<unsigned char>(ch);
+    if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\r') {
+      out += "\\r";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (c < 0x20 || c == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    } else {
+      out += ch;
+    }
+  }
+  return out;
+}
+
 namespace {
 
 // %.17g: enough significant digits that every double reads back exactly.
