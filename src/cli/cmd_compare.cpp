@@ -27,6 +27,7 @@ struct CompareArgs {
   std::string model;
   std::string x0;
   double t_end = std::nan("");
+  bool t_end_given = false;  // --t-end nan is an error, not the model's horizon
   double h = 1e-3;
   bool json = false;
   double stop_erp = bullet::WorldSettings{}.stop_erp;
@@ -49,8 +50,8 @@ void run_compare(const CompareArgs& a) {
                          model.name + "' has a state of size " +
                          std::to_string(model.state_size()) + " (q then v)");
   sim::Options opt;
-  opt.t_end = std::isnan(a.t_end) ? model.t_end : a.t_end;
-  if (std::isnan(opt.t_end))
+  opt.t_end = a.t_end_given ? a.t_end : model.t_end;
+  if (!a.t_end_given && std::isnan(opt.t_end))
     throw io::InputError(a.model + ": no horizon: give --t-end or `t_end` in the model");
   if (!(opt.t_end > 0.0) || !std::isfinite(opt.t_end))
     throw io::InputError("--t-end: must be a finite number > 0 (got " + std::to_string(opt.t_end) +
@@ -127,12 +128,15 @@ void setup(CLI::App& app) {
       "compare", "Run a model in Bullet beside the exact event-driven solution and compare");
   cmd->add_option("model", a->model, "Model file (YAML)")->required();
   cmd->add_option("--x0", a->x0, "Initial state a,b,... (q then v); default: the model's");
-  cmd->add_option("--t-end", a->t_end, "Horizon (s); default: the model's t_end");
+  auto* t_end = cmd->add_option("--t-end", a->t_end, "Horizon (s); default: the model's t_end");
   cmd->add_option("--h", a->h, "Bullet's time step (s); default 1e-3");
   cmd->add_option("--stop-erp", a->stop_erp, "ERP of Bullet's 6DOF2 limits in (0, 1]; default 0.2");
   cmd->add_option("--iterations", a->iterations, "Bullet solver iterations; default 100");
   cmd->add_flag("--json", a->json, "Print the comparison as JSON");
-  cmd->callback([a] { run_compare(*a); });
+  cmd->callback([a, t_end] {
+    a->t_end_given = t_end->count() > 0;
+    run_compare(*a);
+  });
 }
 
 LCSIM_REGISTER_COMMAND(setup);

@@ -19,6 +19,7 @@
 #include <sstream>
 
 #include "cli/command.hpp"
+#include "cli/output.hpp"
 #include "impact/impact.hpp"
 #include "io/io.hpp"
 
@@ -260,19 +261,17 @@ void run_map(const ImpactsArgs& a, const mech::Model& model) {
   std::cout << csv.str();
   std::cout.flush();
   if (a.plot.empty()) return;
-  const std::filesystem::path script = find_plot_script();
   const std::filesystem::path tmp = std::filesystem::temp_directory_path() /
                                     ("lcsim_impact_map_" + std::to_string(::getpid()) + ".csv");
-  {
-    std::ofstream f(tmp);
-    f << csv.str();
-    if (!f) throw io::InputError("--plot: cannot write the temporary file " + tmp.string());
+  io::write_file_atomic(tmp, csv.str());
+  try {
+    draw_plot(find_plot_script(), tmp, a.plot, model.name + ": Moreau impact map (Figure 3.5)",
+              "--plot");
+  } catch (...) {
+    std::filesystem::remove(tmp);
+    throw;
   }
-  const std::string cmd = "/usr/bin/python3 '" + script.string() + "' '" + tmp.string() + "' '" +
-                          a.plot + "' --title '" + model.name + ": Moreau impact map (Figure 3.5)'";
-  const int rc = std::system(cmd.c_str());
   std::filesystem::remove(tmp);
-  if (rc != 0) throw std::runtime_error("--plot: the plot script failed (" + cmd + ")");
   std::cerr << "impact map written to " << a.plot << "\n";
 }
 
@@ -281,8 +280,10 @@ void run_impacts(const ImpactsArgs& a) {
   if (!model.is_mechanical())
     throw io::InputError(a.model + ": impact rules need a mechanical model (M, E), not `lcs:`");
   if (!a.plot.empty() && a.map.empty()) throw io::InputError("--plot: only with --map");
-  if (a.plot.find('\'') != std::string::npos)
-    throw io::InputError("--plot: path must not contain '");
+  if (!a.plot.empty()) {  // checked before the map is computed, not after
+    check_writable(a.plot);
+    (void)find_plot_script();
+  }
   if (a.map.empty())
     run_compare(a, model);
   else

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "cli/command.hpp"
+#include "cli/output.hpp"
 #include "io/io.hpp"
 #include "sim/sim.hpp"
 
@@ -14,7 +15,8 @@ namespace {
 struct SimulateArgs {
   std::string model;
   std::string x0;
-  double t_end = std::nan("");
+  double t_end = std::nan("");  // NaN = the model's (when --t-end is not given)
+  bool t_end_given = false;
   std::string method = "event";
   double dt_out = 0.0;
   std::string out;
@@ -22,8 +24,9 @@ struct SimulateArgs {
   std::string impact = "moreau";
   std::string lcp = "pivot";
   double h = std::nan("");  // time-stepping step (s); NaN = sim::Options default
-  double theta = 0.5;       // Moreau–Jean theta
-  bool force = false;       // backward Euler despite the consistency guard
+  bool h_given = false;
+  double theta = 0.5;  // Moreau–Jean theta
+  bool force = false;  // backward Euler despite the consistency guard
 };
 
 std::string fmt_vec(const Eigen::VectorXd& v) {
@@ -59,18 +62,18 @@ void run_simulate(const SimulateArgs& a) {
                          std::to_string(model.state_size()) +
                          (model.is_mechanical() ? " (q then v)" : ""));
   sim::Options opt;
-  opt.t_end = std::isnan(a.t_end) ? model.t_end : a.t_end;
-  if (std::isnan(opt.t_end))
+  opt.t_end = a.t_end_given ? a.t_end : model.t_end;
+  if (!a.t_end_given && std::isnan(opt.t_end))
     throw io::InputError(a.model + ": no horizon: give --t-end or `t_end` in the model");
   if (!(opt.t_end > 0.0) || !std::isfinite(opt.t_end))
-    throw io::InputError("--t-end: must be a finite number > 0 (got " +
-                         std::to_string(opt.t_end) + ")");
+    throw io::InputError("--t-end: must be a finite number > 0 (got " + std::to_string(opt.t_end) +
+                         ")");
   if (!(a.dt_out >= 0.0) || !std::isfinite(a.dt_out))
-    throw io::InputError("--dt-out: must be a finite number >= 0 (got " +
-                         std::to_string(a.dt_out) + ")");
+    throw io::InputError("--dt-out: must be a finite number >= 0 (got " + std::to_string(a.dt_out) +
+                         ")");
   opt.dt_out = a.dt_out;
-  if (!std::isnan(a.h) || a.method != "event") {
-    const double h = std::isnan(a.h) ? opt.h : a.h;
+  if (a.h_given || a.method != "event") {
+    const double h = a.h_given ? a.h : opt.h;
     if (!(h > 0.0) || !std::isfinite(h))
       throw io::InputError("--h: must be a finite number > 0 (got " + std::to_string(h) + ")");
     if (h > opt.t_end)
@@ -84,6 +87,8 @@ void run_simulate(const SimulateArgs& a) {
   opt.force = a.force;
   opt.impact = a.impact;
   opt.lcp_solver = a.lcp;
+  // An unwritable --out fails now, not after the run.
+  if (!a.out.empty()) check_writable(a.out);
 
   const sim::Trajectory tr = integrator->run(model, x0, opt);
   const bool failed = tr.status != sim::RunStatus::kCompleted;
@@ -91,8 +96,7 @@ void run_simulate(const SimulateArgs& a) {
   if (a.json) {
     std::cout << io::trajectory_json(model, tr).dump(2) << "\n";
   } else {
-    std::printf("model %s, method %s, t_end %g\n", model.name.c_str(), tr.method.c_str(),
-                tr.t_end);
+    std::printf("model %s, method %s, t_end %g\n", model.name.c_str(), tr.method.c_str(), tr.t_end);
     for (const auto& e : tr.events) {
       std::printf("  t = %-20.15g %-12s %s -> %s  mode %s\n", e.t,
                   std::string(sim::to_string(e.type)).c_str(), fmt_vec(e.state_before).c_str(),
@@ -114,18 +118,24 @@ void setup(CLI::App& app) {
   auto* cmd = app.add_subcommand("simulate", "Simulate a model (default: exact event-driven)");
   cmd->add_option("model", a->model, "Model file (YAML)")->required();
   cmd->add_option("--x0", a->x0, "Initial state a,b,... (q then v); default: the model's");
-  cmd->add_option("--t-end", a->t_end, "Horizon (s); default: the model's t_end");
+  auto* t_end = cmd->add_option("--t-end", a->t_end, "Horizon (s); default: the model's t_end");
   cmd->add_option("--method", a->method, "Integrator: event, euler, moreau-jean");
-  cmd->add_option("--h", a->h, "Time step of euler and moreau-jean (s); default 1e-3");
+  auto* h = cmd->add_option("--h", a->h, "Time step of euler and moreau-jean (s); default 1e-3");
   cmd->add_option("--theta", a->theta, "Moreau–Jean theta in [0, 1]; default 0.5");
   cmd->add_flag("--force", a->force,
                 "Run backward Euler even where it is not consistent (rho_i >= 3, §7.3)");
   cmd->add_option("--dt-out", a->dt_out, "Output grid step (s); 0 = events only");
   cmd->add_option("--out", a->out, "Write the trajectory CSV here");
   cmd->add_flag("--json", a->json, "Print the run summary as JSON");
-  cmd->add_option("--impact", a->impact, "Impact law (default moreau, with the model's restitution)");
+  cmd->add_option("--impact", a->impact,
+                  "Impact law (default moreau, with the model's restitution)");
   cmd->add_option("--lcp", a->lcp, "LCP solver: pivot, lemke, pgs, enum");
-  cmd->callback([a] { run_simulate(*a); });
+  cmd->callback([a, t_end, h] {
+    // Given means given: --t-end nan is an error, not the model's horizon.
+    a->t_end_given = t_end->count() > 0;
+    a->h_given = h->count() > 0;
+    run_simulate(*a);
+  });
 }
 
 LCSIM_REGISTER_COMMAND(setup);

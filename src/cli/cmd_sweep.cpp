@@ -24,6 +24,7 @@
 #include <sstream>
 
 #include "cli/command.hpp"
+#include "cli/output.hpp"
 #include "io/io.hpp"
 #include "sim/sim.hpp"
 
@@ -34,6 +35,7 @@ struct SweepArgs {
   std::string model;
   std::string x0;
   double t_end = std::nan("");
+  bool t_end_given = false;  // --t-end nan is an error, not the model's horizon
   std::string methods = "event,euler,moreau-jean";
   std::string hs = "1e-2,1e-3,1e-4";
   int repeat = 3;
@@ -151,8 +153,8 @@ void run_sweep(const SweepArgs& a) {
                          model.name + "' has a state of size " +
                          std::to_string(model.state_size()));
   sim::Options base;
-  base.t_end = std::isnan(a.t_end) ? model.t_end : a.t_end;
-  if (std::isnan(base.t_end))
+  base.t_end = a.t_end_given ? a.t_end : model.t_end;
+  if (!a.t_end_given && std::isnan(base.t_end))
     throw io::InputError(a.model + ": no horizon: give --t-end or `t_end` in the model");
   if (!(base.t_end > 0.0) || !std::isfinite(base.t_end))
     throw io::InputError("--t-end: must be a finite number > 0");
@@ -165,6 +167,12 @@ void run_sweep(const SweepArgs& a) {
   base.theta = a.theta;
   base.force = a.force;
   base.lcp_solver = a.lcp;
+  // The plot's path and script are checked before the runs, not after.
+  std::filesystem::path script;
+  if (!a.plot.empty()) {
+    check_writable(a.plot);
+    script = find_plot_script();
+  }
 
   // The exact reference: event-driven, final state and energy change.
   sim::Options ex_opt = base;
@@ -257,19 +265,16 @@ void run_sweep(const SweepArgs& a) {
   }
   std::cout.flush();
   if (!a.plot.empty()) {
-    const std::filesystem::path script = find_plot_script();
     const std::filesystem::path tmp = std::filesystem::temp_directory_path() /
                                       ("lcsim_sweep_" + std::to_string(::getpid()) + ".json");
-    {
-      std::ofstream f(tmp);
-      f << j.dump(2);
-      if (!f) throw io::InputError("--plot: cannot write the temporary file " + tmp.string());
+    io::write_file_atomic(tmp, j.dump(2));
+    try {
+      draw_plot(script, tmp, a.plot, model.name, "--plot");
+    } catch (...) {
+      std::filesystem::remove(tmp);
+      throw;
     }
-    const std::string cmd = "/usr/bin/python3 '" + script.string() + "' '" + tmp.string() + "' '" +
-                            a.plot + "' --title '" + model.name + "'";
-    const int rc = std::system(cmd.c_str());
     std::filesystem::remove(tmp);
-    if (rc != 0) throw std::runtime_error("--plot: the plot script failed (" + cmd + ")");
     std::cerr << "work-precision diagram written to " << a.plot << "\n";
   }
 }
@@ -280,7 +285,7 @@ void setup(CLI::App& app) {
       "sweep", "Work-precision sweep: methods x step sizes against the exact event-driven run");
   cmd->add_option("model", a->model, "Model file (YAML)")->required();
   cmd->add_option("--x0", a->x0, "Initial state a,b,... (q then v); default: the model's");
-  cmd->add_option("--t-end", a->t_end, "Horizon (s); default: the model's t_end");
+  auto* t_end = cmd->add_option("--t-end", a->t_end, "Horizon (s); default: the model's t_end");
   cmd->add_option("--methods", a->methods, "Comma-separated: event, euler, moreau-jean");
   cmd->add_option("--h", a->hs, "Comma-separated step sizes (s), e.g. 1e-2,1e-3,1e-4");
   cmd->add_option("--repeat", a->repeat, "Timing runs per point (median); default 3");
@@ -289,7 +294,10 @@ void setup(CLI::App& app) {
   cmd->add_option("--lcp", a->lcp, "LCP solver: pivot, lemke, pgs, enum");
   cmd->add_flag("--json", a->json, "Print {\"rows\": [...]} as JSON");
   cmd->add_option("--plot", a->plot, "Draw the work-precision diagram (PNG) here");
-  cmd->callback([a] { run_sweep(*a); });
+  cmd->callback([a, t_end] {
+    a->t_end_given = t_end->count() > 0;
+    run_sweep(*a);
+  });
 }
 
 LCSIM_REGISTER_COMMAND(setup);

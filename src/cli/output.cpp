@@ -1,0 +1,107 @@
+// Output files of the commands (see output.hpp).
+#include "cli/output.hpp"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include "io/io.hpp"
+
+extern char** environ;
+
+namespace lcsim::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+[[noreturn]] void cannot_write(const std::string& path, const std::string& why) {
+  throw io::InputError(path + ": cannot write: " + why);
+}
+
+// A new empty file beside `path`: ".<name>.tmp-XXXXXX<ext>"; returns its name.
+std::string temp_beside(const std::string& path) {
+  const fs::path p(path);
+  if (!p.has_filename()) cannot_write(path, "not a file name");
+  std::error_code ec;
+  if (fs::is_directory(p, ec)) cannot_write(path, std::strerror(EISDIR));
+  fs::path dir = p.parent_path();
+  if (dir.empty()) dir = ".";
+  const std::string ext = p.extension().string();
+  std::string name = (dir / ("." + p.stem().string() + ".tmp-XXXXXX" + ext)).string();
+  const int fd = ::mkstemps(name.data(), static_cast<int>(ext.size()));
+  if (fd < 0) cannot_write(path, std::strerror(errno));
+  // mkstemps creates the file 0600: give it the mode a plain open would have.
+  const mode_t mask = ::umask(0);
+  ::umask(mask);
+  (void)::fchmod(fd, 0666 & ~mask);
+  ::close(fd);
+  return name;
+}
+
+std::string last_line(const fs::path& log) {
+  std::ifstream in(log);
+  std::string line, last;
+  while (std::getline(in, line))
+    if (line.find_first_not_of(" \t\r") != std::string::npos) last = line;
+  const auto b = last.find_first_not_of(" \t");
+  return b == std::string::npos ? std::string("no message") : last.substr(b);
+}
+
+}  // namespace
+
+void check_writable(const std::string& path) {
+  const std::string tmp = temp_beside(path);
+  ::unlink(tmp.c_str());
+}
+
+void draw_plot(const fs::path& script, const fs::path& input, const std::string& out,
+               const std::string& title, const std::string& option) {
+  const std::string tmp = temp_beside(out);
+  const fs::path log =
+      fs::temp_directory_path() / ("lcsim_plot_" + std::to_string(::getpid()) + ".log");
+  std::vector<std::string> args{
+      "/usr/bin/python3", script.string(), input.string(), tmp, "--title", title};
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0600);
+  posix_spawn_file_actions_adddup2(&fa, STDOUT_FILENO, STDERR_FILENO);
+  pid_t pid = -1;
+  const int err = ::posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  int status = 0;
+  if (err == 0)
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+  const bool ok = err == 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  std::string why;
+  if (err != 0)
+    why = std::string("cannot run /usr/bin/python3: ") + std::strerror(err);
+  else if (!ok)
+    why = "the plot script " + script.string() + " failed: " + last_line(log);
+  std::error_code ec;
+  fs::remove(log, ec);
+  if (ok && ::rename(tmp.c_str(), out.c_str()) != 0) {
+    why = out + ": cannot write: " + std::strerror(errno);
+    ::unlink(tmp.c_str());
+    throw io::InputError(option + ": " + why);
+  }
+  if (!ok) {
+    ::unlink(tmp.c_str());
+    throw std::runtime_error(option + ": " + why);
+  }
+}
+
+}  // namespace lcsim::cli
