@@ -18,6 +18,7 @@ packages=(
   libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-matplotlib
+  clang libclang-rt-14-dev
   libsiconos-kernel-dev libsiconos-numerics-dev python3-siconos
 )
 missing=()
@@ -45,5 +46,51 @@ if [ "$what" = demo ]; then
     -o out/two_carts.png --title "Two carts with a stop (thesis §3.7, Figure 3.3)"
   echo "lcsim: wrote out/two_carts.csv, out/two_carts.json and out/two_carts.png"
 else
+  # 1. The test suite, Release build.
   ctest --test-dir build --output-on-failure -j"$jobs"
+
+  # 2. The same suite under AddressSanitizer + UndefinedBehaviorSanitizer
+  #    (g++, -O1 with line tables: quicker to build than -O2 -g, and ASan's
+  #    reports keep their file:line). Any report fails the run: UBSan is built
+  #    with -fno-sanitize-recover, ASan halts on its first error.
+  export ASAN_OPTIONS=halt_on_error=1:abort_on_error=1:detect_leaks=1:strict_string_checks=1
+  export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
+  cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DLCSIM_SANITIZE=ON -DLCSIM_BUILD_BENCH=OFF
+  cmake --build build-asan -j"$jobs"
+  ctest --test-dir build-asan --output-on-failure -j"$jobs"
+
+  # 3. The libFuzzer targets in fuzz/ (clang; ASan + UBSan + coverage), each
+  #    run for LCSIM_FUZZ_SECONDS (default 30) on a copy of its seed corpus
+  #    fuzz/corpus/<target>/, the targets side by side. A crash, a sanitizer
+  #    report, an escaping exception or a broken invariant fails the run; the
+  #    input is kept in build-fuzz/artifacts/.
+  cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DLCSIM_FUZZ=ON \
+    -DLCSIM_BUILD_TESTS=OFF -DLCSIM_BUILD_BENCH=OFF
+  targets=()
+  for src in fuzz/fuzz_*.cpp; do targets+=("$(basename "$src" .cpp)"); done
+  cmake --build build-fuzz -j"$jobs" --target "${targets[@]}"
+  mkdir -p build-fuzz/artifacts
+  pids=()
+  for t in "${targets[@]}"; do
+    rm -rf "build-fuzz/corpus/$t" && mkdir -p "build-fuzz/corpus/$t"
+    cp fuzz/corpus/"$t"/* "build-fuzz/corpus/$t/"
+    "./build-fuzz/fuzz/$t" "build-fuzz/corpus/$t" -max_total_time="${LCSIM_FUZZ_SECONDS:-30}" \
+      -rss_limit_mb=2048 -timeout=20 -max_len=4096 -print_final_stats=1 \
+      -artifact_prefix="build-fuzz/artifacts/$t-" >"build-fuzz/$t.log" 2>&1 &
+    pids+=($!)
+  done
+  failed=0
+  for i in "${!targets[@]}"; do
+    if wait "${pids[$i]}"; then
+      echo "lcsim: ${targets[$i]}: $(grep -m1 -o 'stat::number_of_executed_units: *[0-9]*' \
+        "build-fuzz/${targets[$i]}.log" | grep -o '[0-9]*$') inputs, no failure"
+    else
+      failed=1
+      echo "lcsim: ${targets[$i]} FAILED; the end of build-fuzz/${targets[$i]}.log:" >&2
+      tail -n 60 "build-fuzz/${targets[$i]}.log" >&2
+    fi
+  done
+  exit "$failed"
 fi

@@ -1,0 +1,121 @@
+// libFuzzer target: every LCP solver on an LCP w = M z + q, 0 <= z _|_ w >= 0
+// decoded from the bytes. Solvers never throw (lcp.hpp); whatever status they
+// return must agree with the data:
+//   - kInvalidInput iff lcp::validate(M, q) names a problem (non-finite data);
+//   - kSolved implies z, w finite, of size k, w = M z + q recomputed here,
+//     ||min(z, w)||_inf <= tol (1 + ||q||_inf) and z, w >= -tol (1 + ||q||_inf),
+//     the acceptance test of Options::tolerance.
+// Any violation, crash or sanitizer report aborts the run.
+//
+// Layout: byte 0 gives k = 1 + b % 12; byte 1 the decoding of the entries:
+//   0: raw little-endian doubles (NaN, Inf, subnormals, 1e300 ...),
+//   1: int8 / 8 (small, many ties and zeros: degenerate LCPs),
+//   2: int8 * 10^e with e in [-12, 12] from the next byte (badly scaled),
+//   3: symmetric positive definite A'A + I / 8 from int8 entries of A.
+// Then k*k entries of M (row-major) and k of q; missing bytes read as 0.
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <sstream>
+#include <string>
+
+#include "lcp/lcp.hpp"
+
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+struct Reader {
+  const std::uint8_t* data;
+  std::size_t size, pos = 0;
+  std::uint8_t byte() { return pos < size ? data[pos++] : 0; }
+  double raw() {
+    std::uint8_t b[8];
+    for (auto& x : b) x = byte();
+    double d;
+    std::memcpy(&d, b, sizeof d);
+    return d;
+  }
+};
+
+[[noreturn]] void fail(const std::string& solver, const char* what, const lcsim::lcp::Result& r,
+                       const MatrixXd& M, const VectorXd& q) {
+  std::fprintf(stderr, "fuzz_lcp: %s: %s (status %s, residual %g, min z %g, min w %g: %s)\n",
+               solver.c_str(), what, std::string(lcsim::lcp::to_string(r.status)).c_str(),
+               r.residual, r.min_z, r.min_w, r.message.c_str());
+  Eigen::IOFormat fmt(Eigen::FullPrecision, 0, ", ", "\n", "[", "]");
+  std::fprintf(
+      stderr, "M =\n%s\nq = %s\n",
+      [&] {
+        std::ostringstream os;
+        os << M.format(fmt);
+        return os.str();
+      }()
+          .c_str(),
+      [&] {
+        std::ostringstream os;
+        os << q.transpose().format(fmt);
+        return os.str();
+      }()
+          .c_str());
+  std::abort();
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size < 2) return 0;
+  Reader in{data, size};
+  const int k = 1 + in.byte() % 12;
+  const int mode = in.byte() % 4;
+  MatrixXd M(k, k);
+  VectorXd q(k);
+  auto entry = [&]() -> double {
+    switch (mode) {
+      case 0:
+        return in.raw();
+      case 1:
+        return static_cast<std::int8_t>(in.byte()) / 8.0;
+      case 2: {
+        const double m = static_cast<std::int8_t>(in.byte());
+        return m * std::pow(10.0, static_cast<int>(in.byte() % 25) - 12);
+      }
+      default:
+        return static_cast<std::int8_t>(in.byte()) / 8.0;
+    }
+  };
+  for (int i = 0; i < k; ++i)
+    for (int j = 0; j < k; ++j) M(i, j) = entry();
+  for (int i = 0; i < k; ++i) q(i) = entry();
+  if (mode == 3) M = M.transpose() * M + MatrixXd::Identity(k, k) / 8.0;
+
+  const bool valid = lcsim::lcp::validate(M, q).empty();
+  const lcsim::lcp::Options opt;
+  const double acc = opt.tolerance * (1.0 + (valid ? q.cwiseAbs().maxCoeff() : 0.0));
+  const auto check = [&](const std::string& name, const lcsim::lcp::Result& r) {
+    if (!valid) {
+      if (r.status != lcsim::lcp::Status::kInvalidInput)
+        fail(name, "non-finite data but not kInvalidInput", r, M, q);
+      return;
+    }
+    if (r.status == lcsim::lcp::Status::kInvalidInput)
+      fail(name, "kInvalidInput on a well-formed LCP", r, M, q);
+    if (r.status != lcsim::lcp::Status::kSolved) return;
+    if (r.z.size() != k || !r.z.allFinite())
+      fail(name, "solved but z has the wrong size or is not finite", r, M, q);
+    const VectorXd w = M * r.z + q;
+    if (!w.allFinite()) fail(name, "solved but M z + q is not finite", r, M, q);
+    const double residual = r.z.cwiseMin(w).cwiseAbs().maxCoeff();
+    if (!(residual <= acc)) fail(name, "solved but residual above tolerance", r, M, q);
+    if (!(r.z.minCoeff() >= -acc)) fail(name, "solved but z < -tol", r, M, q);
+    if (!(w.minCoeff() >= -acc)) fail(name, "solved but w < -tol", r, M, q);
+  };
+  for (const std::string& name : lcsim::lcp::solver_names())
+    check(name, lcsim::lcp::make_solver(name)->solve(M, q, opt));
+  check("murty", lcsim::lcp::solve_murty(M, q, opt));
+  return 0;
+}
