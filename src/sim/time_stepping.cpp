@@ -13,11 +13,14 @@
 // h), always the initial and the final state. For time-stepping, Sample::u is
 // the LCP multiplier as a force: backward Euler's u_{k+1} of (7.4), and the
 // Moreau–Jean impulse divided by the step (the mean force over the step).
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 #include "sim/sim.hpp"
 
@@ -267,46 +270,205 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
 // ---------------------------------------------------------------------------
 // Moreau–Jean theta-method (mechanical models). With v_t = theta v+ + (1-theta) v
 // and q_t = theta q+ + (1-theta) q:
-//   M (v+ - v) = h (f - D v_t - K q_t) + E_J' lambda,   q+ = q + h v_t,
-// i.e. W (v+ - v) = h (f - D v - K q - h theta K v) + E_J' lambda with the
-// iteration matrix W = M + h theta D + h^2 theta^2 K (factored once, LLT).
-// Impact law at velocity level on the predicted-active set J:
-//   0 <= E_J v+ + e_J . E_J v  ⟂  lambda >= 0.
-// Activation rule: constraint i is in J when its predicted gap
-//   E_i (q + h theta v) + g_i <= 0,
+//   M (v+ - v) = h (f - D v_t - K q_t) + E_A' lambda,   q+ = q + h v_t,
+// i.e. W (v+ - v) = h (f - D v - K q - h theta K v) + E_A' lambda with the
+// iteration matrix W = M + h theta D + h^2 theta^2 K (factored once per run).
+// Impact law at velocity level on the active set A:
+//   0 <= E_A v+ + e_A . E_A v  ⟂  lambda >= 0.
+// Activation rule: constraint i is in A when its predicted gap
+//   E_i (q + h theta v) + g_i <= kActivationGap (= 0),
 // i.e. the gap extrapolated with the velocity at the point where the scheme
 // evaluates the position (Siconos uses gamma h with gamma = 1/2 by default;
-// here gamma = theta). A constraint left out of J can then penetrate by at
-// most h (1 - theta) |E_i v| + O(h^2) in one step.
+// here gamma = theta). Closed constraints (y <= 0, not opening) are in A; so
+// is every constraint that the prediction says closes within the step. A
+// constraint left out of A can then penetrate by at most
+// h (1 - theta) |E_i v| + O(h^2) in one step (tests/sim/test_scale.cpp checks
+// this bound on the cart chain at every step).
 //
 // Energy balance per step (f included in the potential, derivation in
 // tests/sim/test_time_stepping.cpp):
-//   E+ - E = -h v_t' D v_t + lambda' E_J v_t - (theta - 1/2)(|v+ - v|_M^2 + h^2 |v_t|_K^2),
+//   E+ - E = -h v_t' D v_t + lambda' E_A v_t - (theta - 1/2)(|v+ - v|_M^2 + h^2 |v_t|_K^2),
 // and lambda_i E_i v_t = lambda_i E_i v ((1 - theta) - theta e_i) when lambda_i > 0.
+//
+// Scaling. Cost per step grows with the coordinates N and the constraints in
+// play, not with the constraints declared, and never cubically in N where M, D,
+// K, E are sparse:
+// - One code path over MjOperators (products with D, K, E) and MjIteration
+//   (W^{-1} rhs and the columns W^{-1} E_i'). Models with more than
+//   Options::sparse_dofs_threshold coordinates hold D, K, E as Eigen sparse
+//   matrices and factor W by Eigen::SimplicialLDLT (AMD ordering); smaller ones
+//   use the dense matrices and Eigen::LLT. The step below is written once.
+// - The Delassus matrix is never formed for all k constraints. The column
+//   W^{-1} E_i' is computed (one solve with the factor, O(nnz(L)) for sparse W)
+//   the first time constraint i enters the active set, pruned of entries below
+//   kPruneRelative times its largest entry (W^{-1} of a banded W decays
+//   geometrically away from the band, so the pruned column is short), and kept
+//   for the run. Each step assembles E_A W^{-1} E_A' over the active set only,
+//   as a sparse matrix, from those columns and the columns of E.
+// - The LCP over A: |A| <= Options::pivot_max_active (default 32) goes to the
+//   pivoting solver Options::lcp_solver on the dense copy (exact, and what the
+//   small models always used); larger sets to projected Gauss–Seidel on the
+//   sparse Delassus matrix, warm-started from the previous step's impulses
+//   (the sets change little between steps, so a few sweeps suffice). lcp::
+//   solve_pgs works on dense matrices only, hence the sparse sweep here. PGS
+//   that does not reach the tolerance falls back to the pivoting solver when
+//   |A| <= kPivotFallbackMax, else the step keeps the PGS iterate and a
+//   warning is counted.
 
-struct MoreauJeanFactors {
-  Eigen::LLT<MatrixXd> llt;  // W = M + h theta D + h^2 theta^2 K
-  MatrixXd WinvEt;           // W^{-1} E'  (N x k)
-  MatrixXd delassus;         // E W^{-1} E' (k x k)
-  bool ok = false;
-  std::string message;
+constexpr double kActivationGap = 0.0;  // predicted gap (model units) at or below which i is active
+constexpr double kPruneRelative = 1e-17;  // columns of W^{-1} E' keep |x| > this * max|x|
+constexpr double kPgsTolerance = 1e-13;   // natural residual <= tol * (1 + ||b||_inf)
+constexpr int kPgsMaxSweeps = 5000;
+constexpr int kPivotFallbackMax = 2000;
+
+using SparseCol = Eigen::SparseMatrix<double, Eigen::ColMajor>;
+using SparseRow = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+
+// Products with the model's matrices, dense or sparse.
+class MjOperators {
+ public:
+  MjOperators(const mech::MechanicalModel& m, bool sparse) : m_(m), sparse_(sparse) {
+    // E by columns is needed by both paths to assemble the active Delassus
+    // matrix from sparse columns of W^{-1} E'.
+    Ec_ = m.E.sparseView(1.0, 0.0);
+    Ec_.makeCompressed();
+    if (sparse_) {
+      Ms_ = m.M.sparseView(1.0, 0.0);
+      Ds_ = m.D.sparseView(1.0, 0.0);
+      Ks_ = m.K.sparseView(1.0, 0.0);
+      Er_ = Ec_;
+    }
+  }
+  bool sparse() const { return sparse_; }
+  int dofs() const { return m_.dofs(); }
+  int constraints() const { return m_.num_constraints(); }
+  const SparseCol& E_by_columns() const { return Ec_; }
+  // f - D v - K (q + h theta v): the smooth force of the step.
+  void step_force(const VectorXd& q, const VectorXd& v, double h, double theta,
+                  VectorXd& out) const {
+    out = q + (h * theta) * v;
+    if (sparse_) {
+      out = m_.f - Ks_ * out;
+      out.noalias() -= Ds_ * v;
+    } else {
+      out = m_.f - m_.K * out;
+      out.noalias() -= m_.D * v;
+    }
+  }
+  void E_times(const VectorXd& x, VectorXd& out) const {
+    if (sparse_)
+      out.noalias() = Er_ * x;
+    else
+      out.noalias() = m_.E * x;
+  }
+  // W = M + h theta D + h^2 theta^2 K.
+  SparseCol W_sparse(double h, double theta) const {
+    SparseCol W = Ms_ + (h * theta) * Ds_ + (h * h * theta * theta) * Ks_;
+    W.makeCompressed();
+    return W;
+  }
+  MatrixXd W_dense(double h, double theta) const {
+    return m_.M + h * theta * m_.D + h * h * theta * theta * m_.K;
+  }
+  // T + V = ½ v'Mv + ½ q'Kq - f'q (J), as mech::total_energy.
+  double energy(const VectorXd& q, const VectorXd& v) const {
+    if (!sparse_) return mech::total_energy(m_, q, v);
+    return 0.5 * v.dot(Ms_ * v) + 0.5 * q.dot(Ks_ * q) - m_.f.dot(q);
+  }
+
+ private:
+  const mech::MechanicalModel& m_;
+  bool sparse_;
+  SparseCol Ms_, Ds_, Ks_, Ec_;
+  SparseRow Er_;
 };
 
-MoreauJeanFactors mj_factors(const mech::MechanicalModel& m, double h, double theta) {
-  MoreauJeanFactors f;
-  const MatrixXd W = m.M + h * theta * m.D + h * h * theta * theta * m.K;
-  f.llt.compute(W);
-  if (f.llt.info() != Eigen::Success) {
-    f.message =
-        "iteration matrix M + h theta D + h^2 theta^2 K is not positive definite at h = " + fmt(h) +
-        " (D or K indefinite?)";
-    return f;
+// The factored iteration matrix W for one step length, and the cached columns
+// W^{-1} E_i' (computed on first use).
+class MjIteration {
+ public:
+  bool factor(const MjOperators& ops, double h, double theta) {
+    sparse_ = ops.sparse();
+    if (sparse_) {
+      ldlt_.compute(ops.W_sparse(h, theta));
+      ok_ = ldlt_.info() == Eigen::Success && (ldlt_.vectorD().array() > 0.0).all();
+    } else {
+      llt_.compute(ops.W_dense(h, theta));
+      ok_ = llt_.info() == Eigen::Success;
+    }
+    if (!ok_) {
+      message_ = "iteration matrix M + h theta D + h^2 theta^2 K is not positive definite at h = " +
+                 fmt(h) + " (D or K indefinite?)";
+      return false;
+    }
+    const SparseCol& E = ops.E_by_columns();
+    Et_ = E.transpose();  // column i = E_i'
+    cols_.assign(ops.constraints(), SparseCol());
+    have_.assign(ops.constraints(), 0);
+    return true;
   }
-  f.WinvEt = f.llt.solve(m.E.transpose());
-  f.delassus = m.E * f.WinvEt;
-  f.ok = f.WinvEt.allFinite();
-  if (!f.ok) f.message = "iteration matrix too ill-conditioned at h = " + fmt(h);
-  return f;
+  bool ok() const { return ok_; }
+  const std::string& message() const { return message_; }
+  VectorXd solve(const VectorXd& rhs) const {
+    if (sparse_) return ldlt_.solve(rhs);
+    return llt_.solve(rhs);
+  }
+  // W^{-1} E_i' as an N x 1 sparse column; false if not finite.
+  bool column(int i, const SparseCol*& out) {
+    if (!have_[i]) {
+      const VectorXd c = solve(VectorXd(Et_.col(i)));
+      if (!c.allFinite()) return false;
+      const double cut = kPruneRelative * c.cwiseAbs().maxCoeff();
+      SparseCol s(c.size(), 1);
+      int nnz = 0;
+      for (int r = 0; r < c.size(); ++r) nnz += std::abs(c(r)) > cut;
+      s.reserve(nnz);
+      for (int r = 0; r < c.size(); ++r)
+        if (std::abs(c(r)) > cut) s.insert(r, 0) = c(r);
+      s.makeCompressed();
+      cols_[i] = std::move(s);
+      have_[i] = 1;
+    }
+    out = &cols_[i];
+    return true;
+  }
+
+ private:
+  bool sparse_ = false, ok_ = false;
+  std::string message_;
+  Eigen::LLT<MatrixXd> llt_;
+  Eigen::SimplicialLDLT<SparseCol> ldlt_;
+  SparseCol Et_;
+  std::vector<SparseCol> cols_;
+  std::vector<char> have_;
+};
+
+// Projected Gauss–Seidel on a sparse symmetric LCP w = G z + b, 0 <= z ⟂ w >= 0,
+// from z (warm start, projected onto z >= 0). Returns the natural residual.
+double sparse_pgs(const SparseRow& G, const VectorXd& b, VectorXd& z, int& sweeps) {
+  const int n = static_cast<int>(b.size());
+  VectorXd diag(n);
+  for (int a = 0; a < n; ++a) diag(a) = G.coeff(a, a);
+  z = z.cwiseMax(0.0);
+  const double tol = kPgsTolerance * (1.0 + b.lpNorm<Eigen::Infinity>());
+  double res = 0.0;
+  for (sweeps = 1; sweeps <= kPgsMaxSweeps; ++sweeps) {
+    double change = 0.0;
+    for (int a = 0; a < n; ++a) {
+      double r = b(a);
+      for (SparseRow::InnerIterator it(G, a); it; ++it) r += it.value() * z(it.col());
+      const double za = std::max(0.0, z(a) - r / diag(a));
+      change = std::max(change, std::abs(za - z(a)) * diag(a));
+      z(a) = za;
+    }
+    if (change <= tol) {
+      const VectorXd w = G * z + b;
+      res = z.cwiseMin(w).cwiseAbs().maxCoeff();
+      if (res <= tol) return res;
+    }
+  }
+  const VectorXd w = G * z + b;
+  return z.cwiseMin(w).cwiseAbs().maxCoeff();
 }
 
 Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const Options& opt) {
@@ -330,12 +492,13 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     tr.final_state = x0;
     return tr;
   }
+  const MjOperators ops(m, N > opt.sparse_dofs_threshold);
   VectorXd q = x0.head(N), v = x0.tail(N);
-  tr.energy_initial = mech::total_energy(m, q, v);
+  tr.energy_initial = ops.energy(q, v);
   auto finish = [&]() {
     tr.final_state.resize(2 * N);
     tr.final_state << q, v;
-    tr.energy_final = mech::total_energy(m, q, v);
+    tr.energy_final = ops.energy(q, v);
     tr.wall_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     return tr;
@@ -355,12 +518,10 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
   }
   const double theta = opt.theta;
   const Grid grid = make_grid(opt.t_end, opt.h);
-  MoreauJeanFactors F = mj_factors(m, grid.h, theta), F_last;
-  if (!F.ok) return fail("moreau-jean: " + F.message);
-  if (grid.h_last != grid.h) {
-    F_last = mj_factors(m, grid.h_last, theta);
-    if (!F_last.ok) return fail("moreau-jean: last step: " + F_last.message);
-  }
+  MjIteration F, F_last;
+  if (!F.factor(ops, grid.h, theta)) return fail("moreau-jean: " + F.message());
+  if (grid.h_last != grid.h && !F_last.factor(ops, grid.h_last, theta))
+    return fail("moreau-jean: last step: " + F_last.message());
   const VectorXd e = m.restitution.size() == k ? m.restitution : VectorXd::Zero(k);
 
   Sampler sampler(opt.dt_out);
@@ -376,61 +537,108 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     s.mode = mode;
     tr.samples.push_back(std::move(s));
   };
-  VectorXd y = m.E * q + m.g;
+  VectorXd y(k);
+  ops.E_times(q, y);
+  y += m.g;
   if (k > 0) tr.max_violation = std::min(0.0, y.minCoeff());
   VectorXd u = VectorXd::Zero(k);
   record(0.0, y, u, {});
 
+  const SparseCol& Ec = ops.E_by_columns();
   lcp::Options lopt;
-  IndexSet J, mode;
-  VectorXd rhs(N), v_free(N), Ev(k);
+  IndexSet A, A_prev, mode, u_set;
+  std::vector<int> pos(k, -1);               // position of constraint i in A, or -1
+  VectorXd lambda_prev = VectorXd::Zero(k);  // last step's impulses (warm start)
+  std::vector<const SparseCol*> cols;
+  std::vector<Eigen::Triplet<double>> trip;
+  VectorXd rhs(N), v_free(N), v_next(N), q_next(N), Ev(k), Evf(k), b, z;
   for (long j = 1; j <= grid.n; ++j) {
     const bool last = j == grid.n;
     const double h = last ? grid.h_last : grid.h;
-    const MoreauJeanFactors& f = (last && grid.h_last != grid.h) ? F_last : F;
-    rhs = m.f - m.D * v - m.K * (q + h * theta * v);
-    v_free = v + h * f.llt.solve(rhs);
-    // Activation: predicted gap E_i (q + h theta v) + g_i <= 0.
-    J.clear();
+    MjIteration& f = (last && grid.h_last != grid.h) ? F_last : F;
+    ops.step_force(q, v, h, theta, rhs);
+    v_free = v + h * f.solve(rhs);
+    // Active set: predicted gap E_i (q + h theta v) + g_i <= kActivationGap.
+    for (int i : A) pos[i] = -1;
+    A.clear();
     if (k > 0) {
-      const VectorXd yp = y + h * theta * (m.E * v);
+      ops.E_times(v, Ev);
       for (int i = 0; i < k; ++i)
-        if (yp(i) <= 0.0) J.push_back(i);
-    }
-    u.setZero();
-    mode.clear();
-    VectorXd v_next = v_free;
-    if (!J.empty()) {
-      const int nj = static_cast<int>(J.size());
-      MatrixXd W(nj, nj);
-      VectorXd b(nj);
-      for (int a = 0; a < nj; ++a) {
-        const double Ev_a = m.E.row(J[a]).dot(v);
-        b(a) = m.E.row(J[a]).dot(v_free) + e(J[a]) * Ev_a;
-        for (int c = 0; c < nj; ++c) W(a, c) = f.delassus(J[a], J[c]);
-      }
-      const lcp::Result r = solver->solve(W, b, lopt);
-      ++tr.lcp_solves;
-      if (!r.ok())
-        return fail("moreau-jean: LCP failed at t = " + fmt((j - 1) * grid.h) + " (" +
-                    std::string(lcp::to_string(r.status)) + ")" +
-                    (r.message.empty() ? "" : ": " + r.message));
-      for (int a = 0; a < nj; ++a) {
-        if (r.z(a) > 0.0) {
-          v_next += f.WinvEt.col(J[a]) * r.z(a);
-          mode.push_back(J[a]);
+        if (y(i) + h * theta * Ev(i) <= kActivationGap) {
+          pos[i] = static_cast<int>(A.size());
+          A.push_back(i);
         }
-        u(J[a]) = r.z(a) / h;  // mean force over the step
+    }
+    for (int i : u_set) u(i) = 0.0;
+    u_set.clear();
+    mode.clear();
+    v_next = v_free;
+    z.resize(static_cast<Eigen::Index>(A.size()));  // warm start: last step's impulses
+    for (size_t a = 0; a < A.size(); ++a) z(static_cast<Eigen::Index>(a)) = lambda_prev(A[a]);
+    for (int i : A_prev) lambda_prev(i) = 0.0;  // set again below for this step's A
+    A_prev = A;
+    if (!A.empty()) {
+      const int na = static_cast<int>(A.size());
+      // Delassus matrix E_A W^{-1} E_A' from the cached columns W^{-1} E_a'.
+      cols.resize(na);
+      trip.clear();
+      for (int a = 0; a < na; ++a) {
+        if (!f.column(A[a], cols[a]))
+          return fail("moreau-jean: iteration matrix too ill-conditioned at h = " + fmt(h));
+        for (SparseCol::InnerIterator it(*cols[a], 0); it; ++it)
+          for (SparseCol::InnerIterator e_it(Ec, static_cast<int>(it.row())); e_it; ++e_it) {
+            const int p = pos[e_it.row()];
+            if (p >= 0) trip.emplace_back(p, a, e_it.value() * it.value());
+          }
+      }
+      SparseRow G(na, na);
+      G.setFromTriplets(trip.begin(), trip.end());
+      ops.E_times(v_free, Evf);
+      b.resize(na);
+      for (int a = 0; a < na; ++a) b(a) = Evf(A[a]) + e(A[a]) * Ev(A[a]);
+      bool solved = false;
+      if (na > opt.pivot_max_active) {
+        int sweeps = 0;
+        const double res = sparse_pgs(G, b, z, sweeps);
+        ++tr.lcp_solves;
+        solved = res <= kPgsTolerance * (1.0 + b.lpNorm<Eigen::Infinity>()) && z.allFinite();
+        if (!solved && na > kPivotFallbackMax) {
+          warn(tr, "moreau-jean: PGS stopped at residual " + fmt(res) + " after " +
+                       std::to_string(sweeps) + " sweeps at t = " + fmt((j - 1) * grid.h));
+          solved = z.allFinite();
+        }
+      }
+      if (!solved) {
+        const lcp::Result r = solver->solve(MatrixXd(G), b, lopt);
+        ++tr.lcp_solves;
+        if (!r.ok())
+          return fail("moreau-jean: LCP failed at t = " + fmt((j - 1) * grid.h) + " (" +
+                      std::string(lcp::to_string(r.status)) + ")" +
+                      (r.message.empty() ? "" : ": " + r.message));
+        z = r.z;
+      }
+      for (int a = 0; a < na; ++a) {
+        lambda_prev(A[a]) = z(a);
+        if (z(a) > 0.0) {
+          for (SparseCol::InnerIterator it(*cols[a], 0); it; ++it)
+            v_next(it.row()) += it.value() * z(a);
+          mode.push_back(A[a]);
+        }
+        u(A[a]) = z(a) / h;  // mean force over the step
+        u_set.push_back(A[a]);
       }
     }
-    const VectorXd q_next = q + h * ((1.0 - theta) * v + theta * v_next);
+    q_next = q + h * ((1.0 - theta) * v + theta * v_next);
     if (!q_next.allFinite() || !v_next.allFinite())
       return fail("moreau-jean: non-finite state at t = " + fmt(j * grid.h));
-    q = q_next;
-    v = v_next;
+    q.swap(q_next);
+    v.swap(v_next);
     ++tr.steps;
-    y = m.E * q + m.g;
-    if (k > 0) tr.max_violation = std::min(tr.max_violation, std::min(0.0, y.minCoeff()));
+    if (k > 0) {
+      ops.E_times(q, y);
+      y += m.g;
+      tr.max_violation = std::min(tr.max_violation, std::min(0.0, y.minCoeff()));
+    }
     const double t = last ? opt.t_end : grid.time(j);
     if (sampler.want(t, grid.h, last)) record(t, y, u, mode);
   }
