@@ -1,0 +1,193 @@
+// The cart chain of `lcsim generate chain N --stops` (unit masses and springs,
+// stops q_i + 1 >= 0, x_i = 0.1 (i mod 3), v_i = -1) timed per Moreau–Jean
+// step for N = 10 ... 10000 (h = 1e-3, theta = 0.5), and per event-driven event
+// for N = 10 and 100. bench/run_chain_bench.sh runs it beside Siconos and
+// Bullet.
+//
+// Per step: each iteration runs S steps and 1 step from the same state and
+// reports (T_S - T_1) / (S - 1) as the iteration's (manual) time, so set-up
+// (model conversion, factorisation of W) is not counted. Two windows:
+//   Free: t in [0, 0.2], no constraint active (S = 200);
+//   Impacts: t in [0.7, 1.5], every cart hits its stop in it (S = 800);
+//     the state at t = 0.7 is computed once before timing.
+// Set-up alone (one step) is reported as BM_MoreauJeanSetup.
+// Event-driven: time of a run to t = 1.5 divided by the number of events; the
+// method is dense and refuses state sizes above 1001 (N > 500).
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+
+#include "bullet/bullet.hpp"
+#include "sim/sim.hpp"
+
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+lcsim::mech::Model chain(int n) {
+  lcsim::mech::MechanicalModel m;
+  m.M = MatrixXd::Identity(n, n);
+  m.K = MatrixXd::Zero(n, n);
+  m.K(0, 0) = 1.0;
+  for (int i = 0; i + 1 < n; ++i) {
+    m.K(i, i) += 1.0;
+    m.K(i + 1, i + 1) += 1.0;
+    m.K(i, i + 1) = m.K(i + 1, i) = -1.0;
+  }
+  m.E = MatrixXd::Identity(n, n);
+  m.g = VectorXd::Ones(n);
+  lcsim::mech::fill_defaults(m);
+  lcsim::mech::Model model;
+  model.name = "chain";
+  model.mechanical = std::move(m);
+  return model;
+}
+
+VectorXd start(int n) {
+  VectorXd x(2 * n);
+  for (int i = 0; i < n; ++i) {
+    x(i) = 0.1 * (i % 3);
+    x(n + i) = -1.0;
+  }
+  return x;
+}
+
+lcsim::sim::Options options(long steps) {
+  lcsim::sim::Options opt;
+  opt.h = 1e-3;
+  opt.theta = 0.5;
+  opt.t_end = steps * opt.h;
+  opt.record_samples = false;
+  return opt;
+}
+
+bool g_bullet = false;  // per_step runs Bullet's rb6 scene instead of Moreau–Jean
+
+double seconds(const lcsim::mech::Model& model, const VectorXd& x0, long steps,
+               lcsim::sim::Trajectory* out = nullptr) {
+  const auto mj = lcsim::sim::make_integrator("moreau-jean");
+  const auto t0 = std::chrono::steady_clock::now();
+  lcsim::sim::Trajectory tr = g_bullet ? lcsim::bullet::simulate_bullet(model, x0, options(steps))
+                                       : mj->run(model, x0, options(steps));
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (out) *out = std::move(tr);
+  return s;
+}
+
+void per_step(benchmark::State& state, double t_from, long steps) {
+  const int n = static_cast<int>(state.range(0));
+  const auto model = chain(n);
+  VectorXd x0 = start(n);
+  if (t_from > 0.0) {
+    lcsim::sim::Trajectory pre;
+    seconds(model, x0, std::lround(t_from / 1e-3), &pre);
+    x0 = pre.final_state;
+  }
+  lcsim::sim::Trajectory tr;
+  for (auto _ : state) {
+    const double t1 = seconds(model, x0, 1);
+    const double ts = seconds(model, x0, steps, &tr);
+    state.SetIterationTime(std::max(0.0, ts - t1) / static_cast<double>(steps - 1));
+  }
+  state.counters["N"] = n;
+  state.counters["lcp_solves"] = static_cast<double>(tr.lcp_solves);
+  state.counters["max_violation"] = tr.max_violation;
+  state.SetLabel(tr.status == lcsim::sim::RunStatus::kCompleted ? "per step" : tr.message);
+}
+
+void BM_MoreauJeanStepFree(benchmark::State& state) { per_step(state, 0.0, 200); }
+void BM_MoreauJeanStepImpacts(benchmark::State& state) { per_step(state, 0.7, 800); }
+
+// Bullet, rb6 scene of src/bullet/world.cpp (one btRigidBody per cart, a 6DOF2
+// limit per stop, springs as forces f - K q - D v applied before every step;
+// world.cpp forms these forces with the dense K, O(N^2) per step).
+void BM_BulletStepFree(benchmark::State& state) {
+  g_bullet = true;
+  per_step(state, 0.0, state.range(0) >= 10000 ? 20 : 200);
+  g_bullet = false;
+}
+void BM_BulletStepImpacts(benchmark::State& state) {
+  g_bullet = true;
+  per_step(state, 0.7, 800);
+  g_bullet = false;
+}
+
+void BM_MoreauJeanSetup(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const auto model = chain(n);
+  const VectorXd x0 = start(n);
+  for (auto _ : state) state.SetIterationTime(seconds(model, x0, 1));
+  state.counters["N"] = n;
+}
+
+void BM_EventDrivenPerEvent(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const auto model = chain(n);
+  const VectorXd x0 = start(n);
+  lcsim::sim::Options opt;
+  opt.t_end = 1.5;
+  opt.record_samples = false;
+  lcsim::sim::Trajectory tr;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    tr = lcsim::sim::simulate_event_driven(model, x0, opt);
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    state.SetIterationTime(s / std::max<double>(1.0, static_cast<double>(tr.events.size())));
+  }
+  state.counters["N"] = n;
+  state.counters["events"] = static_cast<double>(tr.events.size());
+  state.SetLabel(tr.status == lcsim::sim::RunStatus::kCompleted ? "per event"
+                                                                : "refused: " + tr.message);
+}
+
+}  // namespace
+
+BENCHMARK(BM_MoreauJeanStepFree)
+    ->Arg(10)
+    ->Arg(100)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond)
+    ->Iterations(3);
+BENCHMARK(BM_MoreauJeanStepImpacts)
+    ->Arg(10)
+    ->Arg(100)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond)
+    ->Iterations(3);
+BENCHMARK(BM_BulletStepFree)
+    ->Arg(10)
+    ->Arg(100)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond)
+    ->Iterations(1);
+BENCHMARK(BM_BulletStepImpacts)
+    ->Arg(10)
+    ->Arg(100)
+    ->Arg(1000)
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond)
+    ->Iterations(1);
+BENCHMARK(BM_MoreauJeanSetup)
+    ->Arg(10)
+    ->Arg(100)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
+BENCHMARK(BM_EventDrivenPerEvent)
+    ->Arg(10)
+    ->Arg(100)
+    ->Arg(1000)
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond)
+    ->Iterations(1);
+
+BENCHMARK_MAIN();
