@@ -1,8 +1,8 @@
 // libFuzzer target: io::parse_model on arbitrary text. A model file is input
 // from a user: the only exception that may escape is io::InputError (one line
 // naming the file, key and value); a crash, a sanitizer report or any other
-// exception is a bug. A valid model also goes through model_notes, which
-// the commands call next (not mech's as_lcs: outside the io layer).
+// exception is a bug. A valid model also goes through model_notes and
+// as_lcs, which the commands call next.
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -16,6 +16,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // makes this a scene whose URDF is not found (fuzz_scene covers scenes).
     const lcsim::mech::Model model = lcsim::io::parse_model(text, "/nonexistent/fuzz.yaml");
     (void)lcsim::io::model_notes(model);
+    (void)model.as_lcs();
   } catch (const lcsim::io::InputError& e) {
     // One line: a newline inside the message would break the CLI's contract.
     const std::string what = e.what();

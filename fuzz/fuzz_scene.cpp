@@ -28,13 +28,9 @@ const std::filesystem::path& folder() {
   return dir;
 }
 
-// One line per error. Known exception, reported: urdf_model.cpp's parse_urdf
-// copies urdfdom's exception text, raw attribute values and newlines
-// included, into "not a valid URDF: ..." (fix: io::one_line from
-// io/detail.hpp); drop the exception here once that is fixed.
+// One line per error (urdfdom's own text is folded by io::one_line).
 void one_line(const lcsim::io::InputError& e) {
   const std::string what = e.what();
-  if (what.find(": not a valid URDF: ") != std::string::npos) return;
   if (what.empty() || what.find('\n') != std::string::npos) __builtin_trap();
 }
 

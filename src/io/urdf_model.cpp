@@ -299,7 +299,7 @@ std::shared_ptr<urdf::ModelInterface> parse_urdf(const std::string& xml,
     try {
       m = urdf::parseURDF(xml);
     } catch (const std::exception& e) {
-      throw InputError(source + ": not a valid URDF: " + e.what());
+      throw InputError(source + ": not a valid URDF: " + one_line(e.what()));
     }
     log = capture.text();
   } catch (const InputError&) {
@@ -309,7 +309,8 @@ std::shared_ptr<urdf::ModelInterface> parse_urdf(const std::string& xml,
   // errors but goes on without them: refuse those as well.
   if (!m || !log.empty())
     throw InputError(
-        source + ": not a valid URDF: " + (log.empty() ? std::string("urdfdom refused it") : log));
+        source + ": not a valid URDF: " +
+        one_line(log.empty() ? std::string("urdfdom refused it") : log));
   check_urdf(*m, source);
   return m;
 }

@@ -31,10 +31,12 @@ lcs::Lcs to_lcs(const MechanicalModel& m) {
   s.A.block(n, n, n, n) = -llt.solve(m.D);
   s.A.block(n, 2 * n, n, 1) = llt.solve(m.f);
   s.B = MatrixXd::Zero(2 * n + 1, k);
-  s.B.block(n, 0, n, k) = llt.solve(m.E.transpose());
   s.C = MatrixXd::Zero(k, 2 * n + 1);
-  s.C.block(0, 0, k, n) = m.E;
-  s.C.col(2 * n) = m.g;
+  if (k > 0) {  // an empty block at a non-zero offset is UB in Eigen (found by UBSan)
+    s.B.block(n, 0, n, k) = llt.solve(m.E.transpose());
+    s.C.block(0, 0, k, n) = m.E;
+    s.C.col(2 * n) = m.g;
+  }
   s.D = MatrixXd::Zero(k, k);
   return s;
 }
