@@ -17,6 +17,7 @@
 
 #include "bullet/bullet.hpp"
 #include "cli/command.hpp"
+#include "cli/run_inputs.hpp"
 #include "io/io.hpp"
 #include "sim/sim.hpp"
 
@@ -41,21 +42,9 @@ nlohmann::json num(double x) {
 void run_compare(const CompareArgs& a) {
   const mech::Model model = io::load_model(a.model);
   bullet::check_expressible(model);  // std::invalid_argument naming the constraint: exit 2
-  Eigen::VectorXd x0 = model.initial;
-  if (!a.x0.empty()) x0 = io::parse_vector(a.x0, "--x0");
-  if (x0.size() == 0)
-    throw io::InputError(a.model + ": no initial state: give --x0 or `initial` in the model");
-  if (x0.size() != model.state_size())
-    throw io::InputError("--x0: has " + std::to_string(x0.size()) + " entries, the model '" +
-                         model.name + "' has a state of size " +
-                         std::to_string(model.state_size()) + " (q then v)");
+  const Eigen::VectorXd x0 = resolve_initial_state(model, a.model, a.x0);
   sim::Options opt;
-  opt.t_end = a.t_end_given ? a.t_end : model.t_end;
-  if (!a.t_end_given && std::isnan(opt.t_end))
-    throw io::InputError(a.model + ": no horizon: give --t-end or `t_end` in the model");
-  if (!(opt.t_end > 0.0) || !std::isfinite(opt.t_end))
-    throw io::InputError("--t-end: must be a finite number > 0 (got " + std::to_string(opt.t_end) +
-                         ")");
+  opt.t_end = resolve_horizon(model, a.model, a.t_end_given, a.t_end);
   if (!(a.h > 0.0) || !std::isfinite(a.h) || a.h > opt.t_end)
     throw io::InputError("--h: must be a finite number > 0 and <= the horizon (got " +
                          std::to_string(a.h) + ")");

@@ -20,6 +20,7 @@
 
 #include "cli/command.hpp"
 #include "cli/output.hpp"
+#include "cli/run_inputs.hpp"
 #include "impact/impact.hpp"
 #include "io/io.hpp"
 
@@ -64,15 +65,7 @@ std::vector<std::string> split(const std::string& text, char sep) {
 
 // The state (q, v) to work on: --x0 or the model's initial state.
 Eigen::VectorXd initial_state(const ImpactsArgs& a, const mech::Model& model) {
-  Eigen::VectorXd x0 = model.initial;
-  if (!a.x0.empty()) x0 = io::parse_vector(a.x0, "--x0");
-  if (x0.size() == 0)
-    throw io::InputError(a.model + ": no state: give --x0 or `initial` in the model");
-  if (x0.size() != model.state_size())
-    throw io::InputError("--x0: has " + std::to_string(x0.size()) + " entries, the model '" +
-                         model.name + "' has a state of size " +
-                         std::to_string(model.state_size()) + " (q then v)");
-  return x0;
+  return resolve_initial_state(model, a.model, a.x0, "state");
 }
 
 Eigen::VectorXd restitution(const ImpactsArgs& a, const mech::MechanicalModel& m) {

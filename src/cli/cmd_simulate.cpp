@@ -6,6 +6,7 @@
 
 #include "cli/command.hpp"
 #include "cli/output.hpp"
+#include "cli/run_inputs.hpp"
 #include "io/io.hpp"
 #include "sim/sim.hpp"
 
@@ -52,22 +53,9 @@ void run_simulate(const SimulateArgs& a) {
   (void)impact::make_impact_law(a.impact);
   (void)lcp::make_solver(a.lcp);
 
-  Eigen::VectorXd x0 = model.initial;
-  if (!a.x0.empty()) x0 = io::parse_vector(a.x0, "--x0");
-  if (x0.size() == 0)
-    throw io::InputError(a.model + ": no initial state: give --x0 or `initial` in the model");
-  if (x0.size() != model.state_size())
-    throw io::InputError("--x0: has " + std::to_string(x0.size()) + " entries, the model '" +
-                         model.name + "' has a state of size " +
-                         std::to_string(model.state_size()) +
-                         (model.is_mechanical() ? " (q then v)" : ""));
+  const Eigen::VectorXd x0 = resolve_initial_state(model, a.model, a.x0);
   sim::Options opt;
-  opt.t_end = a.t_end_given ? a.t_end : model.t_end;
-  if (!a.t_end_given && std::isnan(opt.t_end))
-    throw io::InputError(a.model + ": no horizon: give --t-end or `t_end` in the model");
-  if (!(opt.t_end > 0.0) || !std::isfinite(opt.t_end))
-    throw io::InputError("--t-end: must be a finite number > 0 (got " + std::to_string(opt.t_end) +
-                         ")");
+  opt.t_end = resolve_horizon(model, a.model, a.t_end_given, a.t_end);
   if (!(a.dt_out >= 0.0) || !std::isfinite(a.dt_out))
     throw io::InputError("--dt-out: must be a finite number >= 0 (got " + std::to_string(a.dt_out) +
                          ")");

@@ -25,6 +25,7 @@
 
 #include "cli/command.hpp"
 #include "cli/output.hpp"
+#include "cli/run_inputs.hpp"
 #include "io/io.hpp"
 #include "sim/sim.hpp"
 
@@ -144,20 +145,9 @@ void run_sweep(const SweepArgs& a) {
   }
   if (hs.empty()) throw io::InputError("--h: empty list");
 
-  Eigen::VectorXd x0 = model.initial;
-  if (!a.x0.empty()) x0 = io::parse_vector(a.x0, "--x0");
-  if (x0.size() == 0)
-    throw io::InputError(a.model + ": no initial state: give --x0 or `initial` in the model");
-  if (x0.size() != model.state_size())
-    throw io::InputError("--x0: has " + std::to_string(x0.size()) + " entries, the model '" +
-                         model.name + "' has a state of size " +
-                         std::to_string(model.state_size()));
+  const Eigen::VectorXd x0 = resolve_initial_state(model, a.model, a.x0);
   sim::Options base;
-  base.t_end = a.t_end_given ? a.t_end : model.t_end;
-  if (!a.t_end_given && std::isnan(base.t_end))
-    throw io::InputError(a.model + ": no horizon: give --t-end or `t_end` in the model");
-  if (!(base.t_end > 0.0) || !std::isfinite(base.t_end))
-    throw io::InputError("--t-end: must be a finite number > 0");
+  base.t_end = resolve_horizon(model, a.model, a.t_end_given, a.t_end);
   for (double h : hs)
     if (!(h > 0.0) || !std::isfinite(h) || h > base.t_end)
       throw io::InputError("--h: every step must be finite, > 0 and <= the horizon (got " +
