@@ -307,7 +307,13 @@ mech::Model parse_model(const std::string& yaml_text, const std::string& source)
     throw InputError(source +
                      ": empty file (expected `name` and a `mechanical:` or `lcs:` section)");
   // A top-level `urdf:` key makes the file a scene (scene.cpp).
-  if (root.IsMap() && root["urdf"]) return parse_scene(yaml_text, source);
+  if (root.IsMap() && root["urdf"]) {
+    try {
+      return parse_scene(yaml_text, source);
+    } catch (const InputError& e) {
+      throw InputError(one_line(e.what()));  // URDF names and values may hold newlines
+    }
+  }
   const Keys keys = mapping(root, source, "", {"name", "mechanical", "lcs", "initial", "t_end"});
   mech::Model model;
   model.source = source;

@@ -290,8 +290,21 @@ class CapturedLog : public console_bridge::OutputHandler {
 
 }  // namespace
 
-std::shared_ptr<urdf::ModelInterface> parse_urdf(const std::string& xml,
-                                                 const std::string& source) {
+namespace {
+// Every error of the URDF path is one line: names and values in a URDF may
+// hold newlines (found by fuzz_scene), so the public entry points fold them.
+template <class F>
+auto one_line_errors(F&& f) {
+  try {
+    return f();
+  } catch (const InputError& e) {
+    throw InputError(one_line(e.what()));
+  }
+}
+}  // namespace
+
+static std::shared_ptr<urdf::ModelInterface> parse_urdf_unfolded(const std::string& xml,
+                                                                 const std::string& source) {
   urdf::ModelInterfaceSharedPtr m;
   std::string log;
   try {
@@ -308,9 +321,8 @@ std::shared_ptr<urdf::ModelInterface> parse_urdf(const std::string& xml,
   // urdfdom reports some bad elements (e.g. a non-numeric <mass value>) as
   // errors but goes on without them: refuse those as well.
   if (!m || !log.empty())
-    throw InputError(
-        source + ": not a valid URDF: " +
-        one_line(log.empty() ? std::string("urdfdom refused it") : log));
+    throw InputError(source + ": not a valid URDF: " +
+                     one_line(log.empty() ? std::string("urdfdom refused it") : log));
   check_urdf(*m, source);
   return m;
 }
@@ -326,10 +338,16 @@ std::shared_ptr<urdf::ModelInterface> load_urdf(const std::filesystem::path& pat
   return parse_urdf(ss.str(), path.string());
 }
 
-UrdfLinearisation linearise_urdf(const urdf::ModelInterface& model,
-                                 const std::vector<std::string>& joints,
-                                 const std::map<std::string, double>& q0,
-                                 const Eigen::Vector3d& gravity, const std::string& source) {
+std::shared_ptr<urdf::ModelInterface> parse_urdf(const std::string& xml,
+                                                 const std::string& source) {
+  return one_line_errors([&] { return parse_urdf_unfolded(xml, source); });
+}
+
+static UrdfLinearisation linearise_urdf_unfolded(const urdf::ModelInterface& model,
+                                                 const std::vector<std::string>& joints,
+                                                 const std::map<std::string, double>& q0,
+                                                 const Eigen::Vector3d& gravity,
+                                                 const std::string& source) {
   const Tree t = make_tree(model, joints, source);
   // A simulated joint must move some mass: its body (its child link and the
   // links frozen to it) needs an <inertial> with mass > 0.
@@ -373,6 +391,14 @@ UrdfLinearisation linearise_urdf(const urdf::ModelInterface& model,
     if (j->dynamics) lin.damping(i) = j->dynamics->damping;
   }
   return lin;
+}
+
+UrdfLinearisation linearise_urdf(const urdf::ModelInterface& model,
+                                 const std::vector<std::string>& joints,
+                                 const std::map<std::string, double>& q0,
+                                 const Eigen::Vector3d& gravity, const std::string& source) {
+  return one_line_errors(
+      [&] { return linearise_urdf_unfolded(model, joints, q0, gravity, source); });
 }
 
 }  // namespace lcsim::io
