@@ -86,6 +86,26 @@ bool finite_pose(const urdf::Pose& p) {
 }
 
 void check_urdf(const urdf::ModelInterface& m, const std::string& source) {
+  // urdfdom accepts a joint whose parent is its own child (it only looks for
+  // a root): the link then lists itself among its children and every walk
+  // down the tree recurses for ever. Refuse it, and any link reached twice.
+  for (const auto& [name, joint] : m.joints_)
+    if (joint->parent_link_name == joint->child_link_name)
+      fail(source, "joint '" + name + "'",
+           "parent and child are the same link '" + joint->parent_link_name +
+               "' (the joints must form a tree)");
+  if (const auto root = m.getRoot()) {
+    std::set<const urdf::Link*> seen;
+    std::vector<const urdf::Link*> todo{root.get()};
+    while (!todo.empty()) {
+      const urdf::Link* l = todo.back();
+      todo.pop_back();
+      if (!seen.insert(l).second)
+        fail(source, "link '" + l->name + "'",
+             "reached twice from the root (the joints must form a tree)");
+      for (const auto& c : l->child_links) todo.push_back(c.get());
+    }
+  }
   for (const auto& [name, link] : m.links_) {
     if (!link->inertial) continue;
     const urdf::Inertial& in = *link->inertial;

@@ -301,6 +301,32 @@ TEST_F(SceneErrors, MovingLinkWithoutInertia) {
   EXPECT_NE(e.find("no <inertial>"), std::string::npos) << e;
 }
 
+// urdfdom itself refuses a cycle of joints (no root), but accepts a joint
+// whose parent is its child; lcsim refuses both instead of recursing for ever
+// down the tree (that crashed with a stack overflow). urdfdom leaks the
+// cyclic links (scripts/lsan.supp).
+TEST_F(SceneErrors, CyclicJointGraph) {
+  const std::string links =
+      "<robot name='r'><link name='a'/><link name='b'><inertial><mass value='1'/><inertia "
+      "ixx='1' ixy='0' ixz='0' iyy='1' iyz='0' izz='1'/></inertial></link>"
+      "<joint name='j' type='prismatic'><parent link='a'/><child link='b'/><axis xyz='1 0 0'/>" +
+      kLimit + "</joint>";
+  const std::string self = error(links +
+                                     "<joint name='k' type='prismatic'><parent link='b'/><child "
+                                     "link='b'/><axis xyz='1 0 0'/>" +
+                                     kLimit + "</joint></robot>",
+                                 "urdf: r.urdf\njoints: [j]\n");
+  EXPECT_NE(self.find("r.urdf: joint 'k': parent and child are the same link 'b'"),
+            std::string::npos)
+      << self;
+  const std::string cycle = error(links +
+                                      "<joint name='k' type='fixed'><parent link='b'/><child "
+                                      "link='a'/></joint></robot>",
+                                  "urdf: r.urdf\njoints: [j]\n");
+  EXPECT_NE(cycle.find("r.urdf: not a valid URDF: "), std::string::npos) << cycle;
+  EXPECT_NE(cycle.find("not a valid tree"), std::string::npos) << cycle;
+}
+
 TEST_F(SceneErrors, UnknownJoint) {
   const std::string e =
       error(urdf_with("type='prismatic'", kLimit), "urdf: r.urdf\njoints: [j, nope]\n");
