@@ -25,33 +25,9 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-lcsim::mech::Model chain(int n) {
-  lcsim::mech::MechanicalModel m;
-  m.M = MatrixXd::Identity(n, n);
-  m.K = MatrixXd::Zero(n, n);
-  m.K(0, 0) = 1.0;
-  for (int i = 0; i + 1 < n; ++i) {
-    m.K(i, i) += 1.0;
-    m.K(i + 1, i + 1) += 1.0;
-    m.K(i, i + 1) = m.K(i + 1, i) = -1.0;
-  }
-  m.E = MatrixXd::Identity(n, n);
-  m.g = VectorXd::Ones(n);
-  lcsim::mech::fill_defaults(m);
-  lcsim::mech::Model model;
-  model.name = "chain";
-  model.mechanical = std::move(m);
-  return model;
-}
+lcsim::mech::Model chain(int n) { return lcsim::mech::chain_model({n, true, false, true}); }
 
-VectorXd start(int n) {
-  VectorXd x(2 * n);
-  for (int i = 0; i < n; ++i) {
-    x(i) = 0.1 * (i % 3);
-    x(n + i) = -1.0;
-  }
-  return x;
-}
+VectorXd start(int n) { return chain(n).initial; }
 
 lcsim::sim::Options options(long steps) {
   lcsim::sim::Options opt;

@@ -16,19 +16,7 @@ using Eigen::MatrixXd;
 using Eigen::Vector4d;
 using Eigen::VectorXd;
 
-lcsim::mech::Model two_carts() {
-  lcsim::mech::MechanicalModel m;
-  m.M = MatrixXd::Identity(2, 2);
-  m.K.resize(2, 2);
-  m.K << 2, -1, -1, 1;
-  m.E.resize(1, 2);
-  m.E << 1, 0;
-  lcsim::mech::fill_defaults(m);
-  lcsim::mech::Model model;
-  model.name = "two_carts";
-  model.mechanical = m;
-  return model;
-}
+lcsim::mech::Model two_carts() { return lcsim::mech::two_carts_model(false); }
 
 MatrixXd free_A() {
   MatrixXd A(4, 4);

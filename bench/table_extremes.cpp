@@ -11,9 +11,9 @@ int main() {
   for (double k : {1e-6, 1e-2, 1.0, 1e3, 1e6, 1e9}) {
     double a = 1, w = sqrt(k);
     mech::MechanicalModel m;
-    m.M = Eigen::MatrixXd::Identity(1, 1);
-    m.K = Eigen::MatrixXd::Constant(1, 1, k);
-    m.E = Eigen::MatrixXd::Identity(1, 1);
+    m.M = Eigen::MatrixXd::Identity(1, 1).sparseView();
+    m.K = Eigen::MatrixXd::Constant(1, 1, k).sparseView();
+    m.E = Eigen::MatrixXd::Identity(1, 1).sparseView();
     m.g = Eigen::VectorXd::Constant(1, a / 2);
     mech::fill_defaults(m);
     mech::Model model;
@@ -31,18 +31,7 @@ int main() {
            k, tr.events.size(), et, eq, ev, tr.max_violation, tr.lcp_solves, tr.wall_time_s);
   }
   for (int N : {10, 100}) {
-    mech::MechanicalModel m;
-    m.M = Eigen::MatrixXd::Identity(N, N);
-    m.K = Eigen::MatrixXd::Zero(N, N);
-    for (int i = 0; i + 1 < N; ++i) {
-      m.K(i, i) += 1;
-      m.K(i + 1, i + 1) += 1;
-      m.K(i, i + 1) -= 1;
-      m.K(i + 1, i) -= 1;
-    }
-    m.E = Eigen::MatrixXd::Identity(N, N);
-    m.g = Eigen::VectorXd::Ones(N);
-    mech::fill_defaults(m);
+    const mech::MechanicalModel m = *mech::chain_model({N, true, false, false}).mechanical;
     mech::Model model;
     model.mechanical = m;
     sim::Options o;
@@ -59,8 +48,8 @@ int main() {
   for (double e : {0.5, 0.9}) {
     double g = 9.81, t1 = sqrt(2 / g);
     mech::MechanicalModel b;
-    b.M = Eigen::MatrixXd::Identity(1, 1);
-    b.E = Eigen::MatrixXd::Identity(1, 1);
+    b.M = Eigen::MatrixXd::Identity(1, 1).sparseView();
+    b.E = Eigen::MatrixXd::Identity(1, 1).sparseView();
     b.f = Eigen::VectorXd::Constant(1, -g);
     b.restitution = Eigen::VectorXd::Constant(1, e);
     mech::fill_defaults(b);

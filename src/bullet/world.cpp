@@ -71,15 +71,18 @@ struct Limit {
 Limit classify(const mech::MechanicalModel& m, int i, double range) {
   const int N = m.dofs();
   std::vector<int> nz;
-  double scale = m.E.row(i).cwiseAbs().maxCoeff();
+  double scale = 0.0;
   for (int j = 0; j < N; ++j)
-    if (m.E(i, j) != 0.0) nz.push_back(j);
+    if (m.E.coeff(i, j) != 0.0) {
+      nz.push_back(j);
+      scale = std::max(scale, std::abs(m.E.coeff(i, j)));
+    }
   const std::string who =
       "constraint '" + m.constraints[i] + "' (row " + std::to_string(i + 1) + " of E)";
   Limit L;
   if (nz.size() == 1) {
     const int j = nz[0];
-    const double c = m.E(i, j), bound = -m.g(i) / c;
+    const double c = m.E.coeff(i, j), bound = -m.g(i) / c;
     L.b = j;
     if (c > 0) {  // q_j >= -g/c
       L.lo = bound;
@@ -91,7 +94,7 @@ Limit classify(const mech::MechanicalModel& m, int i, double range) {
     return L;
   }
   if (nz.size() == 2) {
-    const double c0 = m.E(i, nz[0]), c1 = m.E(i, nz[1]);
+    const double c0 = m.E.coeff(i, nz[0]), c1 = m.E.coeff(i, nz[1]);
     if (std::abs(c0 + c1) <= 1e-12 * scale) {
       // c (q_a - q_b) + g >= 0 with c > 0  <=>  q_b - q_a <= g / c.
       const int a = c0 > 0 ? nz[0] : nz[1], b = c0 > 0 ? nz[1] : nz[0];
@@ -115,13 +118,15 @@ std::vector<Limit> limits_of(const mech::Model& model, double range) {
     throw std::invalid_argument("bullet: '" + model.name +
                                 "' is a general LCS: the Bullet scene needs a mechanical model");
   const mech::MechanicalModel& m = *model.mechanical;
-  const int N = m.dofs();
-  const double mscale = m.M.cwiseAbs().maxCoeff();
-  for (int r = 0; r < N; ++r)
-    for (int c = 0; c < N; ++c)
-      if (r != c && std::abs(m.M(r, c)) > 1e-14 * mscale)
-        throw std::invalid_argument("bullet: M(" + std::to_string(r + 1) + "," +
-                                    std::to_string(c + 1) + ") = " + fmt(m.M(r, c)) +
+  double mscale = 0.0;
+  for (int c = 0; c < m.M.outerSize(); ++c)
+    for (mech::SparseMatrix::InnerIterator it(m.M, c); it; ++it)
+      mscale = std::max(mscale, std::abs(it.value()));
+  for (int c = 0; c < m.M.outerSize(); ++c)
+    for (mech::SparseMatrix::InnerIterator it(m.M, c); it; ++it)
+      if (it.row() != c && std::abs(it.value()) > 1e-14 * mscale)
+        throw std::invalid_argument("bullet: M(" + std::to_string(it.row() + 1) + "," +
+                                    std::to_string(c + 1) + ") = " + fmt(it.value()) +
                                     ": one rigid body per coordinate needs a diagonal M");
   std::vector<Limit> out;
   for (int i = 0; i < m.num_constraints(); ++i) out.push_back(classify(m, i, range));
@@ -177,7 +182,7 @@ std::unique_ptr<World> build(const mech::MechanicalModel& m, const std::vector<L
     btTransform tf;
     tf.setIdentity();
     tf.setOrigin(btVector3(q0(j), 0, 0));
-    btRigidBody::btRigidBodyConstructionInfo ci(m.M(j, j), nullptr, w->shape.get(),
+    btRigidBody::btRigidBodyConstructionInfo ci(m.M.coeff(j, j), nullptr, w->shape.get(),
                                                 btVector3(1, 1, 1));
     ci.m_startWorldTransform = tf;
     ci.m_linearDamping = 0.0;
@@ -273,7 +278,7 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
                 ")");
   VectorXd q = x0.head(N), v = x0.tail(N);
   tr.energy_initial = mech::total_energy(m, q, v);
-  if (m.D.size() > 0 && !m.D.isZero(0.0))
+  if (m.D.norm() > 0.0)
     warn(tr, "bullet: dampers are explicit forces -D v (stable only for h small against M/D)");
 
   // Grid as the time-stepping methods: n steps of h, the last shortened.

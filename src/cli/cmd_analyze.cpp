@@ -88,8 +88,9 @@ void run_analyze(const AnalyzeArgs& args) {
   out << "model:       " << model.name << "  (" << model.source << ")\n";
   if (model.is_mechanical()) {
     const mech::MechanicalModel& m = *model.mechanical;
-    const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<MatrixXd>(m.M).eigenvalues();
-    const long rank_e = rank(m.E);
+    const Eigen::VectorXd ev =
+        Eigen::SelfAdjointEigenSolver<MatrixXd>(m.M.toDense()).eigenvalues();
+    const long rank_e = mech::constraint_rank(m);
     j["dofs"] = m.dofs();
     j["coordinates"] = m.coordinates;
     j["constraint_names"] = m.constraints;

@@ -48,6 +48,14 @@ struct LcpProblem {
 // `M` (list of rows) and `q` (list), square and matching, finite.
 LcpProblem load_lcp(const std::filesystem::path& path);
 
+// The YAML text of a mechanical model (docs/model-format.md), read back
+// exactly by parse_model (numbers round-trip). Each matrix is written in the
+// spelling that stores least: a list of rows when small (at most 64 entries),
+// {diagonal: [...]} when diagonal, else {rows, cols, entries} with its
+// non-zeros, so a chain of N carts takes O(N) bytes. `header` lines are
+// written first as comments. std::invalid_argument for an `lcs:` model.
+std::string model_yaml(const mech::Model& model, const std::string& header = "");
+
 // Parses "a,b,c" into a vector; InputError names `what` and the bad token.
 VectorXd parse_vector(const std::string& text, const std::string& what);
 

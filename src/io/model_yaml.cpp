@@ -6,6 +6,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
+#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -133,16 +134,93 @@ MatrixXd matrix(const YAML::Node& n, const std::string& source, const std::strin
   return m;
 }
 
-std::string dims(const MatrixXd& m) {
+template <class Mat>
+std::string dims(const Mat& m) {
   return std::to_string(m.rows()) + " x " + std::to_string(m.cols());
 }
 
-void expect_dims(const MatrixXd& m, Eigen::Index rows, Eigen::Index cols, const std::string& source,
+template <class Mat>
+void expect_dims(const Mat& m, Eigen::Index rows, Eigen::Index cols, const std::string& source,
                  const std::string& key, const std::string& why) {
   if (m.rows() != rows || m.cols() != cols)
     fail(source, key,
          "expected " + std::to_string(rows) + " x " + std::to_string(cols) + " " + why + " (got " +
              dims(m) + ")");
+}
+
+// A non-negative integer below `bound` (an index or a dimension).
+Eigen::Index count(const YAML::Node& n, const std::string& source, const std::string& key,
+                   double bound) {
+  const double x = number(n, source, key);
+  if (x < 0.0 || x != std::floor(x) || x >= bound)
+    fail(source, key,
+         "expected a whole number in [0, " + format_number(bound) + ") (got '" + n.Scalar() + "')");
+  return static_cast<Eigen::Index>(x);
+}
+
+// A model matrix, in one of three spellings (docs/model-format.md):
+//   a list of rows                        [[1, 0], [0, 2]]
+//   its non-zeros                         {rows: 2, cols: 2, entries: [[0, 0, 1], [1, 1, 2]]}
+//   a diagonal                            {diagonal: [1, 2]}
+// Entries are [row, column, value] with 0-based indices; a position given
+// twice is an error (not summed), so a typo cannot silently add up.
+mech::SparseMatrix sparse_matrix(const YAML::Node& n, const std::string& source,
+                                 const std::string& key, Eigen::Index cols_if_empty) {
+  if (n.IsSequence()) return matrix(n, source, key, cols_if_empty).sparseView();
+  if (!n.IsMap())
+    fail(source, key,
+         "expected a matrix: a list of rows, {rows, cols, entries} or {diagonal} (got " +
+             describe(n) + ")");
+  const Keys keys = mapping(n, source, key, {"rows", "cols", "entries", "diagonal"});
+  if (keys.count("diagonal")) {
+    if (keys.size() != 1)
+      fail(source, key, "a {diagonal: [...]} matrix takes no other keys (rows, cols, entries)");
+    const VectorXd d = vector(keys.at("diagonal"), source, key + ".diagonal");
+    mech::SparseMatrix m(d.size(), d.size());
+    m.reserve(Eigen::VectorXi::Constant(d.size(), 1));
+    for (Eigen::Index i = 0; i < d.size(); ++i)
+      if (d(i) != 0.0) m.insert(i, i) = d(i);
+    m.makeCompressed();
+    return m;
+  }
+  for (const char* k : {"rows", "cols", "entries"})
+    if (!keys.count(k))
+      fail(source, key + "." + k,
+           "missing (a sparse matrix is {rows: R, cols: C, entries: [[row, col, value], ...]})");
+  constexpr double kMaxDim = 1e9;
+  const Eigen::Index rows = count(keys.at("rows"), source, key + ".rows", kMaxDim);
+  const Eigen::Index cols = count(keys.at("cols"), source, key + ".cols", kMaxDim);
+  const YAML::Node& e = keys.at("entries");
+  if (!e.IsSequence())
+    fail(source, key + ".entries",
+         "expected a list of [row, col, value] (got " + describe(e) + ")");
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(e.size());
+  for (std::size_t i = 0; i < e.size(); ++i) {
+    const std::string ekey = key + ".entries[" + std::to_string(i) + "]";
+    if (!e[i].IsSequence() || e[i].size() != 3)
+      fail(source, ekey, "expected [row, col, value] (got " + describe(e[i]) + ")");
+    const Eigen::Index r = count(e[i][0], source, ekey + "[0]", static_cast<double>(rows));
+    const Eigen::Index c = count(e[i][1], source, ekey + "[1]", static_cast<double>(cols));
+    t.emplace_back(r, c, number(e[i][2], source, ekey + "[2]"));
+  }
+  mech::SparseMatrix m(rows, cols);
+  // Duplicates: count them instead of summing.
+  bool repeated = false;
+  m.setFromTriplets(t.begin(), t.end(), [&](double a, double) {
+    repeated = true;
+    return a;
+  });
+  if (repeated) {
+    std::set<std::pair<Eigen::Index, Eigen::Index>> seen;
+    for (std::size_t i = 0; i < t.size(); ++i)
+      if (!seen.insert({t[i].row(), t[i].col()}).second)
+        fail(source, key + ".entries[" + std::to_string(i) + "]",
+             "position (" + std::to_string(t[i].row()) + ", " + std::to_string(t[i].col()) +
+                 ") given twice");
+  }
+  m.prune(0.0);
+  return m;
 }
 
 void expect_size(const VectorXd& v, Eigen::Index size, const std::string& source,
@@ -173,29 +251,56 @@ std::vector<std::string> names(const YAML::Node& n, Eigen::Index size, const std
   return out;
 }
 
+// Up to this many coordinates M is checked densely, with its eigenvalues in
+// the message; above it by a sparse LDL' factorisation (O(nnz) for banded M).
+constexpr Eigen::Index kDenseMassCheckMax = 1000;
+
 // M symmetric (relative tolerance 1e-12 of its largest entry) and positive
-// definite: Cholesky succeeds and the smallest eigenvalue is not negligible
-// against the largest (N * eps relative), so a numerically singular M whose
-// Cholesky squeaks through on rounding is refused as well.
-void check_mass_matrix(const MatrixXd& M, const std::string& source) {
-  const double scale = M.cwiseAbs().maxCoeff();
-  for (Eigen::Index i = 0; i < M.rows(); ++i)
-    for (Eigen::Index j = i + 1; j < M.cols(); ++j)
-      if (std::abs(M(i, j) - M(j, i)) > 1e-12 * scale)
+// definite. Dense: Cholesky succeeds and the smallest eigenvalue is not
+// negligible against the largest (N * eps relative), so a numerically
+// singular M whose Cholesky squeaks through on rounding is refused as well.
+// Sparse: the pivots of LDL' are all positive and the smallest is not
+// negligible against the largest (the same N * eps).
+void check_mass_matrix(const mech::SparseMatrix& M, const std::string& source) {
+  double scale = 0.0;
+  for (Eigen::Index j = 0; j < M.outerSize(); ++j)
+    for (mech::SparseMatrix::InnerIterator it(M, j); it; ++it)
+      scale = std::max(scale, std::abs(it.value()));
+  for (Eigen::Index j = 0; j < M.outerSize(); ++j)
+    for (mech::SparseMatrix::InnerIterator it(M, j); it; ++it) {
+      const Eigen::Index i = it.row();
+      if (std::abs(it.value() - M.coeff(j, i)) > 1e-12 * scale) {
+        const Eigen::Index a = std::min(i, j), b = std::max(i, j);
         fail(source, "mechanical.M",
-             "not symmetric (M[" + std::to_string(i) + "][" + std::to_string(j) +
-                 "] = " + format_number(M(i, j)) + " but M[" + std::to_string(j) + "][" +
-                 std::to_string(i) + "] = " + format_number(M(j, i)) + ")");
-  const MatrixXd S = 0.5 * (M + M.transpose());
-  const Eigen::LLT<MatrixXd> llt(S);
-  const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<MatrixXd>(S).eigenvalues();
+             "not symmetric (M[" + std::to_string(a) + "][" + std::to_string(b) +
+                 "] = " + format_number(M.coeff(a, b)) + " but M[" + std::to_string(b) + "][" +
+                 std::to_string(a) + "] = " + format_number(M.coeff(b, a)) + ")");
+      }
+    }
   const double eps = std::numeric_limits<double>::epsilon();
-  if (llt.info() != Eigen::Success ||
-      ev.minCoeff() <= static_cast<double>(M.rows()) * eps * std::abs(ev.maxCoeff())) {
-    // Computed values, not input: 6 digits read better than 17.
-    char buf[96];
-    std::snprintf(buf, sizeof buf, "smallest eigenvalue %.6g, largest %.6g", ev.minCoeff(),
-                  ev.maxCoeff());
+  const double rel = static_cast<double>(M.rows()) * eps;
+  // Computed values, not input: 6 digits read better than 17.
+  char buf[128];
+  if (M.rows() <= kDenseMassCheckMax) {
+    const MatrixXd Md = M.toDense();
+    const MatrixXd S = 0.5 * (Md + Md.transpose());
+    const Eigen::LLT<MatrixXd> llt(S);
+    const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<MatrixXd>(S).eigenvalues();
+    if (llt.info() != Eigen::Success || ev.minCoeff() <= rel * std::abs(ev.maxCoeff())) {
+      std::snprintf(buf, sizeof buf, "smallest eigenvalue %.6g, largest %.6g", ev.minCoeff(),
+                    ev.maxCoeff());
+      fail(source, "mechanical.M", "not positive definite (" + std::string(buf) + ")");
+    }
+    return;
+  }
+  const Eigen::SimplicialLDLT<mech::SparseMatrix> ldlt(M);
+  const VectorXd d = ldlt.info() == Eigen::Success ? ldlt.vectorD() : VectorXd();
+  if (d.size() == 0 || !d.allFinite() || d.minCoeff() <= rel * d.cwiseAbs().maxCoeff()) {
+    if (d.size() == 0)
+      std::snprintf(buf, sizeof buf, "its LDL' factorisation failed");
+    else
+      std::snprintf(buf, sizeof buf, "smallest LDL' pivot %.6g, largest %.6g", d.minCoeff(),
+                    d.maxCoeff());
     fail(source, "mechanical.M", "not positive definite (" + std::string(buf) + ")");
   }
 }
@@ -207,7 +312,7 @@ mech::MechanicalModel parse_mechanical(const YAML::Node& node, const std::string
   const auto has = [&](const char* k) { return keys.count(k) > 0; };
   mech::MechanicalModel m;
   if (!has("M")) fail(source, "mechanical.M", "missing (the mass matrix is required)");
-  m.M = matrix(keys.at("M"), source, "mechanical.M", 0);
+  m.M = sparse_matrix(keys.at("M"), source, "mechanical.M", 0);
   if (m.M.rows() == 0)
     fail(source, "mechanical.M", "empty (a model needs at least one coordinate)");
   if (m.M.rows() != m.M.cols())
@@ -216,16 +321,16 @@ mech::MechanicalModel parse_mechanical(const YAML::Node& node, const std::string
   check_mass_matrix(m.M, source);
   const std::string nn = "(N = " + std::to_string(N) + " coordinates, from M)";
   if (has("D")) {
-    m.D = matrix(keys.at("D"), source, "mechanical.D", N);
+    m.D = sparse_matrix(keys.at("D"), source, "mechanical.D", N);
     expect_dims(m.D, N, N, source, "mechanical.D", nn);
   }
   if (has("K")) {
-    m.K = matrix(keys.at("K"), source, "mechanical.K", N);
+    m.K = sparse_matrix(keys.at("K"), source, "mechanical.K", N);
     expect_dims(m.K, N, N, source, "mechanical.K", nn);
   }
-  m.E = MatrixXd::Zero(0, N);
+  m.E = mech::SparseMatrix(0, N);
   if (has("E")) {
-    m.E = matrix(keys.at("E"), source, "mechanical.E", N);
+    m.E = sparse_matrix(keys.at("E"), source, "mechanical.E", N);
     if (m.E.cols() != N)
       fail(source, "mechanical.E",
            "expected " + std::to_string(N) + " columns " + nn + " (got " + dims(m.E) + ")");
@@ -362,9 +467,7 @@ std::vector<std::string> model_notes(const mech::Model& model) {
     if (k == 0) {
       notes.push_back("no unilateral constraints: the model is a free linear system");
     } else {
-      const Eigen::JacobiSVD<MatrixXd> svd(m.E);
-      const double tol = lcs::rank_tolerance(m.E);
-      const auto rank = (svd.singularValues().array() > tol).count();
+      const int rank = mech::constraint_rank(m);
       if (rank < k)
         notes.push_back("dependent constraints: E (" + std::to_string(k) + " x " +
                         std::to_string(m.dofs()) + ") has rank " + std::to_string(rank) + " < " +

@@ -224,10 +224,11 @@ mech::Model parse_scene(const std::string& yaml_text, const std::string& source)
     if (q0.count(joints[static_cast<std::size_t>(i)]))
       q0v(i) = q0.at(joints[static_cast<std::size_t>(i)]);
 
+  // Scenes are small (one coordinate per simulated joint): assembled dense,
+  // stored sparse (mech::MechanicalModel) at the end.
   mech::MechanicalModel m;
-  m.M = lin.M;
-  m.D = MatrixXd(lin.damping.asDiagonal());
-  m.K = lin.K_g;
+  MatrixXd D = MatrixXd(lin.damping.asDiagonal());
+  MatrixXd K = lin.K_g;
   m.f = lin.tau_g + lin.K_g * q0v;
   m.coordinates = joints;
 
@@ -257,8 +258,8 @@ mech::Model parse_scene(const std::string& yaml_text, const std::string& source)
         fail(source, k + ".stiffness", "must be >= 0 (got " + format_number(stiffness) + ")");
       if (damping < 0.0)
         fail(source, k + ".damping", "must be >= 0 (got " + format_number(damping) + ")");
-      m.K += stiffness * c * c.transpose();
-      m.D += damping * c * c.transpose();
+      K += stiffness * c * c.transpose();
+      D += damping * c * c.transpose();
       m.f += stiffness * rest * c;
     }
   }
@@ -308,12 +309,16 @@ mech::Model parse_scene(const std::string& yaml_text, const std::string& source)
         fail(source, "constraints", "duplicate constraint name '" + c + "'");
   }
   const auto k = static_cast<Eigen::Index>(rows.size());
-  m.E = MatrixXd::Zero(k, N);
+  MatrixXd E = MatrixXd::Zero(k, N);
   m.g = VectorXd::Zero(k);
   for (Eigen::Index i = 0; i < k; ++i) {
-    m.E.row(i) = rows[static_cast<std::size_t>(i)].transpose();
+    E.row(i) = rows[static_cast<std::size_t>(i)].transpose();
     m.g(i) = gaps[static_cast<std::size_t>(i)];
   }
+  m.M = lin.M.sparseView();
+  m.D = D.sparseView();
+  m.K = K.sparseView();
+  m.E = E.sparseView();
   m.restitution = VectorXd::Zero(k);
   if (keys.count("restitution")) {
     for (const auto& [name, e] :
@@ -334,7 +339,7 @@ mech::Model parse_scene(const std::string& yaml_text, const std::string& source)
   // M must be symmetric positive definite (the CRBA makes it symmetric by
   // construction; a massless subtree makes it singular).
   {
-    const Eigen::SelfAdjointEigenSolver<MatrixXd> es(m.M);
+    const Eigen::SelfAdjointEigenSolver<MatrixXd> es(lin.M);
     const double eps = std::numeric_limits<double>::epsilon();
     if (es.eigenvalues().minCoeff() <=
         static_cast<double>(N) * eps * std::abs(es.eigenvalues().maxCoeff()))

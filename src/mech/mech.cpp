@@ -1,5 +1,8 @@
 #include "mech/mech.hpp"
 
+#include <Eigen/OrderingMethods>
+#include <Eigen/SVD>
+#include <Eigen/SparseQR>
 #include <algorithm>
 #include <stdexcept>
 
@@ -8,9 +11,9 @@ namespace lcsim::mech {
 void fill_defaults(MechanicalModel& m) {
   const int n = m.dofs();
   const int k = m.num_constraints();
-  if (m.D.size() == 0) m.D = MatrixXd::Zero(n, n);
-  if (m.K.size() == 0) m.K = MatrixXd::Zero(n, n);
-  if (m.E.size() == 0) m.E = MatrixXd::Zero(0, n);
+  if (m.D.size() == 0) m.D = SparseMatrix(n, n);
+  if (m.K.size() == 0) m.K = SparseMatrix(n, n);
+  if (m.E.size() == 0) m.E = SparseMatrix(0, n);
   if (m.g.size() == 0) m.g = VectorXd::Zero(k);
   if (m.f.size() == 0) m.f = VectorXd::Zero(n);
   if (m.restitution.size() == 0) m.restitution = VectorXd::Zero(k);
@@ -23,27 +26,26 @@ void fill_defaults(MechanicalModel& m) {
 lcs::Lcs to_lcs(const MechanicalModel& m) {
   const int n = m.dofs();
   const int k = m.num_constraints();
-  const Eigen::LLT<MatrixXd> llt(m.M);
+  const Eigen::LLT<MatrixXd> llt(m.M.toDense());
   lcs::Lcs s;
   s.A = MatrixXd::Zero(2 * n + 1, 2 * n + 1);
   s.A.block(0, n, n, n) = MatrixXd::Identity(n, n);
-  s.A.block(n, 0, n, n) = -llt.solve(m.K);
-  s.A.block(n, n, n, n) = -llt.solve(m.D);
+  s.A.block(n, 0, n, n) = -llt.solve(m.K.toDense());
+  s.A.block(n, n, n, n) = -llt.solve(m.D.toDense());
   s.A.block(n, 2 * n, n, 1) = llt.solve(m.f);
   s.B = MatrixXd::Zero(2 * n + 1, k);
   s.C = MatrixXd::Zero(k, 2 * n + 1);
   if (k > 0) {  // an empty block at a non-zero offset is UB in Eigen (found by UBSan)
-    s.B.block(n, 0, n, k) = llt.solve(m.E.transpose());
-    s.C.block(0, 0, k, n) = m.E;
+    const MatrixXd E = m.E.toDense();
+    s.B.block(n, 0, n, k) = llt.solve(E.transpose());
+    s.C.block(0, 0, k, n) = E;
     s.C.col(2 * n) = m.g;
   }
   s.D = MatrixXd::Zero(k, k);
   return s;
 }
 
-double kinetic_energy(const MechanicalModel& m, const VectorXd& v) {
-  return 0.5 * v.dot(m.M * v);
-}
+double kinetic_energy(const MechanicalModel& m, const VectorXd& v) { return 0.5 * v.dot(m.M * v); }
 
 double potential_energy(const MechanicalModel& m, const VectorXd& q) {
   return 0.5 * q.dot(m.K * q) - m.f.dot(q);
@@ -60,8 +62,25 @@ double worst_violation(const MechanicalModel& m, const VectorXd& q) {
   return std::min(0.0, gaps(m, q).minCoeff());
 }
 
+int constraint_rank(const MechanicalModel& m) {
+  if (m.E.size() == 0) return 0;
+  constexpr double kDenseEntries = 1e6;
+  if (static_cast<double>(m.E.rows()) * static_cast<double>(m.E.cols()) <= kDenseEntries) {
+    const MatrixXd E = m.E.toDense();
+    const Eigen::JacobiSVD<MatrixXd> svd(E);
+    return static_cast<int>((svd.singularValues().array() > lcs::rank_tolerance(E)).count());
+  }
+  const SparseMatrix Et = m.E.transpose();
+  Eigen::SparseQR<SparseMatrix, Eigen::COLAMDOrdering<int>> qr;
+  const double scale = m.E.norm() > 0.0 ? m.E.norm() : 1.0;
+  qr.setPivotThreshold(static_cast<double>(std::max(Et.rows(), Et.cols())) * 1e-12 * scale);
+  qr.compute(Et);
+  return static_cast<int>(qr.rank());
+}
+
 MatrixXd delassus(const MechanicalModel& m) {
-  return m.E * Eigen::LLT<MatrixXd>(m.M).solve(m.E.transpose());
+  const MatrixXd Et = m.E.transpose().toDense();
+  return m.E * Eigen::LLT<MatrixXd>(m.M.toDense()).solve(Et);
 }
 
 int Model::state_size() const {
@@ -76,7 +95,19 @@ int Model::num_constraints() const {
   return 0;
 }
 
+int Model::lcs_state_size() const {
+  if (mechanical) return 2 * mechanical->dofs() + 1;
+  if (lcs) return lcs->n();
+  return 0;
+}
+
 lcs::Lcs Model::as_lcs() const {
+  if (lcs_state_size() > kMaxDenseLcsState)
+    throw std::length_error(
+        "the model's LCS has " + std::to_string(lcs_state_size()) + " states, more than the " +
+        std::to_string(kMaxDenseLcsState) +
+        " that dense methods take (event-driven, euler, analyze); simulate models this large "
+        "with --method moreau-jean");
   if (mechanical) return to_lcs(*mechanical);
   if (lcs) return *lcs;
   throw std::logic_error("Model::as_lcs: empty model");

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <Eigen/SparseCore>
 #include <limits>
 #include <optional>
 #include <string>
@@ -17,15 +18,23 @@ namespace lcsim::mech {
 
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
+// Column-major; the storage of every model matrix.
+using SparseMatrix = Eigen::SparseMatrix<double>;
 
+// The model's matrices are held sparse whatever their size: a model stores
+// only its non-zeros (a chain of N carts holds O(N) numbers, not 4 N^2), and a
+// 2 x 2 model pays nothing for it. Algorithms that are dense by nature (the
+// LCS theory, matrix exponentials, small Delassus matrices) take M.toDense()
+// where they need it; the time-stepping layer chooses dense or sparse
+// factorisations by size (sim::Options::sparse_dofs_threshold).
 struct MechanicalModel {
-  MatrixXd M;              // mass matrix, symmetric positive definite (N x N)
-  MatrixXd D;              // damping (N x N), zero if omitted
-  MatrixXd K;              // stiffness (N x N), zero if omitted
-  MatrixXd E;              // constraint rows (k x N): E q + g >= 0
-  VectorXd g;              // gaps at q = 0 (k), zero if omitted
-  VectorXd f;              // constant generalised force (N), e.g. gravity
-  VectorXd restitution;    // per-constraint Newton coefficient in [0, 1] (k)
+  SparseMatrix M;                        // mass matrix, symmetric positive definite (N x N)
+  SparseMatrix D;                        // damping (N x N), zero if omitted
+  SparseMatrix K;                        // stiffness (N x N), zero if omitted
+  SparseMatrix E;                        // constraint rows (k x N): E q + g >= 0
+  VectorXd g;                            // gaps at q = 0 (k), zero if omitted
+  VectorXd f;                            // constant generalised force (N), e.g. gravity
+  VectorXd restitution;                  // per-constraint Newton coefficient in [0, 1] (k)
   std::vector<std::string> coordinates;  // names (N); "q1".. if omitted
   std::vector<std::string> constraints;  // names (k); "c1".. if omitted
   int dofs() const { return static_cast<int>(M.rows()); }
@@ -50,8 +59,20 @@ VectorXd gaps(const MechanicalModel& m, const VectorXd& q);  // E q + g
 // Most negative gap (0 if all are >= 0).
 double worst_violation(const MechanicalModel& m, const VectorXd& q);
 
-// Delassus matrix E M^{-1} E' (the script M = script N of §3.8).
+// Rank of E (numerical, lcs::rank_tolerance): by SVD up to 10^6 entries, by
+// a sparse rank-revealing QR of E' above (its threshold the same tolerance
+// with the Frobenius norm for the largest singular value, an upper bound).
+int constraint_rank(const MechanicalModel& m);
+
+// Delassus matrix E M^{-1} E' (the script M = script N of §3.8), dense (k x k).
 MatrixXd delassus(const MechanicalModel& m);
+
+// The LCS of a model is dense, n x n with n = 2N + 1 for N coordinates: the
+// exact event-driven method, backward Euler and `lcsim analyze` work on it
+// with O(n^2) memory and O(n^3) matrix functions. Beyond this many states they
+// refuse the model with a message naming the limit (Moreau–Jean, which works
+// on the sparse model, has no such limit). N = 500 coordinates fit.
+inline constexpr int kMaxDenseLcsState = 1001;
 
 // A model file holds either a mechanical model or a general LCS, with an
 // optional default initial state and horizon.
@@ -65,8 +86,42 @@ struct Model {
   bool is_mechanical() const { return mechanical.has_value(); }
   int state_size() const;  // 2N for mechanical, n for LCS
   int num_constraints() const;
+  // Size of as_lcs(): 2N + 1 for mechanical models (augmented), n for LCS.
+  int lcs_state_size() const;
   // The LCS to simulate: to_lcs(mechanical) (augmented) or the LCS itself.
+  // Dense; std::length_error beyond kMaxDenseLcsState (see there).
   lcs::Lcs as_lcs() const;
 };
+
+}  // namespace lcsim::mech
+
+namespace lcsim::mech {
+
+// Benchmark models built in memory (src/mech/benchmarks.cpp).
+
+// The two carts of thesis §3.7 (Figure 3.1): unit masses, K = [2 -1; -1 1]
+// (a spring from cart 1 to the wall, one between the carts), the stop
+// x1 >= 0 (eq. (3.1)) and, with `hook`, the hook x1 - x2 >= 0 of Example
+// 3.8.3 (eq. (3.74)). No initial state or horizon (robots/two_carts*.yaml
+// hold the thesis's).
+Model two_carts_model(bool hook);
+
+// The cart chain of the scaling benchmark (`lcsim generate chain`, issue 9):
+// carts i = 0..n-1 (coordinate q_i, m), unit masses (kg), unit springs (N/m)
+// between neighbours and, with `wall_spring`, from cart 0 to the wall, so
+// K = tridiag(-1, 2, -1) with K(n-1, n-1) = 1 (K(0, 0) = 1 without the wall).
+// `stops`: q_i + 1 >= 0 for every cart (rows 0..n-1 of E, g = 1).
+// `hooks`: q_i - q_{i+1} + 0.5 >= 0 for every neighbouring pair (cart i+1 at
+// most 0.5 m ahead of cart i; the rows after the stops).
+// The model's initial state is the benchmark's, x_i = 0.1 (i mod 3) m,
+// v_i = -1 m/s, and t_end = 10 s. O(n) storage.
+struct ChainSpec {
+  int n = 10;
+  bool stops = true;
+  bool hooks = false;
+  bool wall_spring = true;
+};
+inline constexpr double kChainHookGap = 0.5;  // m
+Model chain_model(const ChainSpec& spec);
 
 }  // namespace lcsim::mech

@@ -178,6 +178,7 @@ struct EventResult {
 
 class EventDriven {
  public:
+  // `model` fits the dense LCS (simulate_event_driven checks).
   EventDriven(const mech::Model& model, const Options& opt)
       : model_(model), opt_(opt), sys_(model.as_lcs()) {
     n_ = sys_.n();
@@ -510,16 +511,6 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     tr.status = RunStatus::kFailed;
     tr.message = msg;
   };
-  // The exact method is dense in the state: matrix exponentials of size n
-  // (2N+1 for N coordinates) cost O(n^3) per evaluation.
-  constexpr int kMaxDenseState = 1001;
-  if (n_ > kMaxDenseState) {
-    fail("the exact event-driven method is dense in the state (matrix exponentials of size " +
-         std::to_string(n_) + " > " + std::to_string(kMaxDenseState) +
-         "); use a time-stepping method (--method moreau-jean) for models this large");
-    tr.final_state = x0_user;
-    return tr;
-  }
   VectorXd xa = augment(x0_user);
   tr.energy_initial = energy(xa);
   double t = 0.0;
@@ -828,6 +819,21 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
 }  // namespace
 
 Trajectory simulate_event_driven(const mech::Model& model, const VectorXd& x0, const Options& opt) {
+  // The exact method is dense in the state: matrix exponentials of size n
+  // (2N+1 for N coordinates) cost O(n^3) per evaluation. Refused before any
+  // dense matrix is built.
+  if (model.lcs_state_size() > mech::kMaxDenseLcsState) {
+    Trajectory tr;
+    tr.method = "event";
+    tr.t_end = opt.t_end;
+    tr.status = RunStatus::kFailed;
+    tr.message =
+        "the exact event-driven method is dense in the state (matrix exponentials of size " +
+        std::to_string(model.lcs_state_size()) + " > " + std::to_string(mech::kMaxDenseLcsState) +
+        "); use a time-stepping method (--method moreau-jean) for models this large";
+    tr.final_state = x0;
+    return tr;
+  }
   EventDriven ed(model, opt);
   return ed.run(x0);
 }

@@ -78,9 +78,9 @@ struct Options {
   // refuses it (some leading row index rho_i >= 3, §7.3, Example 7.3.3).
   bool force = false;
   // Moreau–Jean, how its linear algebra scales (src/sim/time_stepping.cpp):
-  // models with more than `sparse_dofs_threshold` coordinates hold M, D, K, E
-  // as sparse matrices and factor W = M + h theta D + h^2 theta^2 K by sparse
-  // LDL'; smaller ones dense (LLT). 0 forces the sparse path, a huge value the
+  // models with more than `sparse_dofs_threshold` coordinates factor
+  // W = M + h theta D + h^2 theta^2 K by sparse LDL'; smaller ones a dense
+  // copy by LLT (the model's matrices are sparse either way). 0 forces the sparse path, a huge value the
   // dense one (the tests run both on one model).
   int sparse_dofs_threshold = 64;
   // Moreau–Jean: a step's LCP over at most this many active constraints is

@@ -293,11 +293,12 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
 // Scaling. Cost per step grows with the coordinates N and the constraints in
 // play, not with the constraints declared, and never cubically in N where M, D,
 // K, E are sparse:
-// - One code path over MjOperators (products with D, K, E) and MjIteration
-//   (W^{-1} rhs and the columns W^{-1} E_i'). Models with more than
-//   Options::sparse_dofs_threshold coordinates hold D, K, E as Eigen sparse
-//   matrices and factor W by Eigen::SimplicialLDLT (AMD ordering); smaller ones
-//   use the dense matrices and Eigen::LLT. The step below is written once.
+// - One code path over MjOperators (products with D, K, E, which the model
+//   holds sparse) and MjIteration (W^{-1} rhs and the columns W^{-1} E_i').
+//   Models with more than Options::sparse_dofs_threshold coordinates factor W
+//   by Eigen::SimplicialLDLT (AMD ordering); smaller ones factor a dense copy
+//   by Eigen::LLT (faster below a few dozen coordinates). The step below is
+//   written once.
 // - The Delassus matrix is never formed for all k constraints. The column
 //   W^{-1} E_i' is computed (one solve with the factor, O(nnz(L)) for sparse W)
 //   the first time constraint i enters the active set, pruned of entries below
@@ -325,20 +326,14 @@ constexpr int kPivotFallbackMax = 2000;
 using SparseCol = Eigen::SparseMatrix<double, Eigen::ColMajor>;
 using SparseRow = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
-// Products with the model's matrices, dense or sparse.
+// Products with the model's matrices (held sparse, mech::MechanicalModel).
+// `sparse` chooses how W is factored, nothing else.
 class MjOperators {
  public:
-  MjOperators(const mech::MechanicalModel& m, bool sparse) : m_(m), sparse_(sparse) {
-    // E by columns is needed by both paths to assemble the active Delassus
-    // matrix from sparse columns of W^{-1} E'.
-    Ec_ = m.E.sparseView(1.0, 0.0);
+  MjOperators(const mech::MechanicalModel& m, bool sparse)
+      : m_(m), sparse_(sparse), Ec_(m.E), Er_(m.E) {
     Ec_.makeCompressed();
-    if (sparse_) {
-      Ms_ = m.M.sparseView(1.0, 0.0);
-      Ds_ = m.D.sparseView(1.0, 0.0);
-      Ks_ = m.K.sparseView(1.0, 0.0);
-      Er_ = Ec_;
-    }
+    Er_.makeCompressed();
   }
   bool sparse() const { return sparse_; }
   int dofs() const { return m_.dofs(); }
@@ -348,40 +343,25 @@ class MjOperators {
   void step_force(const VectorXd& q, const VectorXd& v, double h, double theta,
                   VectorXd& out) const {
     out = q + (h * theta) * v;
-    if (sparse_) {
-      out = m_.f - Ks_ * out;
-      out.noalias() -= Ds_ * v;
-    } else {
-      out = m_.f - m_.K * out;
-      out.noalias() -= m_.D * v;
-    }
+    out = m_.f - m_.K * out;
+    out.noalias() -= m_.D * v;
   }
-  void E_times(const VectorXd& x, VectorXd& out) const {
-    if (sparse_)
-      out.noalias() = Er_ * x;
-    else
-      out.noalias() = m_.E * x;
-  }
+  void E_times(const VectorXd& x, VectorXd& out) const { out.noalias() = Er_ * x; }
   // W = M + h theta D + h^2 theta^2 K.
   SparseCol W_sparse(double h, double theta) const {
-    SparseCol W = Ms_ + (h * theta) * Ds_ + (h * h * theta * theta) * Ks_;
+    SparseCol W = m_.M + (h * theta) * m_.D + (h * h * theta * theta) * m_.K;
     W.makeCompressed();
     return W;
   }
-  MatrixXd W_dense(double h, double theta) const {
-    return m_.M + h * theta * m_.D + h * h * theta * theta * m_.K;
-  }
-  // T + V = ½ v'Mv + ½ q'Kq - f'q (J), as mech::total_energy.
-  double energy(const VectorXd& q, const VectorXd& v) const {
-    if (!sparse_) return mech::total_energy(m_, q, v);
-    return 0.5 * v.dot(Ms_ * v) + 0.5 * q.dot(Ks_ * q) - m_.f.dot(q);
-  }
+  MatrixXd W_dense(double h, double theta) const { return W_sparse(h, theta).toDense(); }
+  // T + V = ½ v'Mv + ½ q'Kq - f'q (J).
+  double energy(const VectorXd& q, const VectorXd& v) const { return mech::total_energy(m_, q, v); }
 
  private:
   const mech::MechanicalModel& m_;
   bool sparse_;
-  SparseCol Ms_, Ds_, Ks_, Ec_;
-  SparseRow Er_;
+  SparseCol Ec_;  // E by columns: assembles the active Delassus matrix
+  SparseRow Er_;  // E by rows: the gap rates E v
 };
 
 // The factored iteration matrix W for one step length, and the cached columns

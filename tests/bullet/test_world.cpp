@@ -135,7 +135,7 @@ TEST(BulletCompare, PerturbedTrajectoryGivesTheDeviationPutIn) {
 
 TEST(BulletWorld, InexpressibleModelsAreRefusedNamingTheConstraint) {
   mech::Model m = load("two_carts_hook.yaml");
-  m.mechanical->E(1, 1) = 1.0;  // hook row now x1 + x2 >= 0
+  m.mechanical->E.coeffRef(1, 1) = 1.0;  // hook row now x1 + x2 >= 0
   try {
     check_expressible(m);
     FAIL() << "expected std::invalid_argument";
@@ -149,7 +149,7 @@ TEST(BulletWorld, InexpressibleModelsAreRefusedNamingTheConstraint) {
   EXPECT_NE(tr.message.find("'hook'"), std::string::npos);
 
   mech::Model nd = load("two_carts.yaml");
-  nd.mechanical->M(0, 1) = nd.mechanical->M(1, 0) = 0.1;
+  nd.mechanical->M.coeffRef(0, 1) = nd.mechanical->M.coeffRef(1, 0) = 0.1;
   EXPECT_THROW(check_expressible(nd), std::invalid_argument);
 }
 

@@ -108,7 +108,8 @@ TEST(Section822, RandomSearchFindsGainsOnlyWithInadmissibleJumps) {
       lam(i) = r.impulse(i) / (1.0 + e(i));
       d(i) = e(i) * lam(i);
     }
-    const Eigen::MatrixXd W = ri.model.E * ri.model.M.llt().solve(ri.model.E.transpose());
+    const Eigen::MatrixXd W =
+        ri.model.E * ri.model.M.toDense().llt().solve(ri.model.E.transpose().toDense());
     // w'lambda = w'd = 0 by complementarity up to the LCP's acceptance; kept
     // in the sum so that the check is pure algebra, exact up to rounding of
     // terms of size lambda'W lambda (hence that scale).

@@ -11,21 +11,14 @@ namespace lcsim::impact::testing {
 
 inline mech::MechanicalModel make_model(const Eigen::MatrixXd& M, const Eigen::MatrixXd& E) {
   mech::MechanicalModel m;
-  m.M = M;
-  m.E = E;
+  m.M = M.sparseView();
+  m.E = E.sparseView();
   mech::fill_defaults(m);
   return m;
 }
 
 // Example 3.8.3, eq. (3.74): two carts, a stop (x1 >= 0) and a hook (x1 - x2 >= 0).
-inline mech::MechanicalModel hook_model() {
-  Eigen::MatrixXd E(2, 2);
-  E << 1, 0, 1, -1;
-  mech::MechanicalModel m = make_model(Eigen::MatrixXd::Identity(2, 2), E);
-  m.K.resize(2, 2);
-  m.K << 2, -1, -1, 1;
-  return m;
-}
+inline mech::MechanicalModel hook_model() { return *mech::two_carts_model(true).mechanical; }
 
 // Example 1.4.1: three unit balls on a line, touching: x2 - x1 >= 0, x3 - x2 >= 0.
 inline mech::MechanicalModel three_balls() {

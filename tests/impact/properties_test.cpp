@@ -42,7 +42,7 @@ double m_norm(const Eigen::MatrixXd& M, const Eigen::VectorXd& x) {
 // |E_i|(|v| + |v+| + |M^{-1}E'||lambda|), what rounding is relative to.
 double worst_relative_rate(const ImpactInput& in, const ImpactResult& r) {
   const Eigen::MatrixXd& E = in.model->E;
-  const Eigen::MatrixXd MinvEt = in.model->M.llt().solve(E.transpose());
+  const Eigen::MatrixXd MinvEt = in.model->M.toDense().llt().solve(E.transpose());
   const Eigen::VectorXd scale = testing::rate_scale(E, in.v, r.v_after) +
                                 E.cwiseAbs() * (MinvEt.cwiseAbs() * r.impulse.cwiseAbs());
   double worst = 0.0;
@@ -117,7 +117,8 @@ TEST(ImpactProperties, EnergyNeverRisesAndContactsNeverApproach) {
       all.violation = std::max(all.violation, violation[which]);
     }
     // Complementarity of Moreau's rule: lambda_i (E_i v+) = 0.
-    const Eigen::MatrixXd MinvEt = ri.model.M.llt().solve(ri.model.E.transpose());
+    const Eigen::MatrixXd MinvEt =
+        ri.model.M.toDense().llt().solve(ri.model.E.transpose().toDense());
     const Eigen::VectorXd scale =
         testing::rate_scale(ri.model.E, ri.v, rm.v_after) +
         ri.model.E.cwiseAbs() * (MinvEt.cwiseAbs() * rm.impulse.cwiseAbs());
@@ -194,7 +195,7 @@ TEST(ImpactProperties, DependentConstraintsShareTheJump) {
     if (ri.closed.size() < 2 || ri.closed.size() > 8) continue;
     Eigen::MatrixXd EJ(ri.closed.size(), ri.model.dofs());
     for (size_t i = 0; i < ri.closed.size(); ++i) EJ.row(i) = ri.model.E.row(ri.closed[i]);
-    const Eigen::MatrixXd W = EJ * ri.model.M.llt().solve(EJ.transpose());
+    const Eigen::MatrixXd W = EJ * ri.model.M.toDense().llt().solve(EJ.transpose());
     const lcp::EnumerationResult all = lcp::enumerate_solutions(W, EJ * ri.v);
     if (all.solutions.empty()) continue;  // enumeration misses singular-only bases
     ++checked;
@@ -205,7 +206,7 @@ TEST(ImpactProperties, DependentConstraintsShareTheJump) {
     const double scale = std::max(m_norm(ri.model.M, ri.v), 1e-300);
     if (all.solutions.size() > 1) ++multiple;
     for (const Eigen::VectorXd& z : all.solutions) {
-      const Eigen::VectorXd jz = ri.model.M.llt().solve(EJ.transpose() * z);
+      const Eigen::VectorXd jz = ri.model.M.toDense().llt().solve(EJ.transpose() * z);
       // Enumeration solves singular subsystems by least squares: 1e-8 relative.
       EXPECT_LE(m_norm(ri.model.M, jz - jump), 1e-8 * scale) << "case " << c;
     }

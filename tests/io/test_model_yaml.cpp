@@ -43,10 +43,10 @@ TEST(ShippedModels, TwoCartsMatchEq31) {
   const mech::MechanicalModel& m = *model.mechanical;
   EXPECT_EQ(model.name, "two_carts");
   // Integers read from YAML are exact doubles: compare exactly.
-  EXPECT_EQ(m.M, MatrixXd::Identity(2, 2));
-  EXPECT_EQ(m.K, (MatrixXd(2, 2) << 2, -1, -1, 1).finished());
-  EXPECT_EQ(m.D, MatrixXd::Zero(2, 2));
-  EXPECT_EQ(m.E, (MatrixXd(1, 2) << 1, 0).finished());
+  EXPECT_EQ(m.M.toDense(), MatrixXd::Identity(2, 2));
+  EXPECT_EQ(m.K.toDense(), (MatrixXd(2, 2) << 2, -1, -1, 1).finished());
+  EXPECT_EQ(m.D.toDense(), MatrixXd::Zero(2, 2));
+  EXPECT_EQ(m.E.toDense(), (MatrixXd(1, 2) << 1, 0).finished());
   EXPECT_EQ(m.g, VectorXd::Zero(1));
   EXPECT_EQ(m.f, VectorXd::Zero(2));
   EXPECT_EQ(m.restitution, VectorXd::Zero(1));
@@ -78,9 +78,9 @@ TEST(ShippedModels, TwoCartsHookIsExample383) {
   const mech::Model model = load_model(kRobots + "two_carts_hook.yaml");
   ASSERT_TRUE(model.is_mechanical());
   const mech::MechanicalModel& m = *model.mechanical;
-  EXPECT_EQ(m.M, MatrixXd::Identity(2, 2));
-  EXPECT_EQ(m.K, (MatrixXd(2, 2) << 2, -1, -1, 1).finished());
-  EXPECT_EQ(m.E, (MatrixXd(2, 2) << 1, 0, 1, -1).finished());
+  EXPECT_EQ(m.M.toDense(), MatrixXd::Identity(2, 2));
+  EXPECT_EQ(m.K.toDense(), (MatrixXd(2, 2) << 2, -1, -1, 1).finished());
+  EXPECT_EQ(m.E.toDense(), (MatrixXd(2, 2) << 1, 0, 1, -1).finished());
   EXPECT_EQ(m.g, VectorXd::Zero(2));
   EXPECT_EQ(m.constraints, (std::vector<std::string>{"stop", "hook"}));
   EXPECT_EQ(model.initial, (VectorXd(4) << 0, 0, -1, 2).finished());
@@ -93,11 +93,11 @@ TEST(ShippedModels, Ball) {
   const mech::Model model = load_model(kRobots + "ball.yaml");
   ASSERT_TRUE(model.is_mechanical());
   const mech::MechanicalModel& m = *model.mechanical;
-  EXPECT_EQ(m.M, MatrixXd::Ones(1, 1));
-  EXPECT_EQ(m.E, MatrixXd::Ones(1, 1));
+  EXPECT_EQ(m.M.toDense(), MatrixXd::Ones(1, 1));
+  EXPECT_EQ(m.E.toDense(), MatrixXd::Ones(1, 1));
   EXPECT_EQ(m.f(0), -9.81);  // the same literal parsed the same way: exact
   EXPECT_EQ(m.restitution(0), 0.5);
-  EXPECT_EQ(m.K, MatrixXd::Zero(1, 1));
+  EXPECT_EQ(m.K.toDense(), MatrixXd::Zero(1, 1));
   EXPECT_EQ(model.initial, (VectorXd(2) << 1, 0).finished());
   EXPECT_EQ(model.t_end, 3.0);
 }
@@ -130,8 +130,8 @@ TEST(ShippedModels, LcpExample) {
 TEST(ModelFile, DefaultsAndNames) {
   const mech::Model model = parse_model(two_dof(""), "ok.yaml");
   const mech::MechanicalModel& m = *model.mechanical;
-  EXPECT_EQ(m.D, MatrixXd::Zero(2, 2));
-  EXPECT_EQ(m.K, MatrixXd::Zero(2, 2));
+  EXPECT_EQ(m.D.toDense(), MatrixXd::Zero(2, 2));
+  EXPECT_EQ(m.K.toDense(), MatrixXd::Zero(2, 2));
   EXPECT_EQ(m.g, VectorXd::Zero(1));
   EXPECT_EQ(m.f, VectorXd::Zero(2));
   EXPECT_EQ(m.restitution, VectorXd::Zero(1));

@@ -23,10 +23,10 @@ void expect_same_matrices(const mech::MechanicalModel& a, const mech::Mechanical
   // Exact equality: the scene's numbers are sums and products of exactly
   // representable inputs (unit masses, unit springs, axis (1,0,0), zero
   // gravity component along x), so nothing may differ, not even in the last bit.
-  EXPECT_EQ(a.M, b.M);
-  EXPECT_EQ(a.D, b.D);
-  EXPECT_EQ(a.K, b.K);
-  EXPECT_EQ(a.E, b.E);
+  EXPECT_EQ(a.M.toDense(), b.M.toDense());
+  EXPECT_EQ(a.D.toDense(), b.D.toDense());
+  EXPECT_EQ(a.K.toDense(), b.K.toDense());
+  EXPECT_EQ(a.E.toDense(), b.E.toDense());
   EXPECT_EQ(a.g, b.g);
   EXPECT_EQ(a.f, b.f);
   EXPECT_EQ(a.restitution, b.restitution);
@@ -117,18 +117,18 @@ TEST(Scene, DoublePendulumAtTheHangingEquilibrium) {
   const mech::Model model = io::load_model(kRobots + "double_pendulum_scene.yaml");
   const mech::MechanicalModel& m = *model.mechanical;
   const Pendulum p;
-  EXPECT_LE((m.M - p.M(0.0)).cwiseAbs().maxCoeff(), 1e-13) << m.M;
-  EXPECT_NEAR(m.M(0, 0), 1.26, 1e-13);  // 0.02 + 0.25 + 0.01 + 0.5 * 1.96
-  EXPECT_NEAR(m.M(0, 1), 0.29, 1e-13);
-  EXPECT_NEAR(m.M(1, 1), 0.09, 1e-13);
-  EXPECT_LE((m.K - p.K(0.0, 0.0)).cwiseAbs().maxCoeff(), 1e-8) << m.K;
-  EXPECT_NEAR(m.K(0, 0), 9.81 * 1.2, 1e-8);
-  EXPECT_NEAR(m.K(1, 1), 9.81 * 0.2, 1e-8);
+  EXPECT_LE((m.M.toDense() - p.M(0.0)).cwiseAbs().maxCoeff(), 1e-13) << m.M;
+  EXPECT_NEAR(m.M.coeff(0, 0), 1.26, 1e-13);  // 0.02 + 0.25 + 0.01 + 0.5 * 1.96
+  EXPECT_NEAR(m.M.coeff(0, 1), 0.29, 1e-13);
+  EXPECT_NEAR(m.M.coeff(1, 1), 0.09, 1e-13);
+  EXPECT_LE((m.K.toDense() - p.K(0.0, 0.0)).cwiseAbs().maxCoeff(), 1e-8) << m.K;
+  EXPECT_NEAR(m.K.coeff(0, 0), 9.81 * 1.2, 1e-8);
+  EXPECT_NEAR(m.K.coeff(1, 1), 9.81 * 0.2, 1e-8);
   EXPECT_LE(m.f.cwiseAbs().maxCoeff(), 1e-8);  // an equilibrium: no net force at q0 = 0
   // the stop: shoulder - (-0.2) >= 0
   ASSERT_EQ(m.E.rows(), 1);
-  EXPECT_EQ(m.E(0, 0), 1.0);
-  EXPECT_EQ(m.E(0, 1), 0.0);
+  EXPECT_EQ(m.E.coeff(0, 0), 1.0);
+  EXPECT_EQ(m.E.coeff(0, 1), 0.0);
   EXPECT_EQ(m.g(0), 0.2);
   EXPECT_EQ(m.restitution(0), 0.5);
   ASSERT_EQ(model.initial.size(), 4);
@@ -151,10 +151,10 @@ TEST(Scene, DoublePendulumAwayFromEquilibrium) {
   const mech::MechanicalModel& m = *model.mechanical;
   const Pendulum p;
   const double t1 = 0.3, t2 = -0.2;
-  EXPECT_LE((m.M - p.M(t2)).cwiseAbs().maxCoeff(), 1e-13) << m.M;
-  EXPECT_LE((m.K - p.K(t1, t2)).cwiseAbs().maxCoeff(), 1e-8) << m.K;
+  EXPECT_LE((m.M.toDense() - p.M(t2)).cwiseAbs().maxCoeff(), 1e-13) << m.M;
+  EXPECT_LE((m.K.toDense() - p.K(t1, t2)).cwiseAbs().maxCoeff(), 1e-8) << m.K;
   std::printf("[ K_g check] double pendulum q0 = (0.3, -0.2): max|K - K_hand| = %.3g N m/rad\n",
-              (m.K - p.K(t1, t2)).cwiseAbs().maxCoeff());
+              (m.K.toDense() - p.K(t1, t2)).cwiseAbs().maxCoeff());
   const VectorXd q0 = (VectorXd(2) << t1, t2).finished();
   const VectorXd f = p.tau(t1, t2) + p.K(t1, t2) * q0;
   EXPECT_LE((m.f - f).cwiseAbs().maxCoeff(), 1e-8) << m.f.transpose();
@@ -162,7 +162,7 @@ TEST(Scene, DoublePendulumAwayFromEquilibrium) {
   ASSERT_EQ(m.E.rows(), 4);
   EXPECT_EQ(m.constraints, (std::vector<std::string>{"shoulder_lower", "shoulder_upper",
                                                      "elbow_lower", "elbow_upper"}));
-  EXPECT_EQ(m.E(1, 0), -1.0);
+  EXPECT_EQ(m.E.coeff(1, 0), -1.0);
   EXPECT_EQ(m.g(1), 1.5);
   EXPECT_EQ(m.g(2), 2.0);
   EXPECT_FALSE(model.initial.size());  // no initial: in the file
@@ -220,14 +220,14 @@ TEST(Scene, FrozenJointsAddMassButNoCoordinates) {
   }
   M(1, 0) = M(0, 1);
   // Same quantities by a different summation order: 1e-13 (~500 ulp of O(1)).
-  EXPECT_LE((m.M - M).cwiseAbs().maxCoeff(), 1e-13) << m.M << "\n" << M;
+  EXPECT_LE((m.M.toDense() - M).cwiseAbs().maxCoeff(), 1e-13) << m.M << "\n" << M;
   // The frozen gripper matters: without it (hand, fingers, tool) M22 would be
   // smaller by far more than the tolerance.
-  EXPECT_GT(m.M(1, 1) - (1 * 0.15 * 0.15 + 0.012), 0.05);
+  EXPECT_GT(m.M.coeff(1, 1) - (1 * 0.15 * 0.15 + 0.012), 0.05);
   // D: <dynamics damping> plus the scene's dampers; E: both limits per joint.
-  EXPECT_NEAR(m.D(0, 0), 2.1, 1e-15);
-  EXPECT_NEAR(m.D(1, 1), 1.05, 1e-15);
-  EXPECT_EQ(m.D(0, 1), 0.0);
+  EXPECT_NEAR(m.D.coeff(0, 0), 2.1, 1e-15);
+  EXPECT_NEAR(m.D.coeff(1, 1), 1.05, 1e-15);
+  EXPECT_EQ(m.D.coeff(0, 1), 0.0);
 }
 
 // ---- bad input ----

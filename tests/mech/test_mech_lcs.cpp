@@ -30,11 +30,11 @@ TEST(Ldcp, JumpEqualsProjectionOnRandomMechanicalModels) {
         S(i, j) = U(gen);
       }
     mech::MechanicalModel m;
-    m.M = R * R.transpose() + 0.5 * MatrixXd::Identity(N, N);
-    m.K = S * S.transpose();
+    m.M = (R * R.transpose() + 0.5 * MatrixXd::Identity(N, N)).sparseView();
+    m.K = (S * S.transpose()).sparseView();
     m.E.resize(k, N);
     for (int i = 0; i < k; ++i)
-      for (int j = 0; j < N; ++j) m.E(i, j) = U(gen);
+      for (int j = 0; j < N; ++j) m.E.coeffRef(i, j) = U(gen);
     mech::fill_defaults(m);
     const Lcs sys = mech::to_lcs(m);
     // q = 0 puts both gaps at zero; a random velocity.

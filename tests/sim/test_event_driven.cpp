@@ -24,24 +24,7 @@ using Eigen::Vector4d;
 using Eigen::VectorXd;
 constexpr double kTol = 1e-10;
 
-mech::Model two_carts(bool hook) {
-  mech::MechanicalModel m;
-  m.M = MatrixXd::Identity(2, 2);
-  m.K.resize(2, 2);
-  m.K << 2, -1, -1, 1;
-  if (hook) {
-    m.E.resize(2, 2);
-    m.E << 1, 0, 1, -1;  // stop x1 >= 0, hook x1 - x2 >= 0 (eq. (3.74))
-  } else {
-    m.E.resize(1, 2);
-    m.E << 1, 0;  // stop x1 >= 0 (eq. (3.1))
-  }
-  mech::fill_defaults(m);
-  mech::Model model;
-  model.name = hook ? "two_carts_hook" : "two_carts";
-  model.mechanical = m;
-  return model;
-}
+mech::Model two_carts(bool hook) { return mech::two_carts_model(hook); }
 
 // A of (3.1) on (x1, x2, x3, x4).
 MatrixXd free_A() {
@@ -185,8 +168,8 @@ TEST(EventDriven, TripleIntegratorReinitialises) {
 
 mech::Model ball(double e) {
   mech::MechanicalModel m;
-  m.M = MatrixXd::Identity(1, 1);
-  m.E = MatrixXd::Identity(1, 1);
+  m.M = MatrixXd::Identity(1, 1).sparseView();
+  m.E = MatrixXd::Identity(1, 1).sparseView();
   m.f = VectorXd::Constant(1, -9.81);
   m.restitution = VectorXd::Constant(1, e);
   mech::fill_defaults(m);
@@ -247,12 +230,12 @@ TEST(EventDriven, RandomModelInvariants) {
         P(i, j) = U(gen);
       }
     mech::MechanicalModel m;
-    m.M = R * R.transpose() + MatrixXd::Identity(N, N);
-    m.K = S * S.transpose();
-    m.D = 0.1 * P * P.transpose();
+    m.M = (R * R.transpose() + MatrixXd::Identity(N, N)).sparseView();
+    m.K = (S * S.transpose()).sparseView();
+    m.D = (0.1 * P * P.transpose()).sparseView();
     m.E.resize(k, N);
     for (int i = 0; i < k; ++i)
-      for (int j = 0; j < N; ++j) m.E(i, j) = U(gen);
+      for (int j = 0; j < N; ++j) m.E.coeffRef(i, j) = U(gen);
     m.g = VectorXd(k);
     for (int i = 0; i < k; ++i) m.g(i) = 0.25 * (U(gen) + 1.0);
     mech::fill_defaults(m);

@@ -19,43 +19,9 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-constexpr double kHookGap = 0.5;
+mech::Model chain(int n, bool hooks) { return mech::chain_model({n, true, hooks, true}); }
 
-mech::Model chain(int n, bool hooks) {
-  mech::MechanicalModel m;
-  m.M = MatrixXd::Identity(n, n);
-  m.K = MatrixXd::Zero(n, n);
-  m.K(0, 0) = 1.0;  // spring from cart 0 to the wall
-  for (int i = 0; i + 1 < n; ++i) {
-    m.K(i, i) += 1.0;
-    m.K(i + 1, i + 1) += 1.0;
-    m.K(i, i + 1) -= 1.0;
-    m.K(i + 1, i) -= 1.0;
-  }
-  const int k = n + (hooks ? n - 1 : 0);
-  m.E = MatrixXd::Zero(k, n);
-  m.g = VectorXd::Ones(k);
-  for (int i = 0; i < n; ++i) m.E(i, i) = 1.0;
-  for (int i = 0; hooks && i + 1 < n; ++i) {
-    m.E(n + i, i) = 1.0;
-    m.E(n + i, i + 1) = -1.0;
-    m.g(n + i) = kHookGap;
-  }
-  mech::fill_defaults(m);
-  mech::Model model;
-  model.name = "chain";
-  model.mechanical = m;
-  return model;
-}
-
-VectorXd chain_start(int n) {
-  VectorXd x(2 * n);
-  for (int i = 0; i < n; ++i) {
-    x(i) = 0.1 * (i % 3);
-    x(n + i) = -1.0;
-  }
-  return x;
-}
+VectorXd chain_start(int n) { return chain(n, false).initial; }
 
 sim::Trajectory run(const mech::Model& model, double t_end, double h, double theta,
                     int sparse_threshold, bool samples = true) {

@@ -172,12 +172,12 @@ TEST(TimeStepping, MoreauJeanEnergyNeverIncreases) {
         P(i, j) = U(gen);
       }
     mech::MechanicalModel m;
-    m.M = R * R.transpose() + MatrixXd::Identity(N, N);
-    m.K = S * S.transpose();
-    m.D = 0.1 * P * P.transpose();
+    m.M = (R * R.transpose() + MatrixXd::Identity(N, N)).sparseView();
+    m.K = (S * S.transpose()).sparseView();
+    m.D = (0.1 * P * P.transpose()).sparseView();
     m.E.resize(k, N);
     for (int i = 0; i < k; ++i)
-      for (int j = 0; j < N; ++j) m.E(i, j) = U(gen);
+      for (int j = 0; j < N; ++j) m.E.coeffRef(i, j) = U(gen);
     m.g = VectorXd(k);
     for (int i = 0; i < k; ++i) m.g(i) = 0.25 * (U(gen) + 1.0);
     mech::fill_defaults(m);

@@ -1,0 +1,81 @@
+#include <stdexcept>
+#include <vector>
+
+#include "mech/mech.hpp"
+
+namespace lcsim::mech {
+
+Model two_carts_model(bool hook) {
+  MechanicalModel m;
+  m.M.resize(2, 2);
+  m.M.setIdentity();
+  const Eigen::Matrix2d K{{2.0, -1.0}, {-1.0, 1.0}};
+  m.K = K.sparseView();
+  const Eigen::MatrixXd E = hook ? Eigen::MatrixXd{{1.0, 0.0}, {1.0, -1.0}}  // stop, hook
+                                 : Eigen::MatrixXd{{1.0, 0.0}};              // stop
+  m.E = E.sparseView();
+  m.coordinates = {"x1", "x2"};
+  m.constraints =
+      hook ? std::vector<std::string>{"stop", "hook"} : std::vector<std::string>{"stop"};
+  fill_defaults(m);
+  Model model;
+  model.name = hook ? "two_carts_hook" : "two_carts";
+  model.source = "generated two carts";
+  model.mechanical = std::move(m);
+  return model;
+}
+
+Model chain_model(const ChainSpec& spec) {
+  const int n = spec.n;
+  if (n < 1) throw std::invalid_argument("chain_model: n must be >= 1");
+  using T = Eigen::Triplet<double>;
+  MechanicalModel m;
+  m.M.resize(n, n);
+  m.M.setIdentity();
+  std::vector<T> k;
+  k.reserve(3 * static_cast<std::size_t>(n));
+  if (spec.wall_spring) k.emplace_back(0, 0, 1.0);
+  for (int i = 0; i + 1 < n; ++i) {  // summed by setFromTriplets
+    k.emplace_back(i, i, 1.0);
+    k.emplace_back(i + 1, i + 1, 1.0);
+    k.emplace_back(i, i + 1, -1.0);
+    k.emplace_back(i + 1, i, -1.0);
+  }
+  m.K.resize(n, n);
+  m.K.setFromTriplets(k.begin(), k.end());
+  m.K.prune(0.0);  // n = 1 without a wall: nothing
+  const int rows = (spec.stops ? n : 0) + (spec.hooks ? n - 1 : 0);
+  std::vector<T> e;
+  m.g.resize(rows);
+  int r = 0;
+  if (spec.stops)
+    for (int i = 0; i < n; ++i, ++r) {
+      e.emplace_back(r, i, 1.0);
+      m.g(r) = 1.0;
+      m.constraints.push_back("stop" + std::to_string(i));
+    }
+  if (spec.hooks)
+    for (int i = 0; i + 1 < n; ++i, ++r) {
+      e.emplace_back(r, i, 1.0);
+      e.emplace_back(r, i + 1, -1.0);
+      m.g(r) = kChainHookGap;
+      m.constraints.push_back("hook" + std::to_string(i));
+    }
+  m.E.resize(rows, n);
+  m.E.setFromTriplets(e.begin(), e.end());
+  fill_defaults(m);
+
+  Model model;
+  model.name = "chain" + std::to_string(n);
+  model.source = "generated chain";
+  model.initial.resize(2 * n);
+  for (int i = 0; i < n; ++i) {
+    model.initial(i) = 0.1 * (i % 3);
+    model.initial(n + i) = -1.0;
+  }
+  model.t_end = 10.0;
+  model.mechanical = std::move(m);
+  return model;
+}
+
+}  // namespace lcsim::mech
