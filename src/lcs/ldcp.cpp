@@ -125,10 +125,12 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
   }
 
   std::vector<RowState> state(k, RowState::kUndecided);
-  std::vector<VectorXd> u;  // u^p for p = first..current, index p - first
+  std::vector<VectorXd> u;          // u^p for p = first..current, index p - first
+  std::vector<int> nonzero_levels;  // the j with u^j != 0 (most levels are zero)
   const int start_lcp = opt.regular_only ? 1 : first;
 
   for (int p = first; p <= last; ++p) {
+    if (p > first && !u.back().isZero(0.0)) nonzero_levels.push_back(p - 1);
     // xi and the scale of its terms.
     VectorXd xi = VectorXd::Zero(k), scale = VectorXd::Zero(k);
     for (int r = 0; r < k; ++r) {
@@ -138,9 +140,8 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
         xi(r) += CAx[m](r);
         scale(r) += CAx_scale[m](r);
       }
-      for (int j = first; j < p; ++j) {
+      for (int j : nonzero_levels) {
         const VectorXd& uj = u[j - first];
-        if (uj.isZero(0.0)) continue;
         const int h = order - j;
         if (h < 0 || h > 3 * n) continue;
         const MatrixXd& Hh = data.markov(h);
