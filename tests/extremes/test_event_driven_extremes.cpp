@@ -163,7 +163,7 @@ TEST_P(SimultaneousImpacts, ChainStopsAtOnce) {
   EXPECT_LE((tr.final_state - rest).cwiseAbs().maxCoeff(), 1e-12);
 }
 
-INSTANTIATE_TEST_SUITE_P(Chains, SimultaneousImpacts, ::testing::Values(10, 100));
+INSTANTIATE_TEST_SUITE_P(Chains, SimultaneousImpacts, ::testing::Values(10, 100, 300));
 
 // N = 1000 is beyond the dense exact method: a clear refusal, not a hang.
 // Too large for the dense methods: refused with the limit and the way out,
