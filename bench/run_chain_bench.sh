@@ -6,6 +6,11 @@
 # out/chain/results.csv (tool, solver, N, window, us_per_step, peak_rss_kb) and
 # out/chain/chain.png (bench/plot_chain.py), and prints the table and ratios.
 #
+# Also the whole command line on the generated file (`lcsim generate chain N
+# --stops`, then `lcsim simulate` with Moreau–Jean for 200 steps): file size,
+# wall time and peak memory of loading and simulating (rows tool = lcsim-cli,
+# window = file: us_per_step is the whole run's wall time / 200).
+#
 # Usage: bench/run_chain_bench.sh [BUILD_DIR]   (default: build)
 #   LCSIM_CHAIN_N="10 100 1000 10000"  lcsim and Bullet sizes
 #   SICONOS_CHAIN_N="10 100"           Siconos sizes (N = 100 with Lemke takes
@@ -57,8 +62,17 @@ for n in $LCSIM_N; do
   /usr/bin/time -v -o "$OUT/time_bullet_$n.txt" "$BUILD/bench/bench_chain" \
     --benchmark_filter="Bullet.*/$n/" --benchmark_format=json >"$OUT/bullet_$n.json"
   gb_rows "$OUT/bullet_$n.json" bullet sequential-impulse "$(peak_kb "$OUT/time_bullet_$n.txt")"
+  echo "lcsim command line N=$n" >&2
+  "$BUILD/lcsim" generate chain "$n" --stops --out "$OUT/chain_$n.yaml"
+  start=$(date +%s.%N)
+  /usr/bin/time -v -o "$OUT/time_cli_$n.txt" "$BUILD/lcsim" simulate "$OUT/chain_$n.yaml" \
+    --method moreau-jean --h 1e-3 --theta 0.5 --t-end 0.2 --json >/dev/null
+  wall=$(/usr/bin/python3 -c "print(f'{$(date +%s.%N) - $start:.3f}')")
+  us=$(/usr/bin/python3 -c "print(f'{$wall * 1e6 / 200:.6g}')")
+  echo "lcsim-cli,moreau-jean,$n,file,$us,$(peak_kb "$OUT/time_cli_$n.txt")" >>"$CSV"
+  echo "  file $(stat -c %s "$OUT/chain_$n.yaml") bytes, ${wall}s, peak $(peak_kb "$OUT/time_cli_$n.txt") kB" >&2
 done
-for n in 10 100 1000; do
+for n in 10 100 300 500 1000; do
   echo "lcsim event-driven N=$n" >&2
   /usr/bin/time -v -o "$OUT/time_event_$n.txt" "$BUILD/bench/bench_chain" \
     --benchmark_filter="EventDriven.*/$n/" --benchmark_format=json >"$OUT/event_$n.json"

@@ -103,7 +103,7 @@ int Model::lcs_state_size() const {
 
 lcs::Lcs Model::as_lcs() const {
   if (lcs_state_size() > kMaxDenseLcsState)
-    throw std::length_error(
+    throw std::invalid_argument(
         "the model's LCS has " + std::to_string(lcs_state_size()) + " states, more than the " +
         std::to_string(kMaxDenseLcsState) +
         " that dense methods take (event-driven, euler, analyze); simulate models this large "

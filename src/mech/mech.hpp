@@ -89,7 +89,7 @@ struct Model {
   // Size of as_lcs(): 2N + 1 for mechanical models (augmented), n for LCS.
   int lcs_state_size() const;
   // The LCS to simulate: to_lcs(mechanical) (augmented) or the LCS itself.
-  // Dense; std::length_error beyond kMaxDenseLcsState (see there).
+  // Dense; std::invalid_argument beyond kMaxDenseLcsState (see there).
   lcs::Lcs as_lcs() const;
 };
 

@@ -49,19 +49,19 @@ struct Trajectory {
   std::vector<Event> events;
   VectorXd final_state;
   double energy_initial = 0.0, energy_final = 0.0;  // mechanical models only
-  double max_violation = 0.0;  // most negative gap over the run (0 if none)
+  double max_violation = 0.0;                       // most negative gap over the run (0 if none)
   long lcp_solves = 0;
-  long steps = 0;              // time-stepping steps, or continuous phases
+  long steps = 0;  // time-stepping steps, or continuous phases
   int warnings = 0;
   std::vector<std::string> warning_messages;  // first few, for the report
   double wall_time_s = 0.0;
 };
 
 struct Options {
-  double t_end = 1.0;   // horizon (s)
-  double dt_out = 0.0;  // output grid (s); 0 = events only (plus start and end)
-  double h = 1e-3;      // time step of time-stepping methods (s)
-  double theta = 0.5;   // Moreau–Jean theta
+  double t_end = 1.0;             // horizon (s)
+  double dt_out = 0.0;            // output grid (s); 0 = events only (plus start and end)
+  double h = 1e-3;                // time step of time-stepping methods (s)
+  double theta = 0.5;             // Moreau–Jean theta
   std::string impact = "moreau";  // impact law name (src/impact)
   std::string lcp_solver = "pivot";
   // Event-driven: extra root tolerance in time (s) and the cap on events per unit
@@ -80,8 +80,8 @@ struct Options {
   // Moreau–Jean, how its linear algebra scales (src/sim/time_stepping.cpp):
   // models with more than `sparse_dofs_threshold` coordinates factor
   // W = M + h theta D + h^2 theta^2 K by sparse LDL'; smaller ones a dense
-  // copy by LLT (the model's matrices are sparse either way). 0 forces the sparse path, a huge value the
-  // dense one (the tests run both on one model).
+  // copy by LLT (the model's matrices are sparse either way). 0 forces the sparse path, a huge
+  // value the dense one (the tests run both on one model).
   int sparse_dofs_threshold = 64;
   // Moreau–Jean: a step's LCP over at most this many active constraints is
   // solved by `lcp_solver` (pivoting, exact); a larger one by projected
@@ -101,11 +101,17 @@ class Integrator {
 std::unique_ptr<Integrator> make_integrator(std::string_view name);
 std::vector<std::string> integrator_names();
 
+// Empty if the initial state x0 (q then v) satisfies E q0 + g >= 0 up to
+// rounding (a gap below -(1e-9 (|E| |q0| + |g|) + 1e-13) counts, the zero test
+// of mode selection); else the message every integrator fails with, naming
+// the first violated constraint and its gap (thesis §3.8: a mechanical state
+// must be admissible). LCS models and wrongly sized x0 give "".
+std::string infeasible_start(const mech::Model& model, const VectorXd& x0);
+
 // Event-driven integration (Algorithm 3.7.1): exact matrix-exponential phases,
 // events as roots of Bohl functions, re-initialisation by the impact law
 // (mechanical models) or by the LDCP and P_I (general LCS).
-Trajectory simulate_event_driven(const mech::Model& model, const VectorXd& x0,
-                                 const Options& opt);
+Trajectory simulate_event_driven(const mech::Model& model, const VectorXd& x0, const Options& opt);
 
 }  // namespace lcsim::sim
 

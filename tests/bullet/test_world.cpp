@@ -153,6 +153,37 @@ TEST(BulletWorld, InexpressibleModelsAreRefusedNamingTheConstraint) {
   EXPECT_THROW(check_expressible(nd), std::invalid_argument);
 }
 
+// The scene's known limits are said, not hidden: an infeasible start is
+// refused as by lcsim's own methods; restitution that Bullet's limits do not
+// reproduce at stop ERP 0.2, and explicit springs past omega h = 2, warn.
+TEST(BulletWorld, InfeasibleStartAndUnreproducibleSettingsAreReported) {
+  mech::Model ball = load("ball.yaml");  // e = 0.5
+  sim::Trajectory tr = bullet_run(ball, Eigen::Vector2d(-0.1, 0.0), 1e-3, 0.0);
+  EXPECT_EQ(tr.status, sim::RunStatus::kFailed);
+  EXPECT_NE(tr.message.find("constraint 'ground' is violated at t = 0 (gap = -0.1)"),
+            std::string::npos)
+      << tr.message;
+
+  tr = bullet_run(ball, ball.initial, 1e-3, 0.0);
+  ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
+  ASSERT_EQ(tr.warning_messages.size(), 1u);
+  EXPECT_NE(tr.warning_messages[0].find("restitution is lost or reduced"), std::string::npos);
+  // What the warning says: no rebound (the ball ends at rest on the ground).
+  EXPECT_LE(std::abs(tr.final_state(1)), 1e-9);
+
+  // omega = sqrt(k) = 1e3 rad/s against h = 1e-2: omega h = 10 > 2.
+  mech::Model stiff = load("two_carts.yaml");
+  stiff.mechanical->K *= 1e6;
+  stiff.t_end = 0.1;
+  tr = bullet_run(stiff, stiff.initial, 1e-2, 0.0);
+  bool said = false;
+  for (const auto& w : tr.warning_messages) said |= w.find("omega h up to") != std::string::npos;
+  EXPECT_TRUE(said) << "no warning about explicit springs";
+  // The safe side stays quiet: omega h <= 2 with the unit springs at 1e-2.
+  tr = bullet_run(load("two_carts.yaml"), load("two_carts.yaml").initial, 1e-2, 0.0);
+  EXPECT_TRUE(tr.warning_messages.empty()) << tr.warning_messages.front();
+}
+
 TEST(BulletWorld, RegisteredAsIntegratorAndSolvers) {
   register_backends();
   EXPECT_EQ(sim::make_integrator("bullet")->name(), "bullet");

@@ -201,6 +201,24 @@ TEST(BadInput, IndefiniteMassMatrix) {
   expect_every_command_rejects(d, s, {"mechanical.M", "not positive definite"});
 }
 
+// A model too large for the dense methods (2N + 1 = 1201 states > 1001):
+// refused with the limit and the way out, exit 2, nothing written; the same
+// file runs with Moreau–Jean.
+TEST(BadInput, ModelTooLargeForDenseMethods) {
+  const fs::path d = fresh_dir();
+  const fs::path f = d / "chain600.yaml";
+  ASSERT_EQ(lcsim(d, "generate chain 600 --stops --out " + quote(f)).exit_code, 0);
+  const CliRun a = lcsim(d, "analyze " + quote(f));
+  expect_rejected(d, a, {"1201 states", "more than the 1001", "--method moreau-jean"});
+  const CliRun e = lcsim(d, "simulate " + quote(f) + " --method euler --h 0.1 --t-end 1 --out " +
+                                quote(d / "out" / "traj.csv"));
+  expect_rejected(d, e, {"1201 states", "more than the 1001"}, 3);
+  const CliRun m =
+      lcsim(d, "simulate " + quote(f) + " --method moreau-jean --h 1e-2 --t-end 0.1 --json");
+  EXPECT_EQ(m.exit_code, 0) << m.err;
+  EXPECT_NE(m.out.find("\"status\": \"completed\""), std::string::npos) << m.out.substr(0, 200);
+}
+
 TEST(BadInput, RestitutionOutsideZeroOne) {
   const fs::path d = fresh_dir();
   const fs::path f =

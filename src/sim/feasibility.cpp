@@ -1,0 +1,26 @@
+#include <sstream>
+
+#include "sim/sim.hpp"
+
+namespace lcsim::sim {
+
+std::string infeasible_start(const mech::Model& model, const VectorXd& x0) {
+  if (!model.is_mechanical()) return "";
+  const mech::MechanicalModel& m = *model.mechanical;
+  if (x0.size() != 2 * m.dofs() || m.num_constraints() == 0) return "";
+  const VectorXd q = x0.head(m.dofs());
+  const VectorXd gap = mech::gaps(m, q);
+  const VectorXd scale = m.E.cwiseAbs() * q.cwiseAbs() + m.g.cwiseAbs();
+  const lcs::LdcpOptions zero_test;  // the zero test of mode selection
+  for (int r = 0; r < m.num_constraints(); ++r) {
+    if (gap(r) >= -(zero_test.tol_rel * scale(r) + zero_test.tol_abs)) continue;
+    std::ostringstream msg;
+    msg.precision(6);
+    msg << "constraint '" << m.constraints[r] << "' is violated at t = 0 (gap = " << gap(r)
+        << "): the state is infeasible, E q + g >= 0 must hold (thesis §3.8)";
+    return msg.str();
+  }
+  return "";
+}
+
+}  // namespace lcsim::sim
