@@ -114,31 +114,9 @@ std::optional<VectorXd> solve_impact_lcp(const MatrixXd& W, const VectorXd& q,
   std::string tried;
   for (const double tol : {1e-12, 1e-10}) {
     opt.tolerance = tol;
-    // A solver's z is accepted on its evidence: Lemke can stop on a ray with
-    // a complementary z already in hand on singular W.
-    const auto accept = [&](lcp::Result r) {
-      if (r.ok() || r.z.size() != n || !r.z.allFinite()) return r;
-      lcp::Result chk = lcp::evaluate(Ws, qs, r.z);
-      const double t = tol * (1.0 + qs.cwiseAbs().maxCoeff());
-      if (chk.residual <= t && chk.min_z >= -t && chk.min_w >= -t) {
-        chk.status = lcp::Status::kSolved;
-        return chk;
-      }
-      return r;
-    };
-    res = accept(solver.solve(Ws, qs, opt));
-    ++out.lcp_solves;
-    tried += (tried.empty() ? "" : ", ") + solver.name();
-    // Enumeration last (k <= 12): near-dependent rows can leave W of low rank
-    // with entries 0.9999...; Lemke and PGS can then stall, enumeration of the
-    // complementary bases cannot.
-    for (const char* fallback : {"lemke", "pgs", "enum"}) {
-      if (res.ok() || solver.name() == fallback) continue;
-      if (std::string(fallback) == "enum" && n > 12) continue;
-      res = accept(lcp::make_solver(fallback)->solve(Ws, qs, opt));
-      ++out.lcp_solves;
-      tried += std::string(", ") + fallback;
-    }
+    int attempts = 0;
+    res = lcp::solve_with_fallbacks(solver, Ws, qs, opt, &attempts, &tried);
+    out.lcp_solves += attempts;
     if (res.ok()) break;
   }
   out.lcp_status = res.status;

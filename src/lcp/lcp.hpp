@@ -105,6 +105,18 @@ class Solver {
 std::unique_ptr<Solver> make_solver(std::string_view name);
 std::vector<std::string> solver_names();
 
+// The LCP solved by `first`, then, while unsolved, by Lemke, PGS and (k <= 12)
+// enumeration, each skipped if it is `first`. A result that is not kSolved is
+// still accepted when its z satisfies the LCP to opt.tolerance (1 + |q|_inf)
+// (Lemke can stop on a ray with a complementary z in hand on a singular M).
+// What impacts, mode selection and time steps do when the configured solver
+// fails: dependent constraints make their matrices PSD, not P, and principal
+// pivoting then stops on a singular block (thesis §4.6.1: the motion is
+// still unique). `attempts` counts the solves, `tried` lists the names.
+Result solve_with_fallbacks(const Solver& first, const MatrixXd& M, const VectorXd& q,
+                            const Options& opt, int* attempts = nullptr,
+                            std::string* tried = nullptr);
+
 }  // namespace lcsim::lcp
 
 // Registration hook for LCP back-ends that live in later layers (the Bullet

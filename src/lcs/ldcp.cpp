@@ -210,16 +210,12 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
       for (size_t i = 0; i < K.size(); ++i)
         if (std::abs(qK(i)) <= opt.tol_rel * (scale(K[i]) + cancelled(i)) + opt.tol_abs)
           qK(i) = 0.0;
-      lcp::Result res = solver->solve(S, qK, lcp::Options{});
-      ++out.lcp_solves;
-      if (!res.ok()) {
-        // Dependent constraints give a PSD, not P, matrix whose LCP Lemke
-        // still solves (q in its range, Lemma 4.6.1); the motion is unique
-        // even where the multipliers are not (Theorem 4.6.5).
-        static const auto lemke = lcp::make_solver("lemke");
-        res = lemke->solve(S, qK, lcp::Options{});
-        ++out.lcp_solves;
-      }
+      // Dependent constraints give a PSD, not P, matrix whose LCP Lemke
+      // still solves (q in its range, Lemma 4.6.1); the motion is unique
+      // even where the multipliers are not (Theorem 4.6.5).
+      int attempts = 0;
+      const lcp::Result res = lcp::solve_with_fallbacks(*solver, S, qK, lcp::Options{}, &attempts);
+      out.lcp_solves += attempts;
       if (!res.ok()) {
         out.message = "LCP at LDCP level " + std::to_string(p) +
                       " failed: " + std::string(lcp::to_string(res.status)) +

@@ -175,6 +175,12 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
     tr.final_state = x0_user;
     return tr;
   }
+  if (const std::string bad = infeasible_start(model, x0_user); !bad.empty()) {
+    tr.status = RunStatus::kFailed;
+    tr.message = "euler: " + bad;
+    tr.final_state = x0_user;
+    return tr;
+  }
   if (mech)
     x << x0_user, 1.0;
   else
@@ -241,8 +247,9 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
     xb.noalias() = f.Phi * x;  // free step (I - hA)^{-1} x_k
     if (k > 0) {
       q.noalias() = sys.C * xb;  // step 4 of Algorithm 7.3.1
-      const lcp::Result r = solver->solve(f.G, q, lopt);
-      ++tr.lcp_solves;
+      int attempts = 0;          // dependent constraints: pivoting fails, Lemke does not
+      const lcp::Result r = lcp::solve_with_fallbacks(*solver, f.G, q, lopt, &attempts);
+      tr.lcp_solves += attempts;
       if (!r.ok())
         return fail("euler: LCP failed at t = " + fmt((j - 1) * grid.h) + " (" +
                         std::string(lcp::to_string(r.status)) + ")" +
@@ -549,6 +556,8 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
   };
   if (const std::string err = check_options(opt, true); !err.empty())
     return fail("moreau-jean: " + err);
+  if (const std::string bad = infeasible_start(model, x0); !bad.empty())
+    return fail("moreau-jean: " + bad);
   std::unique_ptr<lcp::Solver> solver;
   try {
     solver = lcp::make_solver(opt.lcp_solver);
@@ -648,8 +657,9 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
         }
       }
       if (!solved) {
-        const lcp::Result r = solver->solve(MatrixXd(G), b, lopt);
-        ++tr.lcp_solves;
+        int attempts = 0;  // dependent constraints: pivoting fails, Lemke does not
+        const lcp::Result r = lcp::solve_with_fallbacks(*solver, MatrixXd(G), b, lopt, &attempts);
+        tr.lcp_solves += attempts;
         if (!r.ok())
           return fail("moreau-jean: LCP failed at t = " + fmt((j - 1) * grid.h) + " (" +
                       std::string(lcp::to_string(r.status)) + ")" +

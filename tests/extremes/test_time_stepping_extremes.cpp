@@ -437,24 +437,29 @@ TEST(SteppingExtremes, NearlySingularMass) {
   }
 }
 
-// DEFECT (src/sim/time_stepping.cpp, run_moreau_jean and run_euler, the
-// step LCP): with the default lcp_solver "pivot" (principal pivoting, for
-// P-matrices) the dependent rows above fail at t = 0 with "LCP failed at t =
-// 0 (numerical failure): singular principal submatrix of order 2: M is not a
-// P-matrix" for Moreau–Jean theta = 1 and for backward Euler (theta = 1/2
-// happens to pass). The event-driven method falls back to Lemke on a
-// singular Delassus matrix; the time-stepping methods do not. Expected: the
-// single-stop motion (Theorem 4.6.5), as with lcp_solver = "lemke".
+// Dependent rows with the default lcp_solver "pivot" (principal pivoting,
+// for P-matrices): the step's Delassus matrix is singular and pivoting stops
+// on a singular block ("M is not a P-matrix"). Found by helper-12 (Moreau–Jean
+// theta = 1 and backward Euler failed at t = 0); the step now falls back to
+// Lemke, PGS and enumeration (lcp::solve_with_fallbacks) as impacts and mode
+// selection do, and gives the single-stop motion (Theorem 4.6.5): the final
+// state of the single-stop run to 1e-5 (the theta = 1 Lemke difference of
+// 1.4e-6 measured above).
 TEST(SteppingExtremes, DependentConstraintsDefaultSolver) {
-  GTEST_SKIP() << "defect: time-stepping step LCP has no fallback from pivot on a singular "
-                  "Delassus matrix";
   mech::MechanicalModel m;
   m.M = MatrixXd::Identity(2, 2).sparseView();
   m.K = Eigen::Matrix2d{{2, -1}, {-1, 1}}.sparseView();
-  m.E = Eigen::Matrix2d{{1, 0}, {1, 0}}.sparseView();
-  for (const Scheme& s : {kMj05, kMj1, kEuler}) {
-    const auto tr = step(s, wrap(m), Eigen::Vector4d(0, -1, -1, 0), 2.0, 1e-3);
-    EXPECT_EQ(tr.status, sim::RunStatus::kCompleted) << label(s) << ": " << tr.message;
+  mech::MechanicalModel single = m;
+  single.E = Eigen::RowVector2d(1, 0).sparseView();
+  for (const Eigen::Matrix2d& E :
+       {Eigen::Matrix2d{{1, 0}, {1, 0}}, Eigen::Matrix2d{{1, 0}, {2, 0}}}) {
+    m.E = E.sparseView();
+    for (const Scheme& s : {kMj05, kMj1, kEuler}) {
+      const auto tr = step(s, wrap(m), Eigen::Vector4d(0, -1, -1, 0), 2.0, 1e-3);
+      ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << label(s) << ": " << tr.message;
+      const auto ref = step(s, wrap(single), Eigen::Vector4d(0, -1, -1, 0), 2.0, 1e-3);
+      EXPECT_LE(maxabs(tr.final_state - ref.final_state), 1e-5) << label(s) << " E " << E;
+    }
   }
 }
 
@@ -476,16 +481,12 @@ TEST(SteppingExtremes, StepSizeTinyEuler) {
       4 * h);
 }
 
-// An infeasible start (E q0 + g < 0) must be refused naming the constraint
-// and the gap, as the event-driven method does (issue 8 §1, thesis §3.8).
-// DEFECT (src/sim/time_stepping.cpp, run_moreau_jean and run_euler): neither
-// checks E q0 + g >= 0. Moreau–Jean completes with status kCompleted and the
-// ball held 0.1 below the ground for the whole run (the closed constraint is
-// kept at zero rate, max_violation = -0.1, no warning); Euler's
-// position-level LCP closes the gap in one step, i.e. launches the ball at
-// 0.1 / h = 100 m/s (q(1) = 95 m, status kCompleted, no warning).
+// An infeasible start (E q0 + g < 0) is refused naming the constraint and the
+// gap, as the event-driven method does (issue 8 §1, thesis §3.8), through
+// sim::infeasible_start. Before (found by helper-12) Moreau–Jean held the ball
+// 0.1 below the ground for the whole run and Euler's position-level LCP
+// launched it at 0.1 / h = 100 m/s, both with status completed.
 TEST(SteppingExtremes, InfeasibleStartIsRefused) {
-  GTEST_SKIP() << "defect: time-stepping methods accept an infeasible initial state silently";
   mech::MechanicalModel b;
   b.M = MatrixXd::Identity(1, 1).sparseView();
   b.E = MatrixXd::Identity(1, 1).sparseView();
