@@ -16,32 +16,13 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-mech::Model wrap(mech::MechanicalModel m) {
-  mech::fill_defaults(m);
-  mech::Model model;
-  model.mechanical = std::move(m);
-  return model;
-}
+mech::Model wrap(mech::MechanicalModel m) { return mech::model_of(std::move(m), "extreme"); }
 
-// One spring (stiffness k) and one stop at q = -s (unit mass).
 mech::Model spring_stop(double k, double s, double e = 0.0) {
-  mech::MechanicalModel m;
-  m.M = MatrixXd::Identity(1, 1).sparseView();
-  m.K = MatrixXd::Constant(1, 1, k).sparseView();
-  m.E = MatrixXd::Identity(1, 1).sparseView();
-  m.g = VectorXd::Constant(1, s);
-  m.restitution = VectorXd::Constant(1, e);
-  return wrap(m);
+  return mech::spring_stop_model(k, s, e);
 }
 
-mech::Model ball(double e) {
-  mech::MechanicalModel b;
-  b.M = MatrixXd::Identity(1, 1).sparseView();
-  b.E = MatrixXd::Identity(1, 1).sparseView();
-  b.f = VectorXd::Constant(1, -9.81);
-  b.restitution = VectorXd::Constant(1, e);
-  return wrap(b);
-}
+mech::Model ball(double e) { return mech::ball_model(e); }
 
 // The time-stepping methods of the table: Moreau–Jean at theta 1/2 and 1,
 // backward Euler, Bullet.

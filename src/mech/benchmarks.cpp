@@ -5,6 +5,36 @@
 
 namespace lcsim::mech {
 
+Model model_of(MechanicalModel m, const std::string& name) {
+  fill_defaults(m);
+  Model model;
+  model.name = name;
+  model.mechanical = std::move(m);
+  return model;
+}
+
+Model spring_stop_model(double k, double s, double e) {
+  MechanicalModel m;
+  m.M.resize(1, 1);
+  m.M.insert(0, 0) = 1.0;
+  m.K.resize(1, 1);
+  if (k != 0.0) m.K.insert(0, 0) = k;
+  m.E = m.M;
+  m.g = VectorXd::Constant(1, s);
+  m.restitution = VectorXd::Constant(1, e);
+  return model_of(std::move(m), "spring_stop");
+}
+
+Model ball_model(double e, double g) {
+  MechanicalModel m;
+  m.M.resize(1, 1);
+  m.M.insert(0, 0) = 1.0;
+  m.E = m.M;
+  m.f = VectorXd::Constant(1, -g);
+  m.restitution = VectorXd::Constant(1, e);
+  return model_of(std::move(m), "ball");
+}
+
 Model two_carts_model(bool hook) {
   MechanicalModel m;
   m.M.resize(2, 2);

@@ -99,6 +99,16 @@ namespace lcsim::mech {
 
 // Benchmark models built in memory (src/mech/benchmarks.cpp).
 
+// A Model holding `m` (fill_defaults applied) under `name`, no initial state.
+Model model_of(MechanicalModel m, const std::string& name);
+
+// Unit mass on a spring of stiffness k (N/m) with a stop at q = -s (E = 1,
+// g = s), restitution e: the extremes suite's stiff and soft springs.
+Model spring_stop_model(double k, double s, double e = 0.0);
+
+// Unit-mass ball over the ground q >= 0 under gravity g (f = -g), restitution e.
+Model ball_model(double e, double g = 9.81);
+
 // The two carts of thesis §3.7 (Figure 3.1): unit masses, K = [2 -1; -1 1]
 // (a spring from cart 1 to the wall, one between the carts), the stop
 // x1 >= 0 (eq. (3.1)) and, with `hook`, the hook x1 - x2 >= 0 of Example

@@ -20,11 +20,7 @@ using Eigen::VectorXd;
 constexpr double kPi = std::numbers::pi;
 
 mech::Model mechanical(mech::MechanicalModel m, const std::string& name) {
-  mech::fill_defaults(m);
-  mech::Model model;
-  model.name = name;
-  model.mechanical = std::move(m);
-  return model;
+  return mech::model_of(std::move(m), name);
 }
 
 sim::Trajectory run(const mech::Model& model, const VectorXd& x0, double t_end) {

@@ -42,35 +42,13 @@ std::string label(const Scheme& s) {
   return std::string(s.method) + (s.method[0] == 'm' ? " theta " + std::to_string(s.theta) : "");
 }
 
-mech::Model wrap(mech::MechanicalModel m) {
-  mech::fill_defaults(m);
-  mech::Model model;
-  model.name = "extreme";
-  model.mechanical = std::move(m);
-  return model;
-}
+mech::Model wrap(mech::MechanicalModel m) { return mech::model_of(std::move(m), "extreme"); }
 
-// Unit mass on a spring of stiffness k with a stop at q = -s (E = 1, g = s),
-// restitution e.
 mech::Model spring_stop(double k, double s, double e = 0.0) {
-  mech::MechanicalModel m;
-  m.M = MatrixXd::Identity(1, 1).sparseView();
-  m.K = MatrixXd::Constant(1, 1, k).sparseView();
-  m.E = MatrixXd::Identity(1, 1).sparseView();
-  m.g = VectorXd::Constant(1, s);
-  m.restitution = VectorXd::Constant(1, e);
-  return wrap(m);
+  return mech::spring_stop_model(k, s, e);
 }
 
-// Unit-mass ball over the ground q >= 0 under gravity, restitution e.
-mech::Model ball(double e) {
-  mech::MechanicalModel b;
-  b.M = MatrixXd::Identity(1, 1).sparseView();
-  b.E = MatrixXd::Identity(1, 1).sparseView();
-  b.f = VectorXd::Constant(1, -kG);
-  b.restitution = VectorXd::Constant(1, e);
-  return wrap(b);
-}
+mech::Model ball(double e) { return mech::ball_model(e, kG); }
 
 sim::Trajectory step(const Scheme& s, const mech::Model& model, const VectorXd& x0, double T,
                      double h, bool samples = false, const char* lcp_solver = "pivot") {
