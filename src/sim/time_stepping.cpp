@@ -248,7 +248,9 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
     if (k > 0) {
       q.noalias() = sys.C * xb;  // step 4 of Algorithm 7.3.1
       int attempts = 0;          // dependent constraints: pivoting fails, Lemke does not
-      const lcp::Result r = lcp::solve_with_fallbacks(*solver, f.G, q, lopt, &attempts);
+      // Scaled: G = h C (I - hA)^{-1} B is h^2 E M^{-1} E' for a gap, 1e-16 at
+      // h = 1e-8, and an unscaled tolerance would accept any u within 1e4 of it.
+      const lcp::Result r = lcp::solve_scaled(*solver, f.G, q, lopt, &attempts);
       tr.lcp_solves += attempts;
       if (!r.ok())
         return fail("euler: LCP failed at t = " + fmt((j - 1) * grid.h) + " (" +
@@ -299,7 +301,9 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
 //
 // Scaling. Cost per step grows with the coordinates N and the constraints in
 // play, not with the constraints declared, and never cubically in N where M, D,
-// K, E are sparse:
+// K, E are sparse; a step allocates nothing once the active set has been seen
+// (on the 2 x 2 models of the thesis a step takes ~0.1 us, bench/
+// bench_time_stepping.cpp):
 // - One code path over MjOperators (products with D, K, E, which the model
 //   holds sparse) and MjIteration (W^{-1} rhs and the columns W^{-1} E_i').
 //   Models with more than Options::sparse_dofs_threshold coordinates factor W
@@ -312,16 +316,20 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
 //   kPruneRelative times its largest entry (W^{-1} of a banded W decays
 //   geometrically away from the band, so the pruned column is short), and kept
 //   for the run. Each step assembles E_A W^{-1} E_A' over the active set only,
-//   as a sparse matrix, from those columns and the columns of E.
-// - The LCP over A: |A| <= Options::pivot_max_active (default 32) goes to the
-//   pivoting solver Options::lcp_solver on the dense copy (exact, and what the
-//   small models always used); larger sets to projected Gauss–Seidel on the
-//   sparse Delassus matrix, warm-started from the previous step's impulses
-//   (the sets change little between steps, so a few sweeps suffice). lcp::
-//   solve_pgs works on dense matrices only, hence the sparse sweep here. PGS
-//   that does not reach the tolerance falls back to the pivoting solver when
-//   |A| <= kPivotFallbackMax, else the step keeps the PGS iterate and a
-//   warning is counted.
+//   from those columns and the columns of E: dense when |A| <=
+//   Options::pivot_max_active (and then kept while A stays), sparse above.
+// - The LCP over A: |A| <= pivot_max_active (default 32) goes to the pivoting
+//   solver Options::lcp_solver (exact, and what the small models always used).
+//   With the default solver "pivot" the step first tries the previous step's
+//   basis (WarmPivot: the solver's own computation on that basis, accepted by
+//   its own test with a margin), which settles almost every step of a contact
+//   phase without the solver's set-up and gives bitwise its result. Larger
+//   sets go to projected Gauss–Seidel on the sparse Delassus matrix,
+//   warm-started from the previous step's impulses (the sets change little
+//   between steps, so a few sweeps suffice). lcp::solve_pgs works on dense
+//   matrices only, hence the sparse sweep here. PGS that does not reach the
+//   tolerance falls back to the pivoting solver when |A| <= kPivotFallbackMax,
+//   else the step keeps the PGS iterate and a warning is counted.
 
 constexpr double kActivationGap = 0.0;  // predicted gap (model units) at or below which i is active
 constexpr double kPruneRelative = 1e-17;  // columns of W^{-1} E' keep |x| > this * max|x|
@@ -333,27 +341,60 @@ constexpr int kPivotFallbackMax = 2000;
 using SparseCol = Eigen::SparseMatrix<double, Eigen::ColMajor>;
 using SparseRow = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
+// Sparse times dense on compressed matrices, by the loops of Eigen 3.4's
+// sparse_time_dense_product_impl in the same order (so the same rounding: a
+// row sum from 0 in storage order; a column sweep adding A_ij (alpha x_j)),
+// without its per-call set-up (resize, zeroing, evaluators), which costs more
+// than the arithmetic on the 2 x 2 models of the thesis.
+// out = A x, A by rows.
+void times(const SparseRow& A, const VectorXd& x, VectorXd& out) {
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
+  const double* val = A.valuePtr();
+  for (Eigen::Index i = 0; i < A.rows(); ++i) {
+    double s = 0.0;
+    for (int p = outer[i]; p < outer[i + 1]; ++p) s += val[p] * x[inner[p]];
+    out[i] = s;
+  }
+}
+// out += alpha A x, A by columns.
+void add_times(const SparseCol& A, double alpha, const VectorXd& x, VectorXd& out) {
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
+  const double* val = A.valuePtr();
+  for (Eigen::Index j = 0; j < A.cols(); ++j) {
+    const double xj = alpha * x[j];
+    for (int p = outer[j]; p < outer[j + 1]; ++p) out[inner[p]] += val[p] * xj;
+  }
+}
+
 // Products with the model's matrices (held sparse, mech::MechanicalModel).
 // `sparse` chooses how W is factored, nothing else.
 class MjOperators {
  public:
   MjOperators(const mech::MechanicalModel& m, bool sparse)
-      : m_(m), sparse_(sparse), Ec_(m.E), Er_(m.E) {
+      : m_(m), sparse_(sparse), Ec_(m.E), Er_(m.E), K_(m.K), D_(m.D) {
     Ec_.makeCompressed();
     Er_.makeCompressed();
+    K_.makeCompressed();
+    D_.makeCompressed();
   }
   bool sparse() const { return sparse_; }
   int dofs() const { return m_.dofs(); }
   int constraints() const { return m_.num_constraints(); }
   const SparseCol& E_by_columns() const { return Ec_; }
-  // f - D v - K (q + h theta v): the smooth force of the step.
+  // f - D v - K (q + h theta v): the smooth force of the step. No allocation
+  // after the first call (the scratch vector is kept).
   void step_force(const VectorXd& q, const VectorXd& v, double h, double theta,
                   VectorXd& out) const {
-    out = q + (h * theta) * v;
-    out = m_.f - m_.K * out;
-    out.noalias() -= m_.D * v;
+    qt_ = q + (h * theta) * v;
+    out.setZero();
+    add_times(K_, 1.0, qt_, out);  // = K qt
+    out = m_.f - out;
+    add_times(D_, -1.0, v, out);
   }
-  void E_times(const VectorXd& x, VectorXd& out) const { out.noalias() = Er_ * x; }
+  // out = E x (out sized k).
+  void E_times(const VectorXd& x, VectorXd& out) const { times(Er_, x, out); }
   // W = M + h theta D + h^2 theta^2 K.
   SparseCol W_sparse(double h, double theta) const {
     SparseCol W = m_.M + (h * theta) * m_.D + (h * h * theta * theta) * m_.K;
@@ -367,8 +408,10 @@ class MjOperators {
  private:
   const mech::MechanicalModel& m_;
   bool sparse_;
-  SparseCol Ec_;  // E by columns: assembles the active Delassus matrix
-  SparseRow Er_;  // E by rows: the gap rates E v
+  SparseCol Ec_;         // E by columns: assembles the active Delassus matrix
+  SparseRow Er_;         // E by rows: the gap rates E v
+  SparseCol K_, D_;      // compressed copies for add_times
+  mutable VectorXd qt_;  // step_force scratch: q + h theta v
 };
 
 // The factored iteration matrix W for one step length, and the cached columns
@@ -403,6 +446,13 @@ class MjIteration {
   VectorXd solve(const VectorXd& rhs) const {
     if (sparse_) return ldlt_.solve(rhs);
     return llt_.solve(rhs);
+  }
+  // out = W^{-1} rhs into a vector of the right size (no allocation).
+  void solve(const VectorXd& rhs, VectorXd& out) const {
+    if (sparse_)
+      out = ldlt_.solve(rhs);
+    else
+      out = llt_.solve(rhs);
   }
   // W^{-1} E_i' as an N x 1 sparse column; false if not finite.
   bool column(int i, const SparseCol*& out) {
@@ -517,6 +567,87 @@ double sparse_pgs(const SparseRow& G, const VectorXd& b, VectorXd& z, int& sweep
   return z.cwiseMin(w).cwiseAbs().maxCoeff();
 }
 
+// The step's LCP w = G z + b, 0 <= z ⟂ w >= 0, solved by the pivoting solver
+// "pivot" (block principal pivoting: z_J = -G_JJ^{-1} b_J on a basis J, by LLT
+// for symmetric G) warm-started at the previous step's basis: J = the
+// constraints of A with a positive impulse last step. The candidate (z_J from
+// the LLT of G_JJ, zero elsewhere) is accepted when it passes the solver's own
+// acceptance test with a margin, z_J > m, (G z + b)_a > m off J and
+// |(G z + b)_J| <= tol (1 + |b|), with m = kWarmMargin times the solver's
+// pivot tolerance 0.25 tol (1 + |b|); otherwise the solver runs from scratch.
+// With the margin, the solver from scratch ends on the same basis J for any
+// reasonably conditioned G (the LCP solution moves by O(cond(G) tol) under
+// the tolerance's perturbations, far less than m), and on the same basis it
+// computes the same numbers: the same LLT of the same G_JJ and the same
+// solve, so the accepted z is bitwise the solver's (final states bitwise
+// unchanged on the thesis runs and on the 1000-cart chain with hooks). Steps near a change of
+// basis (an impulse or a gap rate within m of zero) go to the solver. The
+// factor of G_JJ is kept while G and J stay (G is kept while A stays).
+constexpr double kWarmMargin = 1e3;
+
+class WarmPivot {
+ public:
+  // z_prev: last step's impulses on A (the warm start); g_version changes
+  // whenever G does. On success z holds the solution.
+  bool solve(const MatrixXd& G, long g_version, const VectorXd& b, const VectorXd& z_prev,
+             double tolerance, VectorXd& z) {
+    const int na = static_cast<int>(b.size());
+    J_.clear();
+    for (int a = 0; a < na; ++a)
+      if (z_prev(a) > 0.0) J_.push_back(a);
+    const int nj = static_cast<int>(J_.size());
+    if (nj > 0) {
+      if (g_version != version_ || J_ != J_factored_) {
+        Gjj_.resize(nj, nj);
+        for (int c = 0; c < nj; ++c)
+          for (int r = 0; r < nj; ++r) Gjj_(r, c) = G(J_[r], J_[c]);
+        llt_.compute(Gjj_);
+        version_ = g_version;
+        J_factored_ = J_;
+      }
+      if (llt_.info() != Eigen::Success) return false;
+      // zj = -G_JJ^{-1} b_J, as the solver computes it (-llt.solve(b_J)).
+      zj_.resize(nj);
+      for (int c = 0; c < nj; ++c) zj_(c) = b(J_[c]);
+      llt_.solveInPlace(zj_);
+      zj_ = -zj_;
+    }
+    // The acceptance test; w = G z + b with z zero off J.
+    const double acc = tolerance * (1.0 + b.lpNorm<Eigen::Infinity>());
+    const double margin = kWarmMargin * 0.25 * acc;
+    for (int c = 0; c < nj; ++c)
+      if (!(zj_(c) > margin)) return false;  // also refuses NaN
+    int next = 0;                            // J_ is sorted
+    for (int a = 0; a < na; ++a) {
+      double w = b(a);
+      for (int c = 0; c < nj; ++c) w += G(a, J_[c]) * zj_(c);
+      if (next < nj && J_[next] == a) {
+        ++next;
+        if (!(std::abs(w) <= acc)) return false;
+      } else if (!(w > margin)) {
+        return false;
+      }
+    }
+    z.setZero(na);
+    for (int c = 0; c < nj; ++c) z(J_[c]) = zj_(c);
+    return true;
+  }
+
+ private:
+  IndexSet J_, J_factored_;
+  long version_ = -1;
+  MatrixXd Gjj_;
+  Eigen::LLT<MatrixXd> llt_;
+  VectorXd zj_;
+};
+
+// x.allFinite() without its two subtractions per entry.
+bool all_finite(const VectorXd& x) {
+  for (Eigen::Index i = 0; i < x.size(); ++i)
+    if (!std::isfinite(x[i])) return false;
+  return true;
+}
+
 Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const Options& opt) {
   const auto wall0 = std::chrono::steady_clock::now();
   Trajectory tr;
@@ -594,18 +725,30 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
 
   const SparseCol& Ec = ops.E_by_columns();
   lcp::Options lopt;
+  // The warm start reproduces the "pivot" solver's own computation (WarmPivot);
+  // other solvers are called on every step.
+  const bool warm_pivot = opt.lcp_solver == "pivot";
+  WarmPivot warm;
   IndexSet A, A_prev, mode, u_set;
   std::vector<int> pos(k, -1);               // position of constraint i in A, or -1
   VectorXd lambda_prev = VectorXd::Zero(k);  // last step's impulses (warm start)
   std::vector<const SparseCol*> cols;
   std::vector<Eigen::Triplet<double>> trip;
-  VectorXd rhs(N), v_free(N), v_next(N), q_next(N), Ev(k), Evf(k), b, z;
+  // The dense Delassus matrix E_A W^{-1} E_A' of an active set of at most
+  // pivot_max_active rows, kept while A and the iteration matrix stay.
+  MatrixXd Gd;
+  IndexSet Gd_A;
+  const MjIteration* Gd_f = nullptr;
+  long Gd_version = 0;
+  // v_next holds the free velocity v + h W^{-1} rhs until the impulses are added.
+  VectorXd rhs(N), dv(N), v_next(N), q_next(N), Ev(k), Evf(k), b, z;
   for (long j = 1; j <= grid.n; ++j) {
     const bool last = j == grid.n;
     const double h = last ? grid.h_last : grid.h;
     MjIteration& f = (last && grid.h_last != grid.h) ? F_last : F;
     ops.step_force(q, v, h, theta, rhs);
-    v_free = v + h * f.solve(rhs);
+    f.solve(rhs, dv);
+    v_next = v + h * dv;  // v_free
     // Active set: predicted gap E_i (q + h theta v) + g_i <= kActivationGap.
     for (int i : A) pos[i] = -1;
     A.clear();
@@ -620,32 +763,58 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     for (int i : u_set) u(i) = 0.0;
     u_set.clear();
     mode.clear();
-    v_next = v_free;
     z.resize(static_cast<Eigen::Index>(A.size()));  // warm start: last step's impulses
     for (size_t a = 0; a < A.size(); ++a) z(static_cast<Eigen::Index>(a)) = lambda_prev(A[a]);
     for (int i : A_prev) lambda_prev(i) = 0.0;  // set again below for this step's A
     A_prev = A;
     if (!A.empty()) {
       const int na = static_cast<int>(A.size());
-      // Delassus matrix E_A W^{-1} E_A' from the cached columns W^{-1} E_a'.
       cols.resize(na);
-      trip.clear();
-      for (int a = 0; a < na; ++a) {
+      for (int a = 0; a < na; ++a)
         if (!f.column(A[a], cols[a]))
           return fail("moreau-jean: iteration matrix too ill-conditioned at h = " + fmt(h));
-        for (SparseCol::InnerIterator it(*cols[a], 0); it; ++it)
-          for (SparseCol::InnerIterator e_it(Ec, static_cast<int>(it.row())); e_it; ++e_it) {
-            const int p = pos[e_it.row()];
-            if (p >= 0) trip.emplace_back(p, a, e_it.value() * it.value());
-          }
-      }
-      SparseRow G(na, na);
-      G.setFromTriplets(trip.begin(), trip.end());
-      ops.E_times(v_free, Evf);
+      ops.E_times(v_next, Evf);  // v_next is still v_free here
       b.resize(na);
       for (int a = 0; a < na; ++a) b(a) = Evf(A[a]) + e(A[a]) * Ev(A[a]);
+      // Delassus matrix E_A W^{-1} E_A' from the cached columns W^{-1} E_a':
+      // entry (p, a) sums E_p,r (W^{-1} E_a')_r over the column's rows r in
+      // this order, dense or sparse alike.
+      auto for_each_entry = [&](auto&& add) {
+        for (int a = 0; a < na; ++a)
+          for (SparseCol::InnerIterator it(*cols[a], 0); it; ++it)
+            for (SparseCol::InnerIterator e_it(Ec, static_cast<int>(it.row())); e_it; ++e_it) {
+              const int p = pos[e_it.row()];
+              if (p >= 0) add(p, a, e_it.value() * it.value());
+            }
+      };
       bool solved = false;
-      if (na > opt.pivot_max_active) {
+      if (na <= opt.pivot_max_active) {
+        if (Gd_f != &f || Gd_A != A) {
+          Gd.setZero(na, na);
+          for_each_entry([&](int p, int a, double x) { Gd(p, a) += x; });
+          Gd_A = A;
+          Gd_f = &f;
+          ++Gd_version;
+        }
+        if (warm_pivot && warm.solve(Gd, Gd_version, b, z, lopt.tolerance, z)) {
+          ++tr.lcp_solves;
+          solved = true;
+        }
+        if (!solved) {
+          int attempts = 0;  // dependent constraints: pivoting fails, Lemke does not
+          const lcp::Result r = lcp::solve_with_fallbacks(*solver, Gd, b, lopt, &attempts);
+          tr.lcp_solves += attempts;
+          if (!r.ok())
+            return fail("moreau-jean: LCP failed at t = " + fmt((j - 1) * grid.h) + " (" +
+                        std::string(lcp::to_string(r.status)) + ")" +
+                        (r.message.empty() ? "" : ": " + r.message));
+          z = r.z;
+        }
+      } else {
+        trip.clear();
+        for_each_entry([&](int p, int a, double x) { trip.emplace_back(p, a, x); });
+        SparseRow G(na, na);
+        G.setFromTriplets(trip.begin(), trip.end());
         int sweeps = 0;
         const double res = sparse_pgs(G, b, z, sweeps);
         ++tr.lcp_solves;
@@ -655,16 +824,16 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
                        std::to_string(sweeps) + " sweeps at t = " + fmt((j - 1) * grid.h));
           solved = z.allFinite();
         }
-      }
-      if (!solved) {
-        int attempts = 0;  // dependent constraints: pivoting fails, Lemke does not
-        const lcp::Result r = lcp::solve_with_fallbacks(*solver, MatrixXd(G), b, lopt, &attempts);
-        tr.lcp_solves += attempts;
-        if (!r.ok())
-          return fail("moreau-jean: LCP failed at t = " + fmt((j - 1) * grid.h) + " (" +
-                      std::string(lcp::to_string(r.status)) + ")" +
-                      (r.message.empty() ? "" : ": " + r.message));
-        z = r.z;
+        if (!solved) {
+          int attempts = 0;
+          const lcp::Result r = lcp::solve_with_fallbacks(*solver, MatrixXd(G), b, lopt, &attempts);
+          tr.lcp_solves += attempts;
+          if (!r.ok())
+            return fail("moreau-jean: LCP failed at t = " + fmt((j - 1) * grid.h) + " (" +
+                        std::string(lcp::to_string(r.status)) + ")" +
+                        (r.message.empty() ? "" : ": " + r.message));
+          z = r.z;
+        }
       }
       for (int a = 0; a < na; ++a) {
         lambda_prev(A[a]) = z(a);
@@ -678,7 +847,7 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
       }
     }
     q_next = q + h * ((1.0 - theta) * v + theta * v_next);
-    if (!q_next.allFinite() || !v_next.allFinite())
+    if (!all_finite(q_next) || !all_finite(v_next))
       return fail("moreau-jean: non-finite state at t = " + fmt(j * grid.h));
     q.swap(q_next);
     v.swap(v_next);
