@@ -34,4 +34,22 @@ Result solve_with_fallbacks(const Solver& first, const MatrixXd& M, const Vector
   return res;
 }
 
+Result solve_scaled(const Solver& first, const MatrixXd& M, const VectorXd& q, const Options& opt,
+                    int* attempts, std::string* tried) {
+  const Eigen::Index n = q.size();
+  VectorXd d(n);
+  for (Eigen::Index i = 0; i < n; ++i) d(i) = M(i, i) > 0.0 ? 1.0 / std::sqrt(M(i, i)) : 1.0;
+  const VectorXd qd = d.cwiseProduct(q);
+  const double s = n && qd.cwiseAbs().maxCoeff() > 0.0 ? qd.cwiseAbs().maxCoeff() : 1.0;
+  const MatrixXd Ms = d.asDiagonal() * M * d.asDiagonal();
+  const Result r = solve_with_fallbacks(first, Ms, qd / s, opt, attempts, tried);
+  if (r.z.size() != n) return r;
+  Result out = evaluate(M, q, s * d.cwiseProduct(r.z));
+  out.status = r.status;
+  out.pivots = r.pivots;
+  out.iterations = r.iterations;
+  out.message = r.message;
+  return out;
+}
+
 }  // namespace lcsim::lcp

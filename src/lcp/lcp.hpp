@@ -117,6 +117,16 @@ Result solve_with_fallbacks(const Solver& first, const MatrixXd& M, const Vector
                             const Options& opt, int* attempts = nullptr,
                             std::string* tried = nullptr);
 
+// solve_with_fallbacks on the diagonally scaled problem
+//   (D M D) z' + D q / s,  D = diag(1 / sqrt(M_ii)) (1 where M_ii <= 0),
+//   s = max |D q| (1 if 0),  z = s D z',
+// so that the acceptance tolerance is relative to the problem's own scale: a
+// step LCP whose matrix is h^2 E M^-1 E' (backward Euler, ~1e-16 at h = 1e-8)
+// otherwise accepts multipliers anywhere within tolerance / 1e-16. The result
+// is unscaled (z, w, residual in the original units).
+Result solve_scaled(const Solver& first, const MatrixXd& M, const VectorXd& q, const Options& opt,
+                    int* attempts = nullptr, std::string* tried = nullptr);
+
 }  // namespace lcsim::lcp
 
 // Registration hook for LCP back-ends that live in later layers (the Bullet
