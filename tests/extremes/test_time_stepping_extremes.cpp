@@ -222,7 +222,7 @@ TEST(SteppingExtremes, MassRatio1e8PlasticHook) {
 // by h/2 at the impact and then turns the mid-phase grazes into small
 // impacts. Bounds: 4 h (theta = 1, Euler), 20 h (theta = 1/2), and at most
 // the amplitude 1 (h = 1: finite and bounded, errors 0.5-0.8). Euler at h =
-// 1e-8 is a separate test (defect).
+// 1e-8 is a separate test (StepSizeTinyEuler, the run that found the scaling defect).
 TEST(SteppingExtremes, StepSizes1e8To1) {
   const auto model = spring_stop(1.0, 0.5);
   const double t1 = 2 * kPi / 3;
@@ -448,7 +448,6 @@ TEST(SteppingExtremes, DependentConstraintsDefaultSolver) {
 // multiplier within 1e4 of the solution. The LCP is now solved diagonally
 // scaled (lcp::solve_scaled). Bound 4 h, as at every other step size.
 TEST(SteppingExtremes, StepSizeTinyEuler) {
-
   const auto model = spring_stop(1.0, 0.5);
   const double t1 = 2 * kPi / 3, h = 1e-8, t0 = t1 - 5000 * h, T = t0 + 1e4 * h;
   const auto tr = step(kEuler, model, Eigen::Vector2d(std::cos(t0), -std::sin(t0)), 1e4 * h, h);
