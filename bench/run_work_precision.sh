@@ -28,15 +28,22 @@
 #   h-list     comma-separated steps (default 1e-2,1e-3,1e-4,1e-5); e.g. 1e-2,1e-3 for a
 #              quick run
 # Environment: LCSIM=path/to/lcsim uses that binary instead of build-dir/lcsim (e.g. one
-# built from a clean checkout while the working tree does not build).
+# built from a clean checkout while the working tree does not build, or a baseline build
+# to compare before/after); PEER=path/to/peer_siconos_wp likewise for the peer.
+# OPENBLAS_NUM_THREADS defaults to 1 here: both programs load OpenBLAS (lcsim through
+# Ipopt, Siconos for its numerics), whose worker thread otherwise spins in sched_yield
+# beside the run, and Siconos's CPU time (all threads of the process) would count it
+# (measured: 3.15 against 2.90 us per step for Siconos on two_carts, h = 1e-5). Each
+# scene's header line records the load average (uptime) at its start.
 set -euo pipefail
+export OPENBLAS_NUM_THREADS=${OPENBLAS_NUM_THREADS:-1}
 cd "$(dirname "$0")/.."
 build=${1:-build-wp}
 repeat=${2:-5}
 hlist=${3:-1e-2,1e-3,1e-4,1e-5}
 t_end=3
 lcsim=${LCSIM:-$build/lcsim}
-peer="$build/bench/peer_siconos_wp"
+peer=${PEER:-$build/bench/peer_siconos_wp}
 for exe in "$lcsim" "$peer"; do
   if [[ ! -x $exe ]]; then
     echo "run_work_precision.sh: $exe not found; build it first:" >&2
@@ -62,7 +69,8 @@ for scene in two_carts hook ball0 ball05; do
     ball0) model=out/ball_e0.yaml ;;
     ball05) model=robots/ball.yaml ;;
   esac
-  echo "== $scene ($model) ==" >&2
+  load=$(cut -d' ' -f1-3 /proc/loadavg)
+  echo "== $scene ($model), load average $load ==" >&2
   # lcsim: the exact event-driven final state, then the sweeps (theta = 1/2 with event and
   # Euler, theta = 1 Moreau–Jean alone).
   "$lcsim" simulate "$model" "${x0[@]}" --t-end "$t_end" --json > "$out/${scene}_lcsim_event.json"
@@ -81,9 +89,9 @@ for scene in two_carts hook ball0 ball05; do
   fi
   "$peer" "$scene" --t-end "$t_end" --h-list "$hlist" --repeats "$repeat" --exact "$exact" \
     --json > "$out/${scene}_siconos.json" 2> "$out/${scene}_siconos.stderr"
-  /usr/bin/python3 - "$scene" "$out" "$exact" "$exact_src" "$model" <<'PY'
+  /usr/bin/python3 - "$scene" "$out" "$exact" "$exact_src" "$model" "$load" "$lcsim" <<'PY'
 import json, math, sys
-scene, out, exact, exact_src, model = sys.argv[1:6]
+scene, out, exact, exact_src, model, load, lcsim_exe = sys.argv[1:8]
 exact = [float(v) for v in exact.split(",")]
 ev_run = json.load(open(f"{out}/{scene}_lcsim_event.json"))
 sweep05 = json.load(open(f"{out}/{scene}_lcsim_theta0.5.json"))
@@ -124,6 +132,7 @@ def fmt(x, f="%.3e"):
 
 print(f"\n== {scene}: {model}, T = 3; exact final state ({exact_src}) = "
       + ", ".join(f"{v:.10g}" for v in exact))
+print(f"   lcsim: {lcsim_exe}; load average at start: {load}")
 print(f"{'tool':8} {'method':12} {'θ/solver':12} {'h':>6} {'err_final':>10} "
       f"{'t/step (s)':>10} {'total (s)':>10} {'steps':>7}")
 for r in rows:
@@ -181,7 +190,8 @@ else:
           f"{fmt(fastest['time_s'])} s (error {fmt(fastest['error_final'])}) -> "
           f"{'event faster by %.0fx' % (fastest['time_s'] / ev['time_s']) if verdict['event_faster'] else 'event NOT faster'}")
 
-json.dump({"model": scene, "model_file": model, "t_end": 3, "exact_final_state": exact,
+json.dump({"model": scene, "model_file": model, "t_end": 3, "load_average": load,
+           "lcsim": lcsim_exe, "exact_final_state": exact,
            "exact_source": exact_src, "rows": rows, "ratios": ratios, "event_vs_1e-4": verdict},
           open(f"{out}/{scene}.json", "w"), indent=1)
 PY
