@@ -26,8 +26,9 @@ struct SimulateArgs {
   std::string lcp = "pivot";
   double h = std::nan("");  // time-stepping step (s); NaN = sim::Options default
   bool h_given = false;
-  double theta = 0.5;  // Moreau–Jean theta
-  bool force = false;  // backward Euler despite the consistency guard
+  double theta = 0.5;    // Moreau–Jean theta
+  bool force = false;    // backward Euler despite the consistency guard
+  bool project = false;  // move an infeasible q0 onto E q + g >= 0 first
 };
 
 std::string fmt_vec(const Eigen::VectorXd& v) {
@@ -53,7 +54,18 @@ void run_simulate(const SimulateArgs& a) {
   (void)impact::make_impact_law(a.impact);
   (void)lcp::make_solver(a.lcp);
 
-  const Eigen::VectorXd x0 = resolve_initial_state(model, a.model, a.x0);
+  Eigen::VectorXd x0 = resolve_initial_state(model, a.model, a.x0);
+  if (a.project && model.is_mechanical() && !sim::infeasible_start(model, x0).empty()) {
+    // Documented in README: positions move to the nearest feasible ones in
+    // the kinetic metric; velocities are kept.
+    const mech::MechanicalModel& m = *model.mechanical;
+    const Eigen::VectorXd q = x0.head(m.dofs());
+    const Eigen::VectorXd p = mech::project_feasible(m, q);
+    const double moved = std::sqrt((p - q).dot(m.M * (p - q)));
+    x0.head(m.dofs()) = p;
+    std::cerr << "lcsim: note: --project moved the initial positions onto E q + g >= 0 "
+              << "(kinetic-metric distance " << moved << ")\n";
+  }
   sim::Options opt;
   opt.t_end = resolve_horizon(model, a.model, a.t_end_given, a.t_end);
   if (!(a.dt_out >= 0.0) || !std::isfinite(a.dt_out))
@@ -110,6 +122,9 @@ void setup(CLI::App& app) {
   cmd->add_option("--method", a->method, "Integrator: event, euler, moreau-jean");
   auto* h = cmd->add_option("--h", a->h, "Time step of euler and moreau-jean (s); default 1e-3");
   cmd->add_option("--theta", a->theta, "Moreau–Jean theta in [0, 1]; default 0.5");
+  cmd->add_flag("--project", a->project,
+                "If the initial state violates a constraint, start from the nearest feasible "
+                "positions (kinetic metric) instead of refusing it");
   cmd->add_flag("--force", a->force,
                 "Run backward Euler even where it is not consistent (rho_i >= 3, §7.3)");
   cmd->add_option("--dt-out", a->dt_out, "Output grid step (s); 0 = events only");

@@ -2,6 +2,7 @@
 
 #include <Eigen/OrderingMethods>
 #include <Eigen/SVD>
+#include <Eigen/SparseCholesky>
 #include <Eigen/SparseQR>
 #include <algorithm>
 #include <stdexcept>
@@ -60,6 +61,47 @@ VectorXd gaps(const MechanicalModel& m, const VectorXd& q) { return m.E * q + m.
 double worst_violation(const MechanicalModel& m, const VectorXd& q) {
   if (m.num_constraints() == 0) return 0.0;
   return std::min(0.0, gaps(m, q).minCoeff());
+}
+
+VectorXd project_feasible(const MechanicalModel& m, const VectorXd& q) {
+  const int k = m.num_constraints();
+  if (k == 0) return q;
+  const Eigen::SimplicialLDLT<SparseMatrix> ldlt(m.M);
+  const SparseMatrix Et = m.E.transpose();
+  const auto violated = [&](const VectorXd& p, std::vector<int>& rows) {
+    const VectorXd y = gaps(m, p);
+    const VectorXd scale = m.E.cwiseAbs() * p.cwiseAbs() + m.g.cwiseAbs();
+    bool added = false;
+    for (int i = 0; i < k; ++i)
+      if (y(i) < -1e-12 * scale(i) && std::find(rows.begin(), rows.end(), i) == rows.end()) {
+        rows.push_back(i);
+        added = true;
+      }
+    return added;
+  };
+  std::vector<int> rows;
+  VectorXd p = q;
+  const auto solver = lcp::make_solver("pivot");
+  for (int round = 0; round <= k && violated(p, rows); ++round) {
+    const auto a = static_cast<Eigen::Index>(rows.size());
+    MatrixXd MinvEt(q.size(), a);  // M^{-1} E_A'
+    VectorXd ya(a);
+    const VectorXd y = gaps(m, q);
+    for (Eigen::Index j = 0; j < a; ++j) {
+      MinvEt.col(j) = ldlt.solve(VectorXd(Et.col(rows[j])));
+      ya(j) = y(rows[j]);
+    }
+    MatrixXd W(a, a);
+    for (Eigen::Index i = 0; i < a; ++i) W.row(i) = (m.E.row(rows[i]) * MinvEt);
+    const lcp::Result r = lcp::solve_scaled(*solver, W, ya, lcp::Options{});
+    if (!r.ok())
+      throw std::invalid_argument(
+          "cannot project the initial state onto E q + g >= 0: the constraints " +
+          std::string("admit no configuration (LCP ") + std::string(lcp::to_string(r.status)) +
+          ")");
+    p = q + MinvEt * r.z;
+  }
+  return p;
 }
 
 int constraint_rank(const MechanicalModel& m) {

@@ -59,6 +59,14 @@ VectorXd gaps(const MechanicalModel& m, const VectorXd& q);  // E q + g
 // Most negative gap (0 if all are >= 0).
 double worst_violation(const MechanicalModel& m, const VectorXd& q);
 
+// The configuration nearest to q in the kinetic metric that satisfies the
+// constraints: argmin ½ (p - q)' M (p - q) subject to E p + g >= 0, i.e.
+// p = q + M^{-1} E' lambda with 0 <= E q + g + E M^{-1} E' lambda ⟂ lambda >= 0
+// (the KKT conditions: an LCP, solved over the rows that are violated, adding
+// rows that the correction violates, at most k rounds). Velocities are the
+// caller's. std::invalid_argument when the constraints admit no such p.
+VectorXd project_feasible(const MechanicalModel& m, const VectorXd& q);
+
 // Rank of E (numerical, lcs::rank_tolerance): by SVD up to 10^6 entries, by
 // a sparse rank-revealing QR of E' above (its threshold the same tolerance
 // with the Frobenius norm for the largest singular value, an upper bound).

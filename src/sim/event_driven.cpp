@@ -886,21 +886,24 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
 }  // namespace
 
 Trajectory simulate_event_driven(const mech::Model& model, const VectorXd& x0, const Options& opt) {
-  // The exact method is dense in the state: matrix exponentials of size n
-  // (2N+1 for N coordinates) cost O(n^3) per evaluation. Refused before any
-  // dense matrix is built.
-  if (model.lcs_state_size() > mech::kMaxDenseLcsState) {
+  const auto refuse = [&](const std::string& why) {
     Trajectory tr;
     tr.method = "event";
     tr.t_end = opt.t_end;
     tr.status = RunStatus::kFailed;
-    tr.message =
-        "the exact event-driven method is dense in the state (matrix exponentials of size " +
-        std::to_string(model.lcs_state_size()) + " > " + std::to_string(mech::kMaxDenseLcsState) +
-        "); use a time-stepping method (--method moreau-jean) for models this large";
+    tr.message = why;
     tr.final_state = x0;
     return tr;
-  }
+  };
+  // The exact method is dense in the state: matrix exponentials of size n
+  // (2N+1 for N coordinates) cost O(n^3) per evaluation. Refused before any
+  // dense matrix is built.
+  if (model.lcs_state_size() > mech::kMaxDenseLcsState)
+    return refuse(
+        "the exact event-driven method is dense in the state (matrix exponentials of size " +
+        std::to_string(model.lcs_state_size()) + " > " + std::to_string(mech::kMaxDenseLcsState) +
+        "); use a time-stepping method (--method moreau-jean) for models this large");
+  if (const std::string bad = infeasible_start(model, x0); !bad.empty()) return refuse(bad);
   EventDriven ed(model, opt);
   return ed.run(x0);
 }

@@ -219,6 +219,30 @@ TEST(BadInput, ModelTooLargeForDenseMethods) {
   EXPECT_NE(m.out.find("\"status\": \"completed\""), std::string::npos) << m.out.substr(0, 200);
 }
 
+// An infeasible start: refused (exit 3, the constraint and its gap, the way
+// out), and with --project started from the nearest feasible positions.
+TEST(BadInput, InfeasibleStartRefusedOrProjected) {
+  const fs::path d = fresh_dir();
+  const fs::path f = write_file(d, "b.yaml",
+                                "mechanical:\n  M: [[1]]\n  E: [[1]]\n  constraints: [floor]\n"
+                                "initial: [-0.1, 0]\nt_end: 1\n");
+  for (const char* method : {"event", "moreau-jean", "euler"}) {
+    SCOPED_TRACE(method);
+    const CliRun r = lcsim(d, "simulate " + quote(f) + " --method " + method + " --h 1e-3 --out " +
+                                  quote(d / "out" / "traj.csv"));
+    EXPECT_EQ(r.exit_code, 3) << r.err;
+    EXPECT_NE(r.err.find("constraint 'floor' is violated at t = 0 (gap = -0.1)"), std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("--project"), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::is_empty(d / "out"));
+    const CliRun p =
+        lcsim(d, "simulate " + quote(f) + " --method " + method + " --h 1e-3 --project --json");
+    EXPECT_EQ(p.exit_code, 0) << p.err;
+    EXPECT_NE(p.err.find("--project moved the initial positions"), std::string::npos) << p.err;
+    EXPECT_NE(p.out.find("\"status\": \"completed\""), std::string::npos);
+  }
+}
+
 TEST(BadInput, RestitutionOutsideZeroOne) {
   const fs::path d = fresh_dir();
   const fs::path f =

@@ -255,6 +255,34 @@ TEST(Extremes, InfeasibleStartIsRefused) {
   EXPECT_EQ(tr.status, sim::RunStatus::kFailed);
   EXPECT_NE(tr.message.find("floor"), std::string::npos) << tr.message;
   EXPECT_NE(tr.message.find("-0.1"), std::string::npos) << tr.message;
+  EXPECT_NE(tr.message.find("--project"), std::string::npos) << tr.message;
+}
+
+// The documented projection (`lcsim simulate --project`): the nearest
+// feasible positions in the kinetic metric, argmin ½ |p - q|_M^2 subject to
+// E p + g >= 0. Closed form with M = diag(1, 4), the stop x1 >= 0 and the hook
+// x1 - x2 >= 0. From q = (-1, 1) both are violated, but only the hook binds
+// at the optimum: p1 = p2 = t minimising ½ (t + 1)^2 + 2 (t - 1)^2, t = 3/5
+// (the heavy cart moves least), and t >= 0 keeps the stop. From q = (-1, -3)
+// only the stop binds: p = (0, -3). Tolerance: a few ulp of the entries.
+TEST(Extremes, ProjectionOntoTheFeasibleSet) {
+  mech::MechanicalModel m;
+  m.M = Eigen::Vector2d(1, 4).asDiagonal().toDenseMatrix().sparseView();
+  m.E = Eigen::Matrix2d{{1, 0}, {1, -1}}.sparseView();
+  mech::fill_defaults(m);
+  const VectorXd p = mech::project_feasible(m, Eigen::Vector2d(-1, 1));
+  EXPECT_LE((p - Eigen::Vector2d(0.6, 0.6)).cwiseAbs().maxCoeff(), 1e-15) << p.transpose();
+  const VectorXd p2 = mech::project_feasible(m, Eigen::Vector2d(-1, -3));
+  EXPECT_LE((p2 - Eigen::Vector2d(0, -3)).cwiseAbs().maxCoeff(), 1e-15) << p2.transpose();
+  // A feasible q is left alone, exactly.
+  EXPECT_EQ(mech::project_feasible(m, Eigen::Vector2d(2, 1)), Eigen::Vector2d(2, 1));
+  // Inconsistent constraints (x1 >= 1 and -x1 >= 0) have nothing to project on.
+  mech::MechanicalModel bad;
+  bad.M = MatrixXd::Identity(1, 1).sparseView();
+  bad.E = Eigen::Vector2d(1, -1).sparseView();
+  bad.g = Eigen::Vector2d(-1, 0);
+  mech::fill_defaults(bad);
+  EXPECT_THROW(mech::project_feasible(bad, VectorXd::Zero(1)), std::invalid_argument);
 }
 
 }  // namespace
