@@ -87,6 +87,12 @@ std::string fmt(double x) {
   return s.str();
 }
 
+// The message of a step whose LCP failed, for both schemes.
+std::string lcp_failure(const char* method, double t, const lcp::Result& r) {
+  return std::string(method) + ": LCP failed at t = " + fmt(t) + " (" +
+         std::string(lcp::to_string(r.status)) + ")" + (r.message.empty() ? "" : ": " + r.message);
+}
+
 // Checks common to both schemes; "" when the options are usable.
 std::string check_options(const Options& opt, bool theta_used) {
   if (!(opt.t_end > 0.0) || !std::isfinite(opt.t_end))
@@ -252,11 +258,7 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
       // h = 1e-8, and an unscaled tolerance would accept any u within 1e4 of it.
       const lcp::Result r = lcp::solve_scaled(*solver, f.G, q, lopt, &attempts);
       tr.lcp_solves += attempts;
-      if (!r.ok())
-        return fail("euler: LCP failed at t = " + fmt((j - 1) * grid.h) + " (" +
-                        std::string(lcp::to_string(r.status)) + ")" +
-                        (r.message.empty() ? "" : ": " + r.message),
-                    x);
+      if (!r.ok()) return fail(lcp_failure("euler", (j - 1) * grid.h, r), x);
       u = r.z;
       x_next.noalias() = xb + f.PhiB * u;  // step 5
     } else {
@@ -742,6 +744,21 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
   long Gd_version = 0;
   // v_next holds the free velocity v + h W^{-1} rhs until the impulses are added.
   VectorXd rhs(N), dv(N), v_next(N), q_next(N), Ev(k), Evf(k), b, z;
+  // The step's LCP G z + b by the configured solver and its fallbacks
+  // (dependent constraints: pivoting fails, Lemke does not); false leaves the
+  // result in `failed`.
+  lcp::Result failed;
+  auto solve_exact = [&](const MatrixXd& G) {
+    int attempts = 0;
+    lcp::Result r = lcp::solve_with_fallbacks(*solver, G, b, lopt, &attempts);
+    tr.lcp_solves += attempts;
+    if (!r.ok()) {
+      failed = std::move(r);
+      return false;
+    }
+    z = r.z;
+    return true;
+  };
   for (long j = 1; j <= grid.n; ++j) {
     const bool last = j == grid.n;
     const double h = last ? grid.h_last : grid.h;
@@ -800,16 +817,8 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
           ++tr.lcp_solves;
           solved = true;
         }
-        if (!solved) {
-          int attempts = 0;  // dependent constraints: pivoting fails, Lemke does not
-          const lcp::Result r = lcp::solve_with_fallbacks(*solver, Gd, b, lopt, &attempts);
-          tr.lcp_solves += attempts;
-          if (!r.ok())
-            return fail("moreau-jean: LCP failed at t = " + fmt((j - 1) * grid.h) + " (" +
-                        std::string(lcp::to_string(r.status)) + ")" +
-                        (r.message.empty() ? "" : ": " + r.message));
-          z = r.z;
-        }
+        if (!solved && !solve_exact(Gd))
+          return fail(lcp_failure("moreau-jean", (j - 1) * grid.h, failed));
       } else {
         trip.clear();
         for_each_entry([&](int p, int a, double x) { trip.emplace_back(p, a, x); });
@@ -824,16 +833,8 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
                        std::to_string(sweeps) + " sweeps at t = " + fmt((j - 1) * grid.h));
           solved = z.allFinite();
         }
-        if (!solved) {
-          int attempts = 0;
-          const lcp::Result r = lcp::solve_with_fallbacks(*solver, MatrixXd(G), b, lopt, &attempts);
-          tr.lcp_solves += attempts;
-          if (!r.ok())
-            return fail("moreau-jean: LCP failed at t = " + fmt((j - 1) * grid.h) + " (" +
-                        std::string(lcp::to_string(r.status)) + ")" +
-                        (r.message.empty() ? "" : ": " + r.message));
-          z = r.z;
-        }
+        if (!solved && !solve_exact(MatrixXd(G)))
+          return fail(lcp_failure("moreau-jean", (j - 1) * grid.h, failed));
       }
       for (int a = 0; a < na; ++a) {
         lambda_prev(A[a]) = z(a);
