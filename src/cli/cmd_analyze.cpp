@@ -5,7 +5,6 @@
 // LCS (Markov parameters (3.32), leading indices and coefficient matrices
 // (3.39), Theorem 3.6.3, passivity §7.2, backward Euler guard §7.3).
 #include <Eigen/Eigenvalues>
-#include <Eigen/SVD>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -65,12 +64,6 @@ nlohmann::json indices_json(const std::vector<int>& v) {
   return a;
 }
 
-long rank(const MatrixXd& X) {
-  if (X.size() == 0) return 0;
-  const Eigen::JacobiSVD<MatrixXd> svd(X);
-  return (svd.singularValues().array() > lcs::rank_tolerance(X)).count();
-}
-
 void run_analyze(const AnalyzeArgs& args) {
   const mech::Model model = io::load_model(args.file);
   const std::vector<std::string> notes = io::model_notes(model);
@@ -88,8 +81,7 @@ void run_analyze(const AnalyzeArgs& args) {
   out << "model:       " << model.name << "  (" << model.source << ")\n";
   if (model.is_mechanical()) {
     const mech::MechanicalModel& m = *model.mechanical;
-    const Eigen::VectorXd ev =
-        Eigen::SelfAdjointEigenSolver<MatrixXd>(m.M.toDense()).eigenvalues();
+    const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<MatrixXd>(m.M.toDense()).eigenvalues();
     const long rank_e = mech::constraint_rank(m);
     j["dofs"] = m.dofs();
     j["coordinates"] = m.coordinates;
@@ -124,11 +116,12 @@ void run_analyze(const AnalyzeArgs& args) {
         << "x = (q, v, 1) of size 2N+1 = " << sys.n() << "\n";
   } else {
     j["lcs_augmented"] = false;
+    const int rank_b = lcs::numerical_rank(sys.B), rank_c = lcs::numerical_rank(sys.C);
     out << "kind:        lcs  x' = A x + B u,  y = C x + D u,  0 <= y _|_ u >= 0\n"
         << "dimensions:  n = " << sys.n() << " states, k = " << sys.k() << " pairs\n"
-        << "rank B:      " << rank(sys.B) << ",  rank C: " << rank(sys.C) << "\n";
-    j["B_rank"] = rank(sys.B);
-    j["C_rank"] = rank(sys.C);
+        << "rank B:      " << rank_b << ",  rank C: " << rank_c << "\n";
+    j["B_rank"] = rank_b;
+    j["C_rank"] = rank_c;
   }
   j["notes"] = notes;
   out << "notes:";

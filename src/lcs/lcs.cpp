@@ -7,11 +7,23 @@
 
 namespace lcsim::lcs {
 
+namespace {
+// max(dim) * 1e-12 * sigma_max (1 for sigma_max = 0), see lcs.hpp.
+double tolerance_for(const MatrixXd& X, double sigma_max) {
+  const double dim = static_cast<double>(std::max(X.rows(), X.cols()));
+  return dim * 1e-12 * (sigma_max > 0.0 ? sigma_max : 1.0);
+}
+}  // namespace
+
 double rank_tolerance(const MatrixXd& X) {
   if (X.size() == 0) return 0.0;
-  const double scale = Eigen::JacobiSVD<MatrixXd>(X).singularValues()(0);
-  const double dim = static_cast<double>(std::max(X.rows(), X.cols()));
-  return dim * 1e-12 * (scale > 0.0 ? scale : 1.0);
+  return tolerance_for(X, Eigen::JacobiSVD<MatrixXd>(X).singularValues()(0));
+}
+
+int numerical_rank(const MatrixXd& X) {
+  if (X.size() == 0) return 0;
+  const VectorXd sv = Eigen::JacobiSVD<MatrixXd>(X).singularValues();
+  return static_cast<int>((sv.array() > tolerance_for(X, sv(0))).count());
 }
 
 std::vector<MatrixXd> markov_parameters(const Lcs& sys, int count) {

@@ -36,6 +36,8 @@ struct Lcs {
 // the largest singular value of the matrix being factored (or 1 if it is 0).
 // The 1e-12 (not eps) leaves room for errors accumulated in products like A^i B.
 double rank_tolerance(const MatrixXd& X);
+// The number of singular values of X above rank_tolerance(X), from one SVD.
+int numerical_rank(const MatrixXd& X);
 
 // H^0 = D, H^i = C A^{i-1} B, i = 1..count-1 (eq. (3.32)).
 std::vector<MatrixXd> markov_parameters(const Lcs& sys, int count);
@@ -139,7 +141,7 @@ struct LdcpOptions {
   // (u = 0 there) and a negative free coefficient is reported (Theorem 3.6.7).
   bool regular_only = false;
   const lcp::Solver* solver = nullptr;  // nullptr = principal pivoting
-  const LdcpData* data = nullptr;        // nullptr = computed here
+  const LdcpData* data = nullptr;       // nullptr = computed here
 };
 ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions& opt = {});
 

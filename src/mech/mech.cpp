@@ -1,7 +1,6 @@
 #include "mech/mech.hpp"
 
 #include <Eigen/OrderingMethods>
-#include <Eigen/SVD>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseQR>
 #include <algorithm>
@@ -69,16 +68,17 @@ VectorXd project_feasible(const MechanicalModel& m, const VectorXd& q) {
   const Eigen::SimplicialLDLT<SparseMatrix> ldlt(m.M);
   const SparseMatrix Et = m.E.transpose();
   const auto violated = [&](const VectorXd& p, std::vector<int>& rows) {
-    const VectorXd y = gaps(m, p);
+    const VectorXd gap = gaps(m, p);
     const VectorXd scale = m.E.cwiseAbs() * p.cwiseAbs() + m.g.cwiseAbs();
     bool added = false;
     for (int i = 0; i < k; ++i)
-      if (y(i) < -1e-12 * scale(i) && std::find(rows.begin(), rows.end(), i) == rows.end()) {
+      if (gap(i) < -1e-12 * scale(i) && std::find(rows.begin(), rows.end(), i) == rows.end()) {
         rows.push_back(i);
         added = true;
       }
     return added;
   };
+  const VectorXd y = gaps(m, q);  // the LCP's constant term, row by row
   std::vector<int> rows;
   VectorXd p = q;
   const auto solver = lcp::make_solver("pivot");
@@ -86,7 +86,6 @@ VectorXd project_feasible(const MechanicalModel& m, const VectorXd& q) {
     const auto a = static_cast<Eigen::Index>(rows.size());
     MatrixXd MinvEt(q.size(), a);  // M^{-1} E_A'
     VectorXd ya(a);
-    const VectorXd y = gaps(m, q);
     for (Eigen::Index j = 0; j < a; ++j) {
       MinvEt.col(j) = ldlt.solve(VectorXd(Et.col(rows[j])));
       ya(j) = y(rows[j]);
@@ -108,9 +107,7 @@ int constraint_rank(const MechanicalModel& m) {
   if (m.E.size() == 0) return 0;
   constexpr double kDenseEntries = 1e6;
   if (static_cast<double>(m.E.rows()) * static_cast<double>(m.E.cols()) <= kDenseEntries) {
-    const MatrixXd E = m.E.toDense();
-    const Eigen::JacobiSVD<MatrixXd> svd(E);
-    return static_cast<int>((svd.singularValues().array() > lcs::rank_tolerance(E)).count());
+    return lcs::numerical_rank(m.E.toDense());
   }
   const SparseMatrix Et = m.E.transpose();
   Eigen::SparseQR<SparseMatrix, Eigen::COLAMDOrdering<int>> qr;
