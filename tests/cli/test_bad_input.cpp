@@ -9,7 +9,6 @@
 //   - leave no output file behind: every run gets a fresh empty folder for
 //     its --out / --plot targets, which must still be empty afterwards.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -19,6 +18,8 @@
 #include <sstream>
 #include <string>
 
+#include "cli_run.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -26,17 +27,8 @@ namespace fs = std::filesystem;
 const std::string kRobots = std::string(LCSIM_SOURCE_DIR) + "/robots/";
 const std::string kTwoCarts = kRobots + "two_carts.yaml";
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using lcsim::cli_test::CliRun;
+using lcsim::cli_test::count_lines;
 
 std::string quote(const fs::path& p) { return "'" + p.string() + "'"; }
 
@@ -51,33 +43,15 @@ fs::path fresh_dir() {
   return d;
 }
 
-// Runs `lcsim <args>`; stdout through the pipe, stderr through a file in `dir`.
+// Runs `lcsim <args>`; stderr through a file in the test's own `dir`.
 CliRun lcsim(const fs::path& dir, const std::string& args) {
-  const fs::path err_file = dir / "stderr.txt";
-  const std::string cmd = std::string("'") + LCSIM_BINARY + "' " + args + " 2> " + quote(err_file);
-  CliRun r;
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) r.out.append(buf, n);
-  const int status = ::pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.err = slurp(err_file);
-  fs::remove(err_file);
-  return r;
+  return lcsim::cli_test::run_lcsim(args, dir / "stderr.txt");
 }
 
 fs::path write_file(const fs::path& dir, const std::string& name, const std::string& text) {
   const fs::path p = dir / name;
   std::ofstream(p) << text;
   return p;
-}
-
-int count_lines(const std::string& s) {
-  int n = 0;
-  for (char c : s) n += c == '\n';
-  return n;
 }
 
 // Exit `code`, one line "lcsim: error: ..." holding every one of `names`, and

@@ -1,7 +1,7 @@
 // The `lcsim lcp` and `lcsim analyze` commands, run as a user would: through
 // the shell, checking exit codes, stdout and the one-line error on stderr.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -10,51 +10,29 @@
 #include <sstream>
 #include <string>
 
+#include "cli_run.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
 
 const std::string kRobots = std::string(LCSIM_SOURCE_DIR) + "/robots/";
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out, err;
-};
+using lcsim::cli_test::CliRun;
+using lcsim::cli_test::count_lines;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-// Runs `lcsim <args>`; stdout through the pipe, stderr through a file.
+// Runs `lcsim <args>`; stderr through a file private to this test process
+// (a shared name raced between tests that ctest runs in parallel).
 CliRun lcsim(const std::string& args) {
-  const fs::path err_file = fs::path(::testing::TempDir()) / "lcsim_cli_stderr.txt";
-  const std::string cmd =
-      std::string("'") + LCSIM_BINARY + "' " + args + " 2> '" + err_file.string() + "'";
-  CliRun r;
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) r.out.append(buf, n);
-  const int status = ::pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.err = slurp(err_file);
-  return r;
+  return lcsim::cli_test::run_lcsim(
+      args,
+      fs::path(::testing::TempDir()) / ("lcsim_cli_stderr_" + std::to_string(::getpid()) + ".txt"));
 }
 
 fs::path write_temp(const std::string& name, const std::string& text) {
   const fs::path p = fs::path(::testing::TempDir()) / name;
   std::ofstream(p) << text;
   return p;
-}
-
-int count_lines(const std::string& s) {
-  int n = 0;
-  for (char c : s) n += c == '\n';
-  return n;
 }
 
 // robots/lcp_example.yaml: M = [[4,1,0],[1,4,1],[0,1,4]], q = (-8,-1,-4).
