@@ -18,7 +18,7 @@
 #include <sstream>
 #include <string>
 
-#include "cli_run.hpp"
+#include "support/run_lcsim.hpp"
 
 namespace {
 

@@ -1,7 +1,6 @@
 // The `lcsim lcp` and `lcsim analyze` commands, run as a user would: through
 // the shell, checking exit codes, stdout and the one-line error on stderr.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -10,7 +9,7 @@
 #include <sstream>
 #include <string>
 
-#include "cli_run.hpp"
+#include "support/run_lcsim.hpp"
 
 namespace {
 
@@ -24,9 +23,8 @@ using lcsim::cli_test::count_lines;
 // Runs `lcsim <args>`; stderr through a file private to this test process
 // (a shared name raced between tests that ctest runs in parallel).
 CliRun lcsim(const std::string& args) {
-  return lcsim::cli_test::run_lcsim(
-      args,
-      fs::path(::testing::TempDir()) / ("lcsim_cli_stderr_" + std::to_string(::getpid()) + ".txt"));
+  return lcsim::cli_test::run_lcsim(args,
+                                    lcsim::cli_test::private_temp("lcsim_cli_stderr", ".txt"));
 }
 
 fs::path write_temp(const std::string& name, const std::string& text) {

@@ -9,7 +9,6 @@
 // O(1) or O(sqrt h) mistake fails. Measured numbers: docs/extremes.md,
 // printed by build/bench/table_extremes.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cmath>
 #include <cstdio>
@@ -23,6 +22,7 @@
 
 #include "io/io.hpp"
 #include "sim/sim.hpp"
+#include "support/run_lcsim.hpp"
 
 namespace lcsim {
 namespace {
@@ -81,27 +81,20 @@ struct BulletRun {
 bool have_lcsim_binary() { return std::filesystem::exists(LCSIM_BINARY); }
 
 BulletRun bullet(mech::Model model, const VectorXd& x0, double T, double h) {
-  namespace fs = std::filesystem;
   model.initial = x0;
   model.t_end = T;
-  const fs::path dir = fs::path(::testing::TempDir());
-  const fs::path file = dir / "extreme_bullet_model.yaml", err = dir / "extreme_bullet_err.txt";
+  const std::filesystem::path file = cli_test::private_temp("extreme_bullet_model", ".yaml");
   std::ofstream(file) << io::model_yaml(model);
-  std::ostringstream cmd;
-  cmd.precision(17);
-  cmd << "'" << LCSIM_BINARY << "' simulate '" << file.string() << "' --method bullet --h " << h
-      << " --json 2> '" << err.string() << "'";
+  std::ostringstream args;
+  args.precision(17);
+  args << "simulate '" << file.string() << "' --method bullet --h " << h << " --json";
+  const cli_test::CliRun run =
+      cli_test::run_lcsim(args.str(), cli_test::private_temp("extreme_bullet_err", ".txt"));
+  std::filesystem::remove(file);
   BulletRun r;
-  FILE* pipe = ::popen(cmd.str().c_str(), "r");
-  if (!pipe) return r;
-  std::string text;
-  char buf[4096];
-  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;) text.append(buf, n);
-  const int status = ::pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream in(err);
-  std::getline(in, r.err, '\0');
-  r.out = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+  r.exit_code = run.exit_code;
+  r.err = run.err;
+  r.out = nlohmann::json::parse(run.out, nullptr, /*allow_exceptions=*/false);
   return r;
 }
 

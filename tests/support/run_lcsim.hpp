@@ -1,8 +1,11 @@
-// Running the lcsim executable (LCSIM_BINARY) from the CLI tests: stdout
-// through a pipe, stderr through a file, the exit code.
+// Running the lcsim executable (LCSIM_BINARY) from tests: stdout through a
+// pipe, stderr through a file, the exit code. Shared by test_cli and
+// test_extremes (Bullet runs through the executable).
 #pragma once
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -28,6 +31,18 @@ inline int count_lines(const std::string& s) {
   int n = 0;
   for (char c : s) n += c == '\n';
   return n;
+}
+
+// A path in the test temp folder private to this test process: ctest runs
+// every test as its own process, in parallel, so a fixed name races (a
+// shared model file made BulletExtremes read another test's model in CI).
+inline std::filesystem::path private_temp(const std::string& stem, const std::string& ext) {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const std::string test = info ? std::string(info->test_suite_name()) + "." + info->name() : "";
+  std::string name = stem + "_" + test + "_" + std::to_string(::getpid()) + ext;
+  for (char& c : name)
+    if (c == '/') c = '_';  // parameterised test names contain '/'
+  return std::filesystem::path(::testing::TempDir()) / name;
 }
 
 // Runs `lcsim <args>` with stderr captured in `err_file`, which is removed
