@@ -187,6 +187,33 @@ void time_stepping_table() {
       }
     }
   }
+  // Nearly dependent constraints: x1 >= 0 and x1 + d (x2 + 1) >= 0, closed
+  // at the §3.7 impact; the exact solution is the single-stop motion.
+  {
+    MatrixXd A(4, 4);
+    A << 0, 0, 1, 0, 0, 0, 0, 1, -2, 1, 0, 0, 1, -1, 0, 0;
+    const VectorXd xT = (A * (2.0 - M_PI / 2)).exp() * Eigen::Vector4d(0, 0, 0, 1);
+    for (double d : {1e-2, 1e-4, 1e-6, 3e-8, 1e-8, 3e-9, 1e-11, 1e-14}) {
+      mech::MechanicalModel m;
+      m.M = MatrixXd::Identity(2, 2).sparseView();
+      m.K = Eigen::Matrix2d{{2, -1}, {-1, 1}}.sparseView();
+      m.E = Eigen::Matrix2d{{1, 0}, {1, d}}.sparseView();
+      m.g = Eigen::Vector2d(0, d);
+      const auto model = wrap(m);
+      sim::Options o;
+      o.t_end = 2.0;
+      const auto ev = sim::simulate_event_driven(model, Eigen::Vector4d(0, -1, -1, 0), o);
+      printf("nearly dependent d=%g event: err=%.1e release_t_err=%.1e viol=%.1e lcp=%ld%s\n", d,
+             maxabs(ev.final_state - xT),
+             ev.events.empty() ? NAN : std::abs(ev.events.back().t - M_PI / 2), ev.max_violation,
+             ev.lcp_solves, diag(ev).c_str());
+      for (const char* meth : kMethods) {
+        const auto tr = step_run(meth, model, Eigen::Vector4d(0, -1, -1, 0), 2.0, 1e-3);
+        printf("nearly dependent d=%g %s: err=%.1e viol=%.1e lcp=%ld%s\n", d, meth,
+               maxabs(tr.final_state - xT), tr.max_violation, tr.lcp_solves, diag(tr).c_str());
+      }
+    }
+  }
   // Nearly singular M (cond 2e8): velocity after the impact vs Moreau's rule.
   {
     const double d = 1e-8;
