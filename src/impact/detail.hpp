@@ -16,6 +16,7 @@ struct Setup {
   MatrixXd W;       // Delassus matrix E_J M^{-1} E_J' (|J| x |J|)
   VectorXd a;       // pre-impact rates E_J v (|J|)
   VectorXd e_J;     // restitution on J (|J|)
+  MatrixXd L;       // Cholesky factor of M (M = L L')
 };
 
 // Validates the input and fills `out` with the no-impact defaults (v_after = v,
@@ -37,5 +38,24 @@ void finish(const ImpactInput& in, const Setup& s, const VectorXd& impulse_J,
 // P). On failure sets out.message and returns nullopt.
 std::optional<VectorXd> solve_impact_lcp(const MatrixXd& W, const VectorXd& q,
                                          const lcp::Solver& solver, ImpactResult& out);
+
+// Refines an impact LCP solution z (impulse on J, post-impact velocity
+// v + M^{-1} E_J' z, rates E_J v+ + e_target∘(E_J v) >= 0 complementary to
+// z; e_target = 0 for Moreau's rule, the restitution for the Moreau–Jean
+// law) on its active set A = {z > 0 or rate within rounding of 0}, without
+// forming W: the M-nearest velocity to v with E_A v+ = -e_A∘(E_A v), from a
+// column-pivoted QR of L^{-1} E_A' (condition cond(E_A); W has its square).
+// Nearly dependent rows (angle d between them) leave W singular to rounding
+// once d^2 < eps, and the LCP may then split the impulse wrongly, moving v+
+// by d; the refinement is exact there. Returns the refined (impulse_J,
+// v_after) when it moves v+ by more than rounding (kRelTol) and is still a
+// solution (impulse >= 0, every closed rate >= 0, to the tolerances of
+// finish); nullopt otherwise (keep z).
+struct Refined {
+  VectorXd impulse_J;
+  VectorXd v_after;
+};
+std::optional<Refined> refine_on_active_set(const Setup& s, const VectorXd& v,
+                                            const VectorXd& e_target, const VectorXd& z);
 
 }  // namespace lcsim::impact::detail

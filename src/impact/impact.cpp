@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -64,7 +65,80 @@ std::optional<Setup> prepare(const ImpactInput& in, ImpactResult& out) {
   s.MinvEt = llt.solve(s.EJ.transpose());
   s.W = s.EJ * s.MinvEt;
   s.a = s.EJ * in.v;
+  s.L = llt.matrixL();
   return s;
+}
+
+std::optional<Refined> refine_on_active_set(const Setup& s, const VectorXd& v,
+                                            const VectorXd& e_target, const VectorXd& z) {
+  const Eigen::Index nj = z.size();
+  const VectorXd c = e_target.cwiseProduct(s.a);
+  const VectorXd v_lcp = v + s.MinvEt * z;
+  const VectorXd rate = s.EJ * v_lcp + c;
+  // Rate scale as in finish; the active-set threshold is the LCP's looser
+  // acceptance (1e-10 relative): a constraint taken into A wrongly moves v+
+  // by at most that, one left out makes the check below reject the result.
+  const VectorXd scale = s.EJ.cwiseAbs() * (v.cwiseAbs() + v_lcp.cwiseAbs()) + c.cwiseAbs();
+  std::vector<Eigen::Index> act;
+  for (Eigen::Index i = 0; i < nj; ++i)
+    if (z(i) > 0.0 || rate(i) <= 1e-10 * scale(i) + kAbsTol) act.push_back(i);
+  if (act.empty()) return std::nullopt;
+  const Eigen::Index na = static_cast<Eigen::Index>(act.size()), N = v.size();
+  MatrixXd Bt(N, na);  // L^{-1} E_A'
+  // c_A = e_A∘(E_A v) split as ebar E_A v + c'_A with ebar the mean
+  // restitution on A: the ebar part is a multiple of the projection of v
+  // (exact for equal restitution), only c' needs the solve with R below.
+  double ebar = 0.0;
+  for (const Eigen::Index i : act) ebar += e_target(i);
+  ebar /= static_cast<double>(act.size());
+  VectorXd cA(na);  // c'_A
+  for (Eigen::Index j = 0; j < na; ++j) {
+    Bt.col(j) = s.EJ.row(act[j]).transpose();
+    cA(j) = (e_target(act[j]) - ebar) * s.a(act[j]);
+  }
+  s.L.triangularView<Eigen::Lower>().solveInPlace(Bt);
+  // y = L' v+, y0 = L' v: minimise |y - y0| subject to B_A y = -c_A =
+  // -ebar B_A y0 - c'_A. With B_A' P = Q R (rank r: dependent rows of E_A are
+  // dropped, their rates follow from the kept ones), y = y0 + Q_r t,
+  // t = -((1 + ebar) Q_r' y0 + R_11^{-T} c'_P): the projection of y0 needs
+  // no solve with R. Impulse: R_11 mu = t on the kept rows.
+  Eigen::ColPivHouseholderQR<MatrixXd> qr(Bt);
+  qr.setThreshold(64 * std::numeric_limits<double>::epsilon());
+  const Eigen::Index r = qr.rank();
+  if (r == 0) return std::nullopt;
+  const auto& perm = qr.colsPermutation().indices();
+  const VectorXd y0 = s.L.transpose() * v;
+  VectorXd cP(r);
+  for (Eigen::Index j = 0; j < r; ++j) cP(j) = cA(perm(j));
+  const auto R11 = qr.matrixR().topLeftCorner(r, r).triangularView<Eigen::Upper>();
+  // Q applied as its Householder reflectors (O(N r)), never formed.
+  const VectorXd Qty0 = (qr.householderQ().transpose() * y0).head(r);
+  const VectorXd t = -((1.0 + ebar) * Qty0 + R11.transpose().solve(cP));
+  VectorXd Qt = VectorXd::Zero(N);
+  Qt.head(r) = t;
+  Qt = qr.householderQ() * Qt;
+  const VectorXd mu = R11.solve(t);
+  Refined out;
+  out.v_after = s.L.transpose().triangularView<Eigen::Upper>().solve(y0 + Qt);
+  // Where the LCP's velocity is the refined one to rounding, keep the LCP's
+  // result: its impulse is the better one when W is well conditioned.
+  const double vscale = v.cwiseAbs().maxCoeff() + out.v_after.cwiseAbs().maxCoeff();
+  if ((v_lcp - out.v_after).cwiseAbs().maxCoeff() <= kRelTol * vscale + kAbsTol)
+    return std::nullopt;
+  out.impulse_J = VectorXd::Zero(nj);
+  for (Eigen::Index j = 0; j < r; ++j) out.impulse_J(act[perm(j)]) = mu(j);
+  // Impulses within rounding of zero are zero (the mode is the support).
+  const double lambda_scale =
+      std::max(out.impulse_J.cwiseAbs().maxCoeff(), z.cwiseAbs().maxCoeff());
+  for (Eigen::Index i = 0; i < nj; ++i)
+    if (std::abs(out.impulse_J(i)) <= kRelTol * lambda_scale) out.impulse_J(i) = 0.0;
+  // Still a solution? Impulse >= 0 and every closed rate >= 0, to the
+  // tolerances of finish.
+  if (out.impulse_J.minCoeff() < -1e-9 * lambda_scale) return std::nullopt;
+  const VectorXd rate_new = s.EJ * out.v_after + c;
+  for (Eigen::Index i = 0; i < nj; ++i)
+    if (rate_new(i) < -(1e-9 * scale(i) + kAbsTol)) return std::nullopt;
+  return out;
 }
 
 void finish(const ImpactInput& in, const Setup& s, const VectorXd& impulse_J,
@@ -139,8 +213,23 @@ ImpactResult moreau_newton(const ImpactInput& in, const lcp::Solver& solver) {
   if (!z) return out;
   // Newton restitution on the inelastic impulse (§8.2.2). The mode is the
   // support of the inelastic impulse: pivoting solvers give exact zeros.
-  const VectorXd scaled = z->cwiseProduct((1.0 + s->e_J.array()).matrix());
-  detail::finish(in, *s, scaled, in.v + s->MinvEt * scaled, 0.0, out);
+  // v+ = w + M^{-1} E_J' (e∘z) with w the inelastic velocity, refined on E
+  // (detail::refine_on_active_set) where that still solves the LCP.
+  VectorXd zi = *z, w = in.v + s->MinvEt * zi;
+  if (const auto ref = detail::refine_on_active_set(*s, in.v, VectorXd::Zero(zi.size()), zi)) {
+    zi = ref->impulse_J;
+    w = ref->v_after;
+  }
+  // M^{-1} E_J' (e∘z) = ebar (w - v) + M^{-1} E_J' ((e - ebar)∘z), ebar the
+  // mean restitution on the support: exact in w when the restitution is equal.
+  double ebar = 0.0;
+  int support = 0;
+  for (Eigen::Index i = 0; i < zi.size(); ++i)
+    if (zi(i) > 0.0) ebar += s->e_J(i), ++support;
+  if (support > 0) ebar /= support;
+  const VectorXd de = (s->e_J.array() - ebar).matrix().cwiseProduct(zi);
+  detail::finish(in, *s, zi + s->e_J.cwiseProduct(zi), w + ebar * (w - in.v) + s->MinvEt * de, 0.0,
+                 out);
   out.ok = true;
   return out;
 }

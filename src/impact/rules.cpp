@@ -18,7 +18,11 @@ ImpactResult moreau_restitution(const ImpactInput& in, const lcp::Solver& solver
   const VectorXd q = (1.0 + s->e_J.array()).matrix().cwiseProduct(s->a);
   const auto z = detail::solve_impact_lcp(s->W, q, solver, out);
   if (!z) return out;
-  detail::finish(in, *s, *z, in.v + s->MinvEt * *z, 0.0, out);
+  // Rates E_J v+ + e∘a >= 0: refined on E where that still solves the LCP.
+  if (const auto ref = detail::refine_on_active_set(*s, in.v, s->e_J, *z))
+    detail::finish(in, *s, ref->impulse_J, ref->v_after, 0.0, out);
+  else
+    detail::finish(in, *s, *z, in.v + s->MinvEt * *z, 0.0, out);
   out.ok = true;
   return out;
 }

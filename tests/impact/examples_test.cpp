@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <stdexcept>
+#include <tuple>
 
 #include "impact/impact.hpp"
 #include "impact_test_util.hpp"
@@ -175,6 +176,36 @@ TEST(ImpactRules, NoClosedContactMeansNoImpact) {
     EXPECT_TRUE(r.ok) << name;
     expect_near(r.v_after, vec({1, 0, 0}), 0.0);
     EXPECT_EQ(r.impulse.size(), 2);
+  }
+}
+
+// Nearly dependent rows: x1 >= 0 and x1 + d x2 >= 0 (angle d), both closed,
+// M = diag(4, 1/100), v = (-1, 0). Moreau's rule gives v+ = (0, 0) with the
+// impulse 4 on the first row: the vertex of the cone, M (v+ - v) = (4, 0) =
+// E'(4, 0). Newton with e = 1/2 on both rows and the Moreau–Jean law with
+// e = 1/2 both give v+ = (1/2, 0), impulse 6. The Delassus matrix [[1/4,
+// 1/4], [1/4, 1/4 + 100 d^2]] rounds to singular once 400 d^2 < eps (d =
+// 1e-8 here): the LCP alone then split the impulse as (0, 4) and left v+ =
+// (0, 400 d) (found by the extremes suite). The rules refine the LCP's
+// answer on E (detail::refine_on_active_set), where the two rows span the
+// plane whatever d: v+ to rounding, 1e-14. The impulse through E' (its
+// first component, the sum of the two) to 1e-12; each one is >= 0.
+TEST(ImpactRules, NearlyDependentRowsGiveTheExactVelocity) {
+  for (double d : {1e-6, 1e-8, 1e-10, 1e-13}) {
+    Eigen::MatrixXd E(2, 2);
+    E << 1, 0, 1, d;
+    const auto m = testing::make_model(Eigen::Vector2d(4, 0.01).asDiagonal().toDenseMatrix(), E);
+    for (const auto& [rule, e, v_after] :
+         {std::tuple{"moreau", 0.0, vec({0, 0})}, std::tuple{"newton", 0.5, vec({0.5, 0})},
+          std::tuple{"moreau-restitution", 0.5, vec({0.5, 0})}}) {
+      SCOPED_TRACE(std::string(rule) + " d " + std::to_string(d));
+      const ImpactResult r = run(rule, input(m, vec({-1, 0}), {0, 1}, vec({e, e})));
+      ASSERT_TRUE(r.ok) << rule << " d " << d << ": " << r.message;
+      expect_near(r.v_after, v_after, 1e-14);
+      EXPECT_NEAR(r.impulse.sum(), 4 * (1 + e), 1e-12) << rule << " d " << d;
+      EXPECT_GE(r.impulse.minCoeff(), 0.0) << rule << " d " << d;
+      EXPECT_TRUE(r.admissible) << rule << " d " << d;
+    }
   }
 }
 
