@@ -18,89 +18,20 @@
 
 #include "io/detail.hpp"
 #include "io/io.hpp"
+#include "io/yaml_read.hpp"
 
 namespace lcsim::io {
 
 namespace {
 
-using Keys = std::map<std::string, YAML::Node>;
-
-[[noreturn]] void fail(const std::string& source, const std::string& key, const std::string& what) {
-  throw InputError(one_line(source + ": " + key + ": " + what));
-}
-
-// What a node holds, for "(got ...)" in messages.
-std::string describe(const YAML::Node& n) {
-  switch (n.Type()) {
-    case YAML::NodeType::Scalar:
-      return "'" + one_line(n.Scalar(), 80) + "'";
-    case YAML::NodeType::Sequence:
-      return "a list of " + std::to_string(n.size()) + " entries";
-    case YAML::NodeType::Map:
-      return "a mapping";
-    case YAML::NodeType::Null:
-      return "nothing";
-    default:
-      return "an undefined value";
-  }
-}
-
-std::string join(const std::vector<std::string>& names) {
-  std::string s;
-  for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
-  return s;
-}
-
-YAML::Node load_yaml(const std::string& text, const std::string& source) {
-  try {
-    return YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    // yaml-cpp marks are 0-based; editors count from 1.
-    throw InputError(one_line(source + ": malformed YAML at line " +
-                              std::to_string(e.mark.line + 1) + ", column " +
-                              std::to_string(e.mark.column + 1) + ": " + e.msg));
-  }
-}
-
-// The entries of a mapping by key; unknown and duplicate keys are errors so
-// that a typo ("restitutoin") never passes silently.
-Keys mapping(const YAML::Node& node, const std::string& source, const std::string& key,
-             const std::vector<std::string>& allowed) {
-  const std::string where = key.empty() ? "top level" : key;
-  if (!node.IsMap()) fail(source, where, "expected a mapping of keys (got " + describe(node) + ")");
-  Keys out;
-  for (const auto& kv : node) {
-    if (!kv.first.IsScalar())
-      fail(source, where, "keys must be plain names (got " + describe(kv.first) + ")");
-    const std::string name = kv.first.Scalar();
-    const std::string full = key.empty() ? name : key + "." + name;
-    if (std::find(allowed.begin(), allowed.end(), name) == allowed.end())
-      fail(source, full, "unknown key (expected one of " + join(allowed) + ")");
-    if (out.count(name)) fail(source, full, "duplicate key");
-    out.emplace(name, kv.second);
-  }
-  return out;
-}
-
-double number(const YAML::Node& n, const std::string& source, const std::string& key) {
-  if (!n.IsScalar()) fail(source, key, "expected a number (got " + describe(n) + ")");
-  double x = 0.0;
-  try {
-    x = n.as<double>();
-  } catch (const YAML::Exception&) {
-    fail(source, key, "not a number (got '" + n.Scalar() + "')");
-  }
-  if (!std::isfinite(x)) fail(source, key, "not finite (got '" + n.Scalar() + "')");
-  return x;
-}
-
-VectorXd vector(const YAML::Node& n, const std::string& source, const std::string& key) {
-  if (!n.IsSequence()) fail(source, key, "expected a list of numbers (got " + describe(n) + ")");
-  VectorXd v(static_cast<Eigen::Index>(n.size()));
-  for (std::size_t i = 0; i < n.size(); ++i)
-    v(static_cast<Eigen::Index>(i)) = number(n[i], source, key + "[" + std::to_string(i) + "]");
-  return v;
-}
+using yaml::describe;
+using yaml::fail;
+using yaml::join;
+using yaml::Keys;
+using yaml::load;
+using yaml::mapping;
+using yaml::number;
+using yaml::vector;
 
 // A list of rows. `cols_if_empty` gives the column count of `[]` (0 rows).
 MatrixXd matrix(const YAML::Node& n, const std::string& source, const std::string& key,
@@ -407,7 +338,7 @@ std::string read_file(const std::filesystem::path& path) {
 }  // namespace
 
 mech::Model parse_model(const std::string& yaml_text, const std::string& source) {
-  const YAML::Node root = load_yaml(yaml_text, source);
+  const YAML::Node root = load(yaml_text, source);
   if (root.IsNull() || !root.IsDefined())
     throw InputError(source +
                      ": empty file (expected `name` and a `mechanical:` or `lcs:` section)");
@@ -491,7 +422,7 @@ std::vector<std::string> model_notes(const mech::Model& model) {
 
 LcpProblem load_lcp(const std::filesystem::path& path) {
   const std::string source = path.string();
-  const YAML::Node root = load_yaml(read_file(path), source);
+  const YAML::Node root = load(read_file(path), source);
   if (root.IsNull() || !root.IsDefined())
     throw InputError(source + ": empty file (expected `M` and `q`)");
   const Keys keys = mapping(root, source, "", {"name", "M", "q"});

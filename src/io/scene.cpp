@@ -22,67 +22,19 @@
 
 #include "io/detail.hpp"
 #include "io/io.hpp"
+#include "io/yaml_read.hpp"
 
 namespace lcsim::io {
 
 namespace {
 
-using Keys = std::map<std::string, YAML::Node>;
-
-[[noreturn]] void fail(const std::string& source, const std::string& key, const std::string& what) {
-  throw InputError(source + ": " + key + ": " + what);
-}
-
-std::string describe(const YAML::Node& n) {
-  switch (n.Type()) {
-    case YAML::NodeType::Scalar:
-      return "'" + n.Scalar() + "'";
-    case YAML::NodeType::Sequence:
-      return "a list of " + std::to_string(n.size()) + " entries";
-    case YAML::NodeType::Map:
-      return "a mapping";
-    case YAML::NodeType::Null:
-      return "nothing";
-    default:
-      return "an undefined value";
-  }
-}
-
-std::string join(const std::vector<std::string>& names) {
-  std::string s;
-  for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
-  return s;
-}
-
-Keys mapping(const YAML::Node& node, const std::string& source, const std::string& key,
-             const std::vector<std::string>& allowed) {
-  const std::string where = key.empty() ? "top level" : key;
-  if (!node.IsMap()) fail(source, where, "expected a mapping of keys (got " + describe(node) + ")");
-  Keys out;
-  for (const auto& kv : node) {
-    if (!kv.first.IsScalar())
-      fail(source, where, "keys must be plain names (got " + describe(kv.first) + ")");
-    const std::string name = kv.first.Scalar();
-    const std::string full = key.empty() ? name : key + "." + name;
-    if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), name) == allowed.end())
-      fail(source, full, "unknown key (expected one of " + join(allowed) + ")");
-    if (out.count(name)) fail(source, full, "duplicate key");
-    out.emplace(name, kv.second);
-  }
-  return out;
-}
-
-double number(const YAML::Node& n, const std::string& source, const std::string& key) {
-  if (!n.IsScalar()) fail(source, key, "expected a number (got " + describe(n) + ")");
-  double x = 0.0;
-  try {
-    x = n.as<double>();
-  } catch (const YAML::Exception&) {
-    fail(source, key, "not a number (got '" + n.Scalar() + "')");
-  }
-  if (!std::isfinite(x)) fail(source, key, "not finite (got '" + n.Scalar() + "')");
-  return x;
-}
+using yaml::describe;
+using yaml::join;
+using yaml::fail;
+using yaml::Keys;
+using yaml::load;
+using yaml::mapping;
+using yaml::number;
 
 std::string name_of(const YAML::Node& n, const std::string& source, const std::string& key) {
   if (!n.IsScalar() || n.Scalar().empty())
@@ -107,13 +59,7 @@ std::map<std::string, double> by_joint(
 }  // namespace
 
 mech::Model parse_scene(const std::string& yaml_text, const std::string& source) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw InputError(source + ": malformed YAML at line " + std::to_string(e.mark.line + 1) +
-                     ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
-  }
+  const YAML::Node root = load(yaml_text, source);
   const Keys keys = mapping(root, source, "",
                             {"name", "urdf", "joints", "q0", "gravity", "springs", "constraints",
                              "restitution", "initial", "t_end"});
