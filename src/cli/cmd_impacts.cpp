@@ -11,7 +11,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -202,22 +201,6 @@ Range parse_range(const std::string& text) {
   return r;
 }
 
-std::filesystem::path find_plot_script() {
-  namespace fs = std::filesystem;
-  if (const char* env = std::getenv("LCSIM_PLOT_IMPACT_MAP")) return env;
-  std::vector<fs::path> roots = {fs::current_path()};
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec)
-    for (fs::path p = exe.parent_path(); !p.empty() && p != p.root_path(); p = p.parent_path())
-      roots.push_back(p);
-  for (const auto& r : roots)
-    if (fs::exists(r / "bench" / "plot_impact_map.py")) return r / "bench" / "plot_impact_map.py";
-  throw std::runtime_error(
-      "bench/plot_impact_map.py not found near the working directory or the lcsim binary "
-      "(set LCSIM_PLOT_IMPACT_MAP)");
-}
-
 void run_map(const ImpactsArgs& a, const mech::Model& model) {
   const mech::MechanicalModel& m = *model.mechanical;
   if (m.dofs() != 2)
@@ -258,8 +241,8 @@ void run_map(const ImpactsArgs& a, const mech::Model& model) {
                                     ("lcsim_impact_map_" + std::to_string(::getpid()) + ".csv");
   io::write_file_atomic(tmp, csv.str());
   try {
-    draw_plot(find_plot_script(), tmp, a.plot, model.name + ": Moreau impact map (Figure 3.5)",
-              "--plot");
+    draw_plot(find_plot_script("plot_impact_map.py", "LCSIM_PLOT_IMPACT_MAP"), tmp, a.plot,
+              model.name + ": Moreau impact map (Figure 3.5)", "--plot");
   } catch (...) {
     std::filesystem::remove(tmp);
     throw;
@@ -275,7 +258,7 @@ void run_impacts(const ImpactsArgs& a) {
   if (!a.plot.empty() && a.map.empty()) throw io::InputError("--plot: only with --map");
   if (!a.plot.empty()) {  // checked before the map is computed, not after
     check_writable(a.plot);
-    (void)find_plot_script();
+    (void)find_plot_script("plot_impact_map.py", "LCSIM_PLOT_IMPACT_MAP");
   }
   if (a.map.empty())
     run_compare(a, model);

@@ -15,7 +15,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -87,23 +86,6 @@ double max_sample_error(const sim::Trajectory& ts, const sim::Trajectory& exact,
   return worst;
 }
 
-std::filesystem::path find_plot_script() {
-  namespace fs = std::filesystem;
-  if (const char* env = std::getenv("LCSIM_PLOT_WORK_PRECISION")) return env;
-  std::vector<fs::path> roots = {fs::current_path()};
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec)
-    for (fs::path p = exe.parent_path(); !p.empty() && p != p.root_path(); p = p.parent_path())
-      roots.push_back(p);
-  for (const auto& r : roots)
-    if (fs::exists(r / "bench" / "plot_work_precision.py"))
-      return r / "bench" / "plot_work_precision.py";
-  throw std::runtime_error(
-      "bench/plot_work_precision.py not found near the working directory or the lcsim binary "
-      "(set LCSIM_PLOT_WORK_PRECISION)");
-}
-
 nlohmann::json rows_json(const std::string& model, const std::vector<Row>& rows) {
   nlohmann::json j;
   j["model"] = model;
@@ -161,7 +143,7 @@ void run_sweep(const SweepArgs& a) {
   std::filesystem::path script;
   if (!a.plot.empty()) {
     check_writable(a.plot);
-    script = find_plot_script();
+    script = find_plot_script("plot_work_precision.py", "LCSIM_PLOT_WORK_PRECISION");
   }
 
   // The exact reference: event-driven, final state and energy change.

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -61,6 +62,21 @@ std::string last_line(const fs::path& log) {
 void check_writable(const std::string& path) {
   const std::string tmp = temp_beside(path);
   ::unlink(tmp.c_str());
+}
+
+fs::path find_plot_script(const std::string& name, const char* env_var) {
+  if (const char* env = std::getenv(env_var)) return env;
+  std::vector<fs::path> roots = {fs::current_path()};
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec)
+    for (fs::path p = exe.parent_path(); !p.empty() && p != p.root_path(); p = p.parent_path())
+      roots.push_back(p);
+  for (const auto& r : roots)
+    if (fs::exists(r / "bench" / name)) return r / "bench" / name;
+  throw std::runtime_error("bench/" + name +
+                           " not found near the working directory or the lcsim binary (set " +
+                           env_var + ")");
 }
 
 void draw_plot(const fs::path& script, const fs::path& input, const std::string& out,

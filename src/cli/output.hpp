@@ -15,6 +15,13 @@ namespace lcsim::cli {
 // a folder. Creates and removes a temporary file to find out.
 void check_writable(const std::string& path);
 
+// The plotting script bench/<name> (a Python file shipped with lcsim): the
+// path in the environment variable `env_var` if set, else the first
+// bench/<name> found in the working directory or a parent folder of the
+// lcsim executable (the build tree sits inside the source tree).
+// std::runtime_error naming both when it is nowhere.
+std::filesystem::path find_plot_script(const std::string& name, const char* env_var);
+
 // Runs `/usr/bin/python3 script input <tmp> --title title` without a shell,
 // where <tmp> is a new file beside `out` with the same extension, then renames
 // <tmp> to `out`. The script's own output goes to a log that is dropped on
