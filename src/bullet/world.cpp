@@ -135,11 +135,6 @@ std::vector<Limit> limits_of(const mech::Model& model, double range) {
   return out;
 }
 
-void warn(sim::Trajectory& tr, const std::string& w) {
-  ++tr.warnings;
-  if (tr.warning_messages.size() < 10) tr.warning_messages.push_back(w);
-}
-
 // The Bullet world; members in construction order so that destruction runs
 // constraints -> bodies -> world -> solver -> ... .
 struct World {
@@ -235,22 +230,6 @@ std::unique_ptr<World> build(const mech::MechanicalModel& m, const std::vector<L
   return w;
 }
 
-// Output sampling, as in src/sim/time_stepping.cpp.
-class Sampler {
- public:
-  explicit Sampler(double dt_out) : dt_out_(dt_out), next_(dt_out) {}
-  bool want(double t, double h, bool last) {
-    if (last || dt_out_ <= 0.0) return true;
-    if (t < next_ - 1e-9 * h) return false;
-    while (next_ <= t + 1e-9 * h) next_ += dt_out_;
-    return true;
-  }
-
- private:
-  double dt_out_;
-  double next_;
-};
-
 }  // namespace
 
 std::string solver_description(const WorldSettings& s) {
@@ -285,17 +264,15 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
   if (x0.size() != 2 * N)
     return fail("bullet: initial state has " + std::to_string(x0.size()) +
                 " entries, the model needs " + std::to_string(2 * N));
-  if (!(opt.t_end > 0.0) || !std::isfinite(opt.t_end))
-    return fail("bullet: t_end must be a finite number > 0 (got " + fmt(opt.t_end) + ")");
-  if (!(opt.h > 0.0) || !std::isfinite(opt.h) || opt.t_end / opt.h > 1e9)
-    return fail("bullet: step h must be finite, > 0 and give at most 1e9 steps (got " + fmt(opt.h) +
-                ")");
+  if (const std::string bad = sim::check_step_options(opt, false); !bad.empty())
+    return fail("bullet: " + bad);
   if (const std::string bad = sim::infeasible_start(model, x0); !bad.empty())
     return fail("bullet: " + bad);
   VectorXd q = x0.head(N), v = x0.tail(N);
   tr.energy_initial = mech::total_energy(m, q, v);
   if (m.D.norm() > 0.0)
-    warn(tr, "bullet: dampers are explicit forces -D v (stable only for h small against M/D)");
+    tr.add_warning(
+        "bullet: dampers are explicit forces -D v (stable only for h small against M/D)");
   // Springs are explicit forces too (symplectic Euler): stable for omega h <= 2
   // with omega the fastest frequency, bounded here by Gershgorin on M^-1 K
   // (M is diagonal in this scene).
@@ -307,9 +284,10 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
       w2 = std::max(w2, row / m.M.coeff(j, j));  // K symmetric: column sums = row sums
     }
     if (std::sqrt(w2) * opt.h > 2.0)
-      warn(tr, "bullet: springs are explicit forces -K q, unstable for omega h > 2: omega <= " +
-                   fmt(std::sqrt(w2)) + " rad/s gives omega h up to " + fmt(std::sqrt(w2) * opt.h) +
-                   " at h = " + fmt(opt.h) + "; expect growth, or reduce h");
+      tr.add_warning(
+          "bullet: springs are explicit forces -K q, unstable for omega h > 2: omega <= " +
+          fmt(std::sqrt(w2)) + " rad/s gives omega h up to " + fmt(std::sqrt(w2) * opt.h) +
+          " at h = " + fmt(opt.h) + "; expect growth, or reduce h");
   }
   // Measured (a ball dropped on a 6DOF2 lower limit, e = 0.5, h = 1e-3,
   // Bullet 3.24 from Debian): no rebound at the pinned stop ERP 0.2 (nor at
@@ -317,27 +295,18 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
   // lcsim keeps ERP 0.2 (what the comparisons were measured with) and says so.
   for (int i = 0; i < k; ++i)
     if (m.restitution(i) > 0.0 && s.stop_erp < 1.0) {
-      warn(tr,
-           "bullet: restitution is lost or reduced: Bullet 3.24 applies a limit's bounce "
-           "only near stop ERP 1 (this scene uses " +
-               fmt(s.stop_erp) + "; at 0.2 nothing rebounds); constraint '" + m.constraints[i] +
-               "' has e = " + fmt(m.restitution(i)));
+      tr.add_warning(
+          "bullet: restitution is lost or reduced: Bullet 3.24 applies a limit's bounce "
+          "only near stop ERP 1 (this scene uses " +
+          fmt(s.stop_erp) + "; at 0.2 nothing rebounds); constraint '" + m.constraints[i] +
+          "' has e = " + fmt(m.restitution(i)));
       break;
     }
 
-  // Grid as the time-stepping methods: n steps of h, the last shortened.
-  long n;
-  double h_last;
-  {
-    const double r = opt.t_end / opt.h, rn = std::round(r);
-    if (rn >= 1.0 && std::abs(r - rn) <= 1e-9 * rn) {
-      n = static_cast<long>(rn);
-      h_last = opt.h;
-    } else {
-      n = static_cast<long>(std::floor(r)) + 1;
-      h_last = opt.t_end - std::floor(r) * opt.h;
-    }
-  }
+  // The grid of the time-stepping methods: n steps of h, the last shortened.
+  const sim::StepGrid grid = sim::StepGrid::of(opt.t_end, opt.h);
+  const long n = grid.n;
+  const double h_last = grid.h_last;
 
   std::unique_ptr<World> w = build(m, limits, q, v, s);
   // Multipliers from the momentum balance M (v+ - v) = h F + E' (h u):
@@ -357,7 +326,7 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
 
   VectorXd y = m.E * q + m.g;
   if (k > 0) tr.max_violation = std::min(0.0, y.minCoeff());
-  Sampler sampler(opt.dt_out);
+  sim::OutputSampler sampler(opt.dt_out);
   auto record = [&](double t, const VectorXd& u, const sim::IndexSet& mode) {
     if (!opt.record_samples) return;
     sim::Sample smp;

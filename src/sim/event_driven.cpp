@@ -288,10 +288,6 @@ class EventDriven {
     if (!model_.is_mechanical()) return 0.0;
     return mech::total_energy(*model_.mechanical, xa.head(N_), xa.segment(N_, N_));
   }
-  void warn(Trajectory& tr, const std::string& w) const {
-    ++tr.warnings;
-    if (tr.warning_messages.size() < 10) tr.warning_messages.push_back(w);
-  }
 
   const mech::Model& model_;
   const Options& opt_;
@@ -579,7 +575,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
   // Initial mode selection (and jump, if the initial state is not regular).
   EventResult ev = process_event(t, xa);
   tr.lcp_solves += ev.lcp_solves;
-  for (const auto& w : ev.warnings) warn(tr, w);
+  for (const auto& w : ev.warnings) tr.add_warning(w);
   std::string err;
   Phase phase;
   if (!ev.ok) {
@@ -831,7 +827,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     }
     ev = process_event(t, x_minus);
     tr.lcp_solves += ev.lcp_solves;
-    for (const auto& w : ev.warnings) warn(tr, w);
+    for (const auto& w : ev.warnings) tr.add_warning(w);
     if (!ev.ok) {
       fail(ev.message);
       xa = x_minus;

@@ -55,6 +55,9 @@ struct Trajectory {
   int warnings = 0;
   std::vector<std::string> warning_messages;  // first few, for the report
   double wall_time_s = 0.0;
+  // Counts a warning; keeps the text of the first kMaxWarningMessages.
+  void add_warning(std::string w);
+  static constexpr std::size_t kMaxWarningMessages = 10;
 };
 
 struct Options {
@@ -107,6 +110,30 @@ std::vector<std::string> integrator_names();
 // the first violated constraint and its gap (thesis §3.8: a mechanical state
 // must be admissible). LCS models and wrongly sized x0 give "".
 std::string infeasible_start(const mech::Model& model, const VectorXd& x0);
+
+// What every time-stepping method shares (Moreau–Jean, backward Euler, and
+// the Bullet scene in src/bullet):
+// - the step grid: n steps of h, the last shortened so that t_n = t_end
+//   (h "divides" t_end when t_end / h is an integer to 1e-9 relative);
+// - the output sampler on the grid dt_out (every step when dt_out = 0);
+// - the checks of t_end, h and (when used) theta: "" when usable.
+struct StepGrid {
+  long n = 0;
+  double h = 0.0;
+  double h_last = 0.0;
+  static StepGrid of(double t_end, double h);
+};
+class OutputSampler {
+ public:
+  explicit OutputSampler(double dt_out) : dt_out_(dt_out), next_(dt_out) {}
+  // True if the state at step time t (steps of h) is to be recorded.
+  bool want(double t, double h, bool last);
+
+ private:
+  double dt_out_;
+  double next_;
+};
+std::string check_step_options(const Options& opt, bool theta_used);
 
 // Event-driven integration (Algorithm 3.7.1): exact matrix-exponential phases,
 // events as roots of Bohl functions, re-initialisation by the impact law

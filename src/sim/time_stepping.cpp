@@ -30,56 +30,6 @@ namespace {
 
 using Eigen::MatrixXd;
 
-// The step grid: n steps, all of length h except possibly the last.
-struct Grid {
-  long n = 0;
-  double h = 0.0;
-  double h_last = 0.0;
-  double time(long j) const {  // t_j, with t_n = t_end exactly
-    return j * h;
-  }
-};
-
-Grid make_grid(double t_end, double h) {
-  Grid g;
-  g.h = h;
-  const double r = t_end / h;
-  const double rn = std::round(r);
-  // h "divides" t_end when t_end / h is an integer up to rounding of the quotient.
-  if (rn >= 1.0 && std::abs(r - rn) <= 1e-9 * rn) {
-    g.n = static_cast<long>(rn);
-    g.h_last = h;
-  } else {
-    const double nf = std::floor(r);
-    g.n = static_cast<long>(nf) + 1;
-    g.h_last = t_end - nf * h;
-  }
-  return g;
-}
-
-// Output sampling shared by both schemes.
-class Sampler {
- public:
-  explicit Sampler(double dt_out) : dt_out_(dt_out) {}
-  // True if the state at step time t (with step h) should be recorded.
-  bool want(double t, double h, bool last) {
-    if (last || dt_out_ <= 0.0) return true;
-    if (t < next_ - 1e-9 * h) return false;
-    while (next_ <= t + 1e-9 * h) next_ += dt_out_;
-    return true;
-  }
-  void start() { next_ = dt_out_; }
-
- private:
-  double dt_out_;
-  double next_ = 0.0;
-};
-
-void warn(Trajectory& tr, const std::string& w) {
-  ++tr.warnings;
-  if (tr.warning_messages.size() < 10) tr.warning_messages.push_back(w);
-}
-
 std::string fmt(double x) {
   std::ostringstream s;
   s.precision(6);
@@ -91,19 +41,6 @@ std::string fmt(double x) {
 std::string lcp_failure(const char* method, double t, const lcp::Result& r) {
   return std::string(method) + ": LCP failed at t = " + fmt(t) + " (" +
          std::string(lcp::to_string(r.status)) + ")" + (r.message.empty() ? "" : ": " + r.message);
-}
-
-// Checks common to both schemes; "" when the options are usable.
-std::string check_options(const Options& opt, bool theta_used) {
-  if (!(opt.t_end > 0.0) || !std::isfinite(opt.t_end))
-    return "t_end must be a finite number > 0 (got " + fmt(opt.t_end) + ")";
-  if (!(opt.h > 0.0) || !std::isfinite(opt.h))
-    return "step h must be a finite number > 0 (got " + fmt(opt.h) + ")";
-  if (opt.t_end / opt.h > 1e9)
-    return "t_end / h = " + fmt(opt.t_end / opt.h) + " steps is more than 1e9";
-  if (theta_used && !(opt.theta >= 0.0 && opt.theta <= 1.0))
-    return "theta must lie in [0, 1] (got " + fmt(opt.theta) + ")";
-  return "";
 }
 
 // ---------------------------------------------------------------------------
@@ -192,7 +129,7 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
   else
     x = x0_user;
   tr.energy_initial = energy(x);
-  if (const std::string err = check_options(opt, false); !err.empty())
+  if (const std::string err = check_step_options(opt, false); !err.empty())
     return fail("euler: " + err, x);
 
   // Consistency guard (§7.3, Example 7.3.3): with a leading row index
@@ -209,16 +146,16 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
         if (!opt.force)
           return fail(
               "euler: refused: " + msg + "; set Options::force (lcsim --force) to run anyway", x);
-        warn(tr, "forced despite " + msg);
+        tr.add_warning("forced despite " + msg);
         break;
       }
     }
   }
   if (mech && model.mechanical->restitution.size() > 0 &&
       model.mechanical->restitution.maxCoeff() > 0.0)
-    warn(tr, "backward Euler ignores restitution: every impact is inelastic");
+    tr.add_warning("backward Euler ignores restitution: every impact is inelastic");
 
-  const Grid grid = make_grid(opt.t_end, opt.h);
+  const StepGrid grid = StepGrid::of(opt.t_end, opt.h);
   EulerFactors F = euler_factors(sys, grid.h);
   if (!F.ok) return fail("euler: " + F.message, x);
   EulerFactors F_last;
@@ -227,8 +164,7 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
     if (!F_last.ok) return fail("euler: last step: " + F_last.message, x);
   }
 
-  Sampler sampler(opt.dt_out);
-  sampler.start();
+  OutputSampler sampler(opt.dt_out);
   VectorXd u = VectorXd::Zero(k);
   auto record = [&](double t, const VectorXd& xa, const VectorXd& uu) {
     const VectorXd y = sys.C * xa + sys.D * uu;
@@ -267,7 +203,7 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
     if (!x_next.allFinite()) return fail("euler: non-finite state at t = " + fmt(j * grid.h), x);
     x = x_next;
     ++tr.steps;
-    const double t = last ? opt.t_end : grid.time(j);
+    const double t = last ? opt.t_end : j * grid.h;
     if (sampler.want(t, grid.h, last)) {
       record(t, x, u);  // also updates max_violation
     } else if (k > 0) {
@@ -687,7 +623,7 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     tr.message = msg;
     return finish();
   };
-  if (const std::string err = check_options(opt, true); !err.empty())
+  if (const std::string err = check_step_options(opt, true); !err.empty())
     return fail("moreau-jean: " + err);
   if (const std::string bad = infeasible_start(model, x0); !bad.empty())
     return fail("moreau-jean: " + bad);
@@ -698,15 +634,14 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     return fail(std::string("moreau-jean: ") + e.what());
   }
   const double theta = opt.theta;
-  const Grid grid = make_grid(opt.t_end, opt.h);
+  const StepGrid grid = StepGrid::of(opt.t_end, opt.h);
   MjIteration F, F_last;
   if (!F.factor(ops, grid.h, theta)) return fail("moreau-jean: " + F.message());
   if (grid.h_last != grid.h && !F_last.factor(ops, grid.h_last, theta))
     return fail("moreau-jean: last step: " + F_last.message());
   const VectorXd e = m.restitution.size() == k ? m.restitution : VectorXd::Zero(k);
 
-  Sampler sampler(opt.dt_out);
-  sampler.start();
+  OutputSampler sampler(opt.dt_out);
   auto record = [&](double t, const VectorXd& y, const VectorXd& uu, const IndexSet& mode) {
     if (!opt.record_samples) return;
     Sample s;
@@ -829,8 +764,8 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
         ++tr.lcp_solves;
         solved = res <= kPgsTolerance * (1.0 + b.lpNorm<Eigen::Infinity>()) && z.allFinite();
         if (!solved && na > kPivotFallbackMax) {
-          warn(tr, "moreau-jean: PGS stopped at residual " + fmt(res) + " after " +
-                       std::to_string(sweeps) + " sweeps at t = " + fmt((j - 1) * grid.h));
+          tr.add_warning("moreau-jean: PGS stopped at residual " + fmt(res) + " after " +
+                         std::to_string(sweeps) + " sweeps at t = " + fmt((j - 1) * grid.h));
           solved = z.allFinite();
         }
         if (!solved && !solve_exact(MatrixXd(G)))
@@ -858,7 +793,7 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
       y += m.g;
       tr.max_violation = std::min(tr.max_violation, std::min(0.0, y.minCoeff()));
     }
-    const double t = last ? opt.t_end : grid.time(j);
+    const double t = last ? opt.t_end : j * grid.h;
     if (sampler.want(t, grid.h, last)) record(t, y, u, mode);
   }
   return finish();

@@ -1,7 +1,8 @@
+#include <cmath>
 #include <functional>
 #include <sstream>
-#include <utility>
 #include <stdexcept>
+#include <utility>
 
 #include "sim/sim.hpp"
 
@@ -21,6 +22,52 @@ std::string_view to_string(EventType t) {
       return "start";
   }
   return "unknown";
+}
+
+void Trajectory::add_warning(std::string w) {
+  ++warnings;
+  if (warning_messages.size() < kMaxWarningMessages) warning_messages.push_back(std::move(w));
+}
+
+StepGrid StepGrid::of(double t_end, double h) {
+  StepGrid g;
+  g.h = h;
+  const double r = t_end / h;
+  const double rn = std::round(r);
+  if (rn >= 1.0 && std::abs(r - rn) <= 1e-9 * rn) {
+    g.n = static_cast<long>(rn);
+    g.h_last = h;
+  } else {
+    const double nf = std::floor(r);
+    g.n = static_cast<long>(nf) + 1;
+    g.h_last = t_end - nf * h;
+  }
+  return g;
+}
+
+bool OutputSampler::want(double t, double h, bool last) {
+  if (last || dt_out_ <= 0.0) return true;
+  if (t < next_ - 1e-9 * h) return false;
+  while (next_ <= t + 1e-9 * h) next_ += dt_out_;
+  return true;
+}
+
+std::string check_step_options(const Options& opt, bool theta_used) {
+  auto fmt = [](double x) {
+    std::ostringstream s;
+    s.precision(6);
+    s << x;
+    return s.str();
+  };
+  if (!(opt.t_end > 0.0) || !std::isfinite(opt.t_end))
+    return "t_end must be a finite number > 0 (got " + fmt(opt.t_end) + ")";
+  if (!(opt.h > 0.0) || !std::isfinite(opt.h))
+    return "step h must be a finite number > 0 (got " + fmt(opt.h) + ")";
+  if (opt.t_end / opt.h > 1e9)
+    return "t_end / h = " + fmt(opt.t_end / opt.h) + " steps is more than 1e9";
+  if (theta_used && !(opt.theta >= 0.0 && opt.theta <= 1.0))
+    return "theta must lie in [0, 1] (got " + fmt(opt.theta) + ")";
+  return "";
 }
 
 namespace {
