@@ -47,6 +47,7 @@
 #include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "bullet/bullet.hpp"
 
@@ -251,7 +252,7 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
     tr.message = msg;
     tr.wall_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-    return tr;
+    return std::move(tr);  // only ever returned from the run: no copy of the samples
   };
   std::vector<Limit> limits;
   try {

@@ -20,6 +20,7 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "sim/sim.hpp"
@@ -90,7 +91,7 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
     tr.energy_final = energy(xa);
     tr.wall_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-    return tr;
+    return std::move(tr);  // only ever returned from the run: no copy of the samples
   };
   auto fail = [&](const std::string& msg, const VectorXd& xa) {
     tr.status = RunStatus::kFailed;
@@ -616,7 +617,7 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     tr.energy_final = ops.energy(q, v);
     tr.wall_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-    return tr;
+    return std::move(tr);  // only ever returned from the run: no copy of the samples
   };
   auto fail = [&](const std::string& msg) {
     tr.status = RunStatus::kFailed;
