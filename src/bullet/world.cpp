@@ -345,6 +345,7 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
   VectorXd F(N), q_next(N), v_next(N), u(k);
   for (long j = 1; j <= n; ++j) {
     const bool last = j == n;
+    if (opt.progress && j % sim::Options::kProgressSteps == 0) opt.progress(j * opt.h);
     const double h = last ? h_last : opt.h;
     F = m.f - m.K * q - m.D * v;
     for (int i = 0; i < N; ++i) w->bodies[i]->applyCentralForce(btVector3(F(i), 0, 0));

@@ -26,9 +26,11 @@ struct SimulateArgs {
   std::string lcp = "pivot";
   double h = std::nan("");  // time-stepping step (s); NaN = sim::Options default
   bool h_given = false;
-  double theta = 0.5;    // Moreau–Jean theta
-  bool force = false;    // backward Euler despite the consistency guard
-  bool project = false;  // move an infeasible q0 onto E q + g >= 0 first
+  double theta = 0.5;        // Moreau–Jean theta
+  bool force = false;        // backward Euler despite the consistency guard
+  bool project = false;      // move an infeasible q0 onto E q + g >= 0 first
+  bool progress = false;     // --progress: progress lines on stderr even when not a terminal
+  bool no_progress = false;  // --no-progress
 };
 
 std::string fmt_vec(const Eigen::VectorXd& v) {
@@ -93,7 +95,12 @@ void run_simulate(const SimulateArgs& a) {
   // An unwritable --out fails now, not after the run.
   if (!a.out.empty()) check_writable(a.out);
 
+  ProgressLine progress(opt.t_end, a.no_progress ? ProgressLine::Mode::kNever
+                                   : a.progress  ? ProgressLine::Mode::kAlways
+                                                 : ProgressLine::Mode::kAuto);
+  opt.progress = [&progress](double t) { progress.update(t); };
   const sim::Trajectory tr = integrator->run(model, x0, opt);
+  if (tr.status == sim::RunStatus::kCompleted) progress.done();
   const bool failed = tr.status != sim::RunStatus::kCompleted;
   if (!failed && !a.out.empty()) io::write_file_atomic(a.out, io::trajectory_csv(model, tr));
   if (a.json) {
@@ -128,6 +135,10 @@ void setup(CLI::App& app) {
   cmd->add_flag("--project", a->project,
                 "If the initial state violates a constraint, start from the nearest feasible "
                 "positions (kinetic metric) instead of refusing it");
+  auto* prog = cmd->add_flag("--progress", a->progress,
+                             "Report progress on stderr, one line at most twice a second "
+                             "(default: only on a terminal, after the first second)");
+  cmd->add_flag("--no-progress", a->no_progress, "Never report progress")->excludes(prog);
   cmd->add_flag("--force", a->force,
                 "Run backward Euler even where it is not consistent (rho_i >= 3, §7.3)");
   cmd->add_option("--dt-out", a->dt_out, "Output grid step (s); 0 = events only");

@@ -7,7 +7,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -118,6 +121,51 @@ void draw_plot(const fs::path& script, const fs::path& input, const std::string&
     ::unlink(tmp.c_str());
     throw std::runtime_error(option + ": " + why);
   }
+}
+
+namespace {
+double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+}  // namespace
+
+ProgressLine::ProgressLine(double t_end, Mode mode)
+    : t_end_(t_end), mode_(mode), tty_(::isatty(STDERR_FILENO) != 0), start_(now_s()) {
+  if (mode_ == Mode::kAlways) draw(0.0);
+}
+
+ProgressLine::~ProgressLine() {
+  if (drawn_ && tty_ && mode_ == Mode::kAuto && !finished_) std::fputc('\n', stderr);
+}
+
+void ProgressLine::update(double t) {
+  if (mode_ == Mode::kNever || (mode_ == Mode::kAuto && !tty_)) return;
+  const double now = now_s();
+  if (mode_ == Mode::kAuto && now - start_ < 1.0) return;
+  if (last_ >= 0.0 && now - last_ < 0.5) return;
+  draw(t);
+}
+
+void ProgressLine::done() {
+  if (finished_) return;
+  if (mode_ == Mode::kAlways || drawn_) draw(t_end_);
+  if (drawn_ && tty_ && mode_ == Mode::kAuto) std::fputc('\n', stderr);
+  finished_ = true;
+}
+
+void ProgressLine::draw(double t) {
+  const double now = now_s(), elapsed = now - start_;
+  const double frac = t_end_ > 0.0 ? std::clamp(t / t_end_, 0.0, 1.0) : 1.0;
+  char left[64] = "";
+  if (frac > 0.0 && frac < 1.0)
+    std::snprintf(left, sizeof left, ", about %.3g s left", elapsed * (1.0 - frac) / frac);
+  const bool in_place = tty_ && mode_ == Mode::kAuto;
+  std::fprintf(stderr, "%slcsim: t = %.6g of %.6g (%.0f %%), %.3g s so far%s%s",
+               in_place ? "\r" : "", t, t_end_, 100.0 * frac, elapsed, left,
+               in_place ? "\x1b[K" : "\n");
+  std::fflush(stderr);
+  drawn_ = true;
+  last_ = now;
 }
 
 }  // namespace lcsim::cli

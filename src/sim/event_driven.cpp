@@ -611,6 +611,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
   double window_start = 0.0;
   while (t < t_end) {
     ++tr.steps;
+    if (opt_.progress) opt_.progress(t);
     // Sampling step: a quarter of the fastest time scale of the closed loop,
     // so a Bohl function changes the sign of its derivative at most once
     // between samples; first steps shorter where a monitor starts at zero.

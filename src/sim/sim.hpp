@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -77,6 +78,11 @@ struct Options {
   // falls below this, the limit state is taken and the run continues.
   double accumulation_dt = 1e-10;
   bool record_samples = true;
+  // Progress of a long run: when set, called with the time reached, every
+  // kProgressSteps steps of a time-stepping method and once per phase of the
+  // event-driven method (cheap enough for a wall-clock check in the callee).
+  std::function<void(double t)> progress;
+  static constexpr long kProgressSteps = 1024;
   // Time-stepping: run backward Euler even where the consistency guard
   // refuses it (some leading row index rho_i >= 3, §7.3, Example 7.3.3).
   bool force = false;

@@ -186,6 +186,7 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
   VectorXd xb(n), q(k), x_next(n);
   for (long j = 1; j <= grid.n; ++j) {
     const bool last = j == grid.n;
+    if (opt.progress && j % Options::kProgressSteps == 0) opt.progress(j * grid.h);
     const EulerFactors& f = (last && grid.h_last != grid.h) ? F_last : F;
     xb.noalias() = f.Phi * x;  // free step (I - hA)^{-1} x_k
     if (k > 0) {
@@ -697,6 +698,7 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
   };
   for (long j = 1; j <= grid.n; ++j) {
     const bool last = j == grid.n;
+    if (opt.progress && j % Options::kProgressSteps == 0) opt.progress(j * grid.h);
     const double h = last ? grid.h_last : grid.h;
     MjIteration& f = (last && grid.h_last != grid.h) ? F_last : F;
     ops.step_force(q, v, h, theta, rhs);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "bullet/bullet.hpp"
 #include "io/io.hpp"
@@ -189,6 +190,24 @@ TEST(BulletWorld, RegisteredAsIntegratorAndSolvers) {
   EXPECT_EQ(sim::make_integrator("bullet")->name(), "bullet");
   for (const char* n : {"bullet-dantzig", "bullet-lemke", "bullet-pgs"})
     EXPECT_EQ(lcp::make_solver(n)->name(), n);
+}
+
+// Options::progress, as for lcsim's time stepping (tests/sim/test_progress.cpp):
+// 3 / 1e-4 = 30000 steps, a report every kProgressSteps = 1024 steps at
+// t = j h: floor(30000 / 1024) = 29 reports.
+TEST(BulletWorld, ReportsProgressEveryKProgressSteps) {
+  const mech::Model model = mech::two_carts_model(false);
+  sim::Options opt;
+  opt.t_end = 3.0;
+  opt.h = 1e-4;
+  opt.record_samples = false;
+  std::vector<double> ts;
+  opt.progress = [&ts](double t) { ts.push_back(t); };
+  const sim::Trajectory tr = simulate_bullet(model, Eigen::Vector4d(0, -1, -1, 0), opt);
+  ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
+  ASSERT_EQ(ts.size(), 30000u / sim::Options::kProgressSteps);
+  for (std::size_t i = 0; i < ts.size(); ++i)
+    EXPECT_EQ(ts[i], static_cast<double>((i + 1) * sim::Options::kProgressSteps) * 1e-4);
 }
 
 }  // namespace

@@ -187,4 +187,21 @@ TEST(AnalyzeCommand, BadModelExitsTwoWithOneLineNamingTheFile) {
                        ": mechanical.M: not symmetric (M[0][1] = 2 but M[1][0] = 1)\n");
 }
 
+// Progress on stderr: --progress writes a line at the start and the 100 %
+// line at the end (a short run: nothing in between), each on its own line;
+// stdout is untouched; without a terminal and without --progress, nothing.
+TEST(SimulateCommand, ProgressLinesOnStderr) {
+  const std::string model = std::string("'") + LCSIM_SOURCE_DIR + "/robots/two_carts.yaml'";
+  const CliRun r = lcsim("simulate " + model + " --method moreau-jean --h 1e-3 --json --progress");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.rfind("lcsim: t = 0 of 3 (0 %)", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find("\nlcsim: t = 3 of 3 (100 %)"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.back(), '\n');
+  EXPECT_TRUE(nlohmann::json::accept(r.out)) << r.out;
+  const CliRun quiet = lcsim("simulate " + model + " --json");
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err.find("lcsim: t ="), std::string::npos) << quiet.err;
+  EXPECT_NE(lcsim("simulate " + model + " --progress --no-progress").exit_code, 0);
+}
+
 }  // namespace
