@@ -79,8 +79,9 @@ struct Options {
   double accumulation_dt = 1e-10;
   bool record_samples = true;
   // Progress of a long run: when set, called with the time reached, every
-  // kProgressSteps steps of a time-stepping method and once per phase of the
-  // event-driven method (cheap enough for a wall-clock check in the callee).
+  // kProgressSteps steps of a time-stepping method and once per sampling step
+  // of the event-driven method's event search (at least once per phase;
+  // cheap enough for a wall-clock check in the callee).
   std::function<void(double t)> progress;
   static constexpr long kProgressSteps = 1024;
   // Time-stepping: run backward Euler even where the consistency guard
