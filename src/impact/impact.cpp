@@ -165,17 +165,10 @@ void finish(const ImpactInput& in, const Setup& s, const VectorXd& impulse_J,
 
 std::optional<VectorXd> solve_impact_lcp(const MatrixXd& W, const VectorXd& q,
                                          const lcp::Solver& solver, ImpactResult& out) {
-  // Scale to a unit diagonal and |q|_inf = 1: z = s D z~ with D = diag(W)^{-1/2}.
+  // Solved scaled to a unit diagonal and |q|_inf = 1 (lcp::solve_scaled).
   // The LCP solvers accept a residual of 1e-12 (1 + |q|_inf), an absolute
   // test; masses over four decades give W entries from 1e-4 to 1e4, where
   // the rounding of the unscaled problem alone exceeds that.
-  const Eigen::Index n = q.size();
-  VectorXd d(n);
-  for (Eigen::Index i = 0; i < n; ++i) d(i) = W(i, i) > 0.0 ? 1.0 / std::sqrt(W(i, i)) : 1.0;
-  const VectorXd qd = d.cwiseProduct(q);
-  const double s = qd.cwiseAbs().maxCoeff() > 0.0 ? qd.cwiseAbs().maxCoeff() : 1.0;
-  const MatrixXd Ws = d.asDiagonal() * W * d.asDiagonal();
-  const VectorXd qs = qd / s;
   // The given solver, then Lemke (dependent constraints make W singular, PSD
   // but not P; Lemke still solves it since q is in the range of W, Lemma
   // 4.6.1), then projected Gauss–Seidel (converges on PSD W).
@@ -189,7 +182,7 @@ std::optional<VectorXd> solve_impact_lcp(const MatrixXd& W, const VectorXd& q,
   for (const double tol : {1e-12, 1e-10}) {
     opt.tolerance = tol;
     int attempts = 0;
-    res = lcp::solve_with_fallbacks(solver, Ws, qs, opt, &attempts, &tried);
+    res = lcp::solve_scaled(solver, W, q, opt, &attempts, &tried);
     out.lcp_solves += attempts;
     if (res.ok()) break;
   }
@@ -199,7 +192,7 @@ std::optional<VectorXd> solve_impact_lcp(const MatrixXd& W, const VectorXd& q,
                   (res.message.empty() ? "" : " (" + res.message + ")");
     return std::nullopt;
   }
-  return VectorXd(s * d.cwiseProduct(res.z));
+  return res.z;
 }
 
 }  // namespace detail
