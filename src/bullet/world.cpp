@@ -45,7 +45,6 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
-#include <sstream>
 #include <stdexcept>
 #include <utility>
 
@@ -58,12 +57,8 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-std::string fmt(double x) {
-  std::ostringstream s;
-  s.precision(6);
-  s << x;
-  return s.str();
-}
+// Messages print numbers as every integrator does.
+std::string fmt(double x) { return sim::short_number(x); }
 
 // One row of E as Bullet sees it.
 struct Limit {

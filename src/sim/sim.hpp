@@ -142,6 +142,10 @@ class OutputSampler {
 };
 std::string check_step_options(const Options& opt, bool theta_used);
 
+// A number with six significant digits, as the integrators' messages print it
+// ("0.001", "3.16228e+04").
+std::string short_number(double x);
+
 // Event-driven integration (Algorithm 3.7.1): exact matrix-exponential phases,
 // events as roots of Bohl functions, re-initialisation by the impact law
 // (mechanical models) or by the LDCP and P_I (general LCS).

@@ -18,7 +18,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -31,12 +30,8 @@ namespace {
 
 using Eigen::MatrixXd;
 
-std::string fmt(double x) {
-  std::ostringstream s;
-  s.precision(6);
-  s << x;
-  return s.str();
-}
+// Messages print numbers as every integrator does.
+std::string fmt(double x) { return short_number(x); }
 
 // The message of a step whose LCP failed, for both schemes.
 std::string lcp_failure(const char* method, double t, const lcp::Result& r) {

@@ -52,13 +52,15 @@ bool OutputSampler::want(double t, double h, bool last) {
   return true;
 }
 
+std::string short_number(double x) {
+  std::ostringstream s;
+  s.precision(6);
+  s << x;
+  return s.str();
+}
+
 std::string check_step_options(const Options& opt, bool theta_used) {
-  auto fmt = [](double x) {
-    std::ostringstream s;
-    s.precision(6);
-    s << x;
-    return s.str();
-  };
+  const auto fmt = short_number;
   if (!(opt.t_end > 0.0) || !std::isfinite(opt.t_end))
     return "t_end must be a finite number > 0 (got " + fmt(opt.t_end) + ")";
   if (!(opt.h > 0.0) || !std::isfinite(opt.h))
