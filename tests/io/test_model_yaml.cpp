@@ -9,6 +9,7 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "io/io.hpp"
+#include "support/same_model.hpp"
 
 namespace lcsim::io {
 namespace {
@@ -424,13 +425,7 @@ void expect_round_trip(const mech::Model& model) {
   const mech::MechanicalModel &a = *model.mechanical, &b = *back.mechanical;
   EXPECT_EQ(back.name, model.name);
   // Exact: numbers are written in shortest round-trip form.
-  EXPECT_EQ(a.M.toDense(), b.M.toDense());
-  EXPECT_EQ(a.D.toDense(), b.D.toDense());
-  EXPECT_EQ(a.K.toDense(), b.K.toDense());
-  EXPECT_EQ(a.E.toDense(), b.E.toDense());
-  EXPECT_EQ(a.g, b.g);
-  EXPECT_EQ(a.f, b.f);
-  EXPECT_EQ(a.restitution, b.restitution);
+  test_support::expect_same_matrices(a, b);
   EXPECT_EQ(a.coordinates, b.coordinates);
   EXPECT_EQ(a.constraints, b.constraints);
   EXPECT_EQ(back.initial, model.initial);

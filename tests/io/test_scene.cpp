@@ -10,6 +10,7 @@
 
 #include "io/io.hpp"
 #include "sim/sim.hpp"
+#include "support/same_model.hpp"
 
 namespace lcsim {
 namespace {
@@ -19,18 +20,11 @@ using Eigen::VectorXd;
 
 const std::string kRobots = std::string(LCSIM_SOURCE_DIR) + "/robots/";
 
-void expect_same_matrices(const mech::MechanicalModel& a, const mech::MechanicalModel& b) {
-  // Exact equality: the scene's numbers are sums and products of exactly
-  // representable inputs (unit masses, unit springs, axis (1,0,0), zero
-  // gravity component along x), so nothing may differ, not even in the last bit.
-  EXPECT_EQ(a.M.toDense(), b.M.toDense());
-  EXPECT_EQ(a.D.toDense(), b.D.toDense());
-  EXPECT_EQ(a.K.toDense(), b.K.toDense());
-  EXPECT_EQ(a.E.toDense(), b.E.toDense());
-  EXPECT_EQ(a.g, b.g);
-  EXPECT_EQ(a.f, b.f);
-  EXPECT_EQ(a.restitution, b.restitution);
-}
+// Exact equality (expect_same_matrices): the scene's numbers are sums and
+// products of exactly representable inputs (unit masses, unit springs, axis
+// (1,0,0), zero gravity component along x), so nothing may differ, not even
+// in the last bit.
+using test_support::expect_same_matrices;
 
 void expect_same_run(const mech::Model& a, const mech::Model& b) {
   sim::Options opt;
