@@ -174,11 +174,8 @@ void time_stepping_table() {
     A << 0, 0, 1, 0, 0, 0, 0, 1, -2, 1, 0, 0, 1, -1, 0, 0;
     const VectorXd xT = (A * (2.0 - M_PI / 2)).exp() * Eigen::Vector4d(0, 0, 0, 1);
     for (double c : {0.0, 1.0, 2.0}) {
-      mech::MechanicalModel m;
-      m.M = MatrixXd::Identity(2, 2).sparseView();
-      m.K = Eigen::Matrix2d{{2, -1}, {-1, 1}}.sparseView();
-      m.E = (c == 0 ? MatrixXd(Eigen::RowVector2d(1, 0)) : MatrixXd{{1, 0}, {c, 0}}).sparseView();
-      const auto model = wrap(m);
+      const auto model = mech::two_carts_model(c == 0 ? MatrixXd(Eigen::RowVector2d(1, 0))
+                                                      : MatrixXd{{1, 0}, {c, 0}});
       for (const char* meth : kMethods) {
         const auto tr = step_run(meth, model, Eigen::Vector4d(0, -1, -1, 0), 2.0, 1e-3);
         printf("dependent c=%g %s: err=%.1e final=(%.17g %.17g %.17g %.17g)%s\n", c, meth,
@@ -194,12 +191,8 @@ void time_stepping_table() {
     A << 0, 0, 1, 0, 0, 0, 0, 1, -2, 1, 0, 0, 1, -1, 0, 0;
     const VectorXd xT = (A * (2.0 - M_PI / 2)).exp() * Eigen::Vector4d(0, 0, 0, 1);
     for (double d : {1e-2, 1e-4, 1e-6, 3e-8, 1e-8, 3e-9, 1e-11, 1e-14}) {
-      mech::MechanicalModel m;
-      m.M = MatrixXd::Identity(2, 2).sparseView();
-      m.K = Eigen::Matrix2d{{2, -1}, {-1, 1}}.sparseView();
-      m.E = Eigen::Matrix2d{{1, 0}, {1, d}}.sparseView();
-      m.g = Eigen::Vector2d(0, d);
-      const auto model = wrap(m);
+      const auto model =
+          mech::two_carts_model(Eigen::Matrix2d{{1, 0}, {1, d}}, Eigen::Vector2d(0, d));
       sim::Options o;
       o.t_end = 2.0;
       const auto ev = sim::simulate_event_driven(model, Eigen::Vector4d(0, -1, -1, 0), o);

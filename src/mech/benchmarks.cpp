@@ -35,16 +35,24 @@ Model ball_model(double e, double g) {
   return model_of(std::move(m), "ball");
 }
 
-Model two_carts_model(bool hook) {
+namespace {
+// The §3.7 carts without constraints: unit masses, K = [2 -1; -1 1].
+MechanicalModel two_carts() {
   MechanicalModel m;
   m.M.resize(2, 2);
   m.M.setIdentity();
   const Eigen::Matrix2d K{{2.0, -1.0}, {-1.0, 1.0}};
   m.K = K.sparseView();
+  m.coordinates = {"x1", "x2"};
+  return m;
+}
+}  // namespace
+
+Model two_carts_model(bool hook) {
+  MechanicalModel m = two_carts();
   const Eigen::MatrixXd E = hook ? Eigen::MatrixXd{{1.0, 0.0}, {1.0, -1.0}}  // stop, hook
                                  : Eigen::MatrixXd{{1.0, 0.0}};              // stop
   m.E = E.sparseView();
-  m.coordinates = {"x1", "x2"};
   m.constraints =
       hook ? std::vector<std::string>{"stop", "hook"} : std::vector<std::string>{"stop"};
   fill_defaults(m);
@@ -52,6 +60,16 @@ Model two_carts_model(bool hook) {
   model.name = hook ? "two_carts_hook" : "two_carts";
   model.source = "generated two carts";
   model.mechanical = std::move(m);
+  return model;
+}
+
+Model two_carts_model(const Eigen::MatrixXd& E, const Eigen::VectorXd& g) {
+  if (E.cols() != 2) throw std::invalid_argument("two_carts_model: E needs 2 columns");
+  MechanicalModel m = two_carts();
+  m.E = E.sparseView();
+  m.g = g;
+  Model model = model_of(std::move(m), "two_carts_rows");
+  model.source = "generated two carts";
   return model;
 }
 

@@ -123,6 +123,10 @@ Model ball_model(double e, double g = 9.81);
 // 3.8.3 (eq. (3.74)). No initial state or horizon (robots/two_carts*.yaml
 // hold the thesis's).
 Model two_carts_model(bool hook);
+// The same two carts with the constraint rows E q + g >= 0 given instead (E
+// with two columns; g empty for zero): the repeated, parallel and nearly
+// dependent stops of the extremes suite. Constraints named by fill_defaults.
+Model two_carts_model(const Eigen::MatrixXd& E, const Eigen::VectorXd& g = Eigen::VectorXd());
 
 // The cart chain of the scaling benchmark (`lcsim generate chain`, issue 9):
 // carts i = 0..n-1 (coordinate q_i, m), unit masses (kg), unit springs (N/m)

@@ -209,11 +209,7 @@ TEST(Extremes, DependentConstraintsSameMotion) {
   const VectorXd x0 = Eigen::Vector4d(0, -1, -1, 0);  // at the impact of §3.7
   const VectorXd xT = (A * (2.0 - kPi / 2)).exp() * Eigen::Vector4d(0, 0, 0, 1);
   for (double c : {1.0, 2.0}) {
-    mech::MechanicalModel m;
-    m.M = MatrixXd::Identity(2, 2).sparseView();
-    m.K = Eigen::Matrix2d{{2, -1}, {-1, 1}}.sparseView();
-    m.E = Eigen::Matrix2d{{1, 0}, {c, 0}}.sparseView();
-    const auto tr = run(mechanical(m, "dependent"), x0, 2.0);
+    const auto tr = run(mech::two_carts_model(Eigen::Matrix2d{{1, 0}, {c, 0}}), x0, 2.0);
     ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << "c = " << c << ": " << tr.message;
     ASSERT_GE(tr.events.size(), 2u);
     EXPECT_NEAR(tr.events.back().t, kPi / 2, 1e-10);
@@ -241,12 +237,8 @@ TEST(Extremes, NearlyDependentConstraints) {
   const VectorXd x0 = Eigen::Vector4d(0, -1, -1, 0);
   const VectorXd xT = (A * (2.0 - kPi / 2)).exp() * Eigen::Vector4d(0, 0, 0, 1);
   for (double d : {1e-2, 1e-4, 1e-6, 3e-8, 1e-8, 3e-9, 1e-11, 1e-14}) {
-    mech::MechanicalModel m;
-    m.M = MatrixXd::Identity(2, 2).sparseView();
-    m.K = Eigen::Matrix2d{{2, -1}, {-1, 1}}.sparseView();
-    m.E = Eigen::Matrix2d{{1, 0}, {1, d}}.sparseView();
-    m.g = Eigen::Vector2d(0, d);
-    const auto tr = run(mechanical(m, "nearly dependent"), x0, 2.0);
+    const auto tr =
+        run(mech::two_carts_model(Eigen::Matrix2d{{1, 0}, {1, d}}, Eigen::Vector2d(0, d)), x0, 2.0);
     ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << "d = " << d << ": " << tr.message;
     ASSERT_GE(tr.events.size(), 2u) << "d = " << d;
     const double bound = 2e-12;

@@ -369,13 +369,7 @@ TEST(SteppingExtremes, DependentConstraintsSameMotion) {
   A << 0, 0, 1, 0, 0, 0, 0, 1, -2, 1, 0, 0, 1, -1, 0, 0;
   const VectorXd xT = (A * (2.0 - kPi / 2)).exp() * Eigen::Vector4d(0, 0, 0, 1);
   const VectorXd x0 = Eigen::Vector4d(0, -1, -1, 0);
-  auto carts = [](const MatrixXd& E) {
-    mech::MechanicalModel m;
-    m.M = MatrixXd::Identity(2, 2).sparseView();
-    m.K = Eigen::Matrix2d{{2, -1}, {-1, 1}}.sparseView();
-    m.E = E.sparseView();
-    return wrap(m);
-  };
+  const auto carts = [](const MatrixXd& E) { return mech::two_carts_model(E); };
   for (const auto& [s, bound] : {std::pair{kMj05, 2e-3}, {kMj1, 2e-3}, {kEuler, 2e-3}}) {
     const auto one = step(s, carts(Eigen::RowVector2d(1, 0)), x0, 2.0, 1e-3);
     ASSERT_EQ(one.status, sim::RunStatus::kCompleted) << one.message;
@@ -401,18 +395,14 @@ TEST(SteppingExtremes, DependentConstraintsSameMotion) {
 TEST(SteppingExtremes, NearlyDependentConstraints) {
   const double eps = std::numeric_limits<double>::epsilon();
   const VectorXd x0 = Eigen::Vector4d(0, -1, -1, 0);
-  mech::MechanicalModel m;
-  m.M = MatrixXd::Identity(2, 2).sparseView();
-  m.K = Eigen::Matrix2d{{2, -1}, {-1, 1}}.sparseView();
-  mech::MechanicalModel single = m;
-  single.E = Eigen::RowVector2d(1, 0).sparseView();
+  const mech::Model single = mech::two_carts_model(Eigen::RowVector2d(1, 0));
   for (const Scheme& s : {kMj05, kMj1, kEuler}) {
-    const auto ref = step(s, wrap(single), x0, 2.0, 1e-3);
+    const auto ref = step(s, single, x0, 2.0, 1e-3);
     ASSERT_EQ(ref.status, sim::RunStatus::kCompleted) << label(s) << ": " << ref.message;
     for (double d : {1e-2, 1e-4, 1e-6, 3e-8, 1e-8, 3e-9, 1e-11, 1e-14}) {
-      m.E = Eigen::Matrix2d{{1, 0}, {1, d}}.sparseView();
-      m.g = Eigen::Vector2d(0, d);
-      const auto tr = step(s, wrap(m), x0, 2.0, 1e-3);
+      const auto tr =
+          step(s, mech::two_carts_model(Eigen::Matrix2d{{1, 0}, {1, d}}, Eigen::Vector2d(0, d)), x0,
+               2.0, 1e-3);
       ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << label(s) << " d " << d << tr.message;
       EXPECT_LE(maxabs(tr.final_state - ref.final_state), 2 * std::min(d, eps / d) + 1e-14)
           << label(s) << " d " << d;
@@ -451,18 +441,13 @@ TEST(SteppingExtremes, NearlySingularMass) {
 // state of the single-stop run to 1e-5 (the theta = 1 Lemke difference of
 // 1.4e-6 measured above).
 TEST(SteppingExtremes, DependentConstraintsDefaultSolver) {
-  mech::MechanicalModel m;
-  m.M = MatrixXd::Identity(2, 2).sparseView();
-  m.K = Eigen::Matrix2d{{2, -1}, {-1, 1}}.sparseView();
-  mech::MechanicalModel single = m;
-  single.E = Eigen::RowVector2d(1, 0).sparseView();
+  const mech::Model single = mech::two_carts_model(Eigen::RowVector2d(1, 0));
   for (const Eigen::Matrix2d& E :
        {Eigen::Matrix2d{{1, 0}, {1, 0}}, Eigen::Matrix2d{{1, 0}, {2, 0}}}) {
-    m.E = E.sparseView();
     for (const Scheme& s : {kMj05, kMj1, kEuler}) {
-      const auto tr = step(s, wrap(m), Eigen::Vector4d(0, -1, -1, 0), 2.0, 1e-3);
+      const auto tr = step(s, mech::two_carts_model(E), Eigen::Vector4d(0, -1, -1, 0), 2.0, 1e-3);
       ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << label(s) << ": " << tr.message;
-      const auto ref = step(s, wrap(single), Eigen::Vector4d(0, -1, -1, 0), 2.0, 1e-3);
+      const auto ref = step(s, single, Eigen::Vector4d(0, -1, -1, 0), 2.0, 1e-3);
       EXPECT_LE(maxabs(tr.final_state - ref.final_state), 1e-5) << label(s) << " E " << E;
     }
   }
@@ -556,14 +541,12 @@ TEST(BulletExtremes, NearlySingularMassRefusedDependentRowsRun) {
   A << 0, 0, 1, 0, 0, 0, 0, 1, -2, 1, 0, 0, 1, -1, 0, 0;
   const VectorXd xT = (A * (2.0 - kPi / 2)).exp() * Eigen::Vector4d(0, 0, 0, 1);
   for (double c : {1.0, 2.0}) {
-    mech::MechanicalModel d;
-    d.M = MatrixXd::Identity(2, 2).sparseView();
-    d.K = Eigen::Matrix2d{{2, -1}, {-1, 1}}.sparseView();
-    d.E = Eigen::Matrix2d{{1, 0}, {c, 0}}.sparseView();
-    const BulletRun b = bullet(wrap(d), Eigen::Vector4d(0, -1, -1, 0), 2.0, 1e-3);
+    const BulletRun b = bullet(mech::two_carts_model(Eigen::Matrix2d{{1, 0}, {c, 0}}),
+                               Eigen::Vector4d(0, -1, -1, 0), 2.0, 1e-3);
     ASSERT_EQ(b.exit_code, 0) << b.err;
     EXPECT_LE(maxabs(b.final_state() - xT), 2e-3) << "c " << c;
-  }  // A nearly dependent row x1 + d x2 + d >= 0 is no limit of one body nor a
+  }
+  // A nearly dependent row x1 + d x2 + d >= 0 is no limit of one body nor a
   // hook between two: refused, naming the row and its coefficients.
   mech::MechanicalModel nd;
   nd.M = MatrixXd::Identity(2, 2).sparseView();
