@@ -201,6 +201,11 @@ Range parse_range(const std::string& text) {
   return r;
 }
 
+// bench/plot_impact_map.py (or $LCSIM_PLOT_IMPACT_MAP).
+std::filesystem::path impact_map_script() {
+  return find_plot_script("plot_impact_map.py", "LCSIM_PLOT_IMPACT_MAP");
+}
+
 void run_map(const ImpactsArgs& a, const mech::Model& model) {
   const mech::MechanicalModel& m = *model.mechanical;
   if (m.dofs() != 2)
@@ -241,8 +246,8 @@ void run_map(const ImpactsArgs& a, const mech::Model& model) {
                                     ("lcsim_impact_map_" + std::to_string(::getpid()) + ".csv");
   io::write_file_atomic(tmp, csv.str());
   try {
-    draw_plot(find_plot_script("plot_impact_map.py", "LCSIM_PLOT_IMPACT_MAP"), tmp, a.plot,
-              model.name + ": Moreau impact map (Figure 3.5)", "--plot");
+    draw_plot(impact_map_script(), tmp, a.plot, model.name + ": Moreau impact map (Figure 3.5)",
+              "--plot");
   } catch (...) {
     std::filesystem::remove(tmp);
     throw;
@@ -258,7 +263,7 @@ void run_impacts(const ImpactsArgs& a) {
   if (!a.plot.empty() && a.map.empty()) throw io::InputError("--plot: only with --map");
   if (!a.plot.empty()) {  // checked before the map is computed, not after
     check_writable(a.plot);
-    (void)find_plot_script("plot_impact_map.py", "LCSIM_PLOT_IMPACT_MAP");
+    (void)impact_map_script();
   }
   if (a.map.empty())
     run_compare(a, model);
