@@ -301,8 +301,6 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
 
   // The grid of the time-stepping methods: n steps of h, the last shortened.
   const sim::StepGrid grid = sim::StepGrid::of(opt.t_end, opt.h);
-  const long n = grid.n;
-  const double h_last = grid.h_last;
 
   std::unique_ptr<World> w = build(m, limits, q, v, s);
   // Multipliers from the momentum balance M (v+ - v) = h F + E' (h u):
@@ -338,10 +336,10 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
   record(0.0, VectorXd::Zero(k), mode);
 
   VectorXd F(N), q_next(N), v_next(N), u(k);
-  for (long j = 1; j <= n; ++j) {
-    const bool last = j == n;
+  for (long j = 1; j <= grid.n; ++j) {
+    const bool last = j == grid.n;
     if (opt.progress && j % sim::Options::kProgressSteps == 0) opt.progress(j * opt.h);
-    const double h = last ? h_last : opt.h;
+    const double h = last ? grid.h_last : grid.h;
     F = m.f - m.K * q - m.D * v;
     for (int i = 0; i < N; ++i) w->bodies[i]->applyCentralForce(btVector3(F(i), 0, 0));
     // maxSubSteps = 0: exactly one step of length h (no interpolation).
