@@ -29,8 +29,8 @@ namespace lcsim::io {
 namespace {
 
 using yaml::describe;
-using yaml::join;
 using yaml::fail;
+using yaml::join;
 using yaml::Keys;
 using yaml::load;
 using yaml::mapping;
