@@ -4,6 +4,7 @@
 
 #include <Eigen/SVD>
 #include <algorithm>
+#include <limits>
 
 namespace lcsim::lcs {
 
@@ -41,20 +42,16 @@ std::vector<MatrixXd> markov_parameters(const Lcs& sys, int count) {
 
 namespace {
 
-// A row or column of H^i counts as nonzero when its largest entry exceeds a
-// tolerance relative to the scale of the whole Markov sequence at that order,
-// so that rounding in C A^{i-1} B is not mistaken for structure.
-double markov_zero_tol(const std::vector<MatrixXd>& H, const Lcs& sys, int i) {
-  double scale = H[i].cwiseAbs().maxCoeff();
-  if (i > 0) {
-    // ||C|| ||A||^{i-1} ||B|| bounds the size of the terms summed.
-    const double a = std::max(sys.A.cwiseAbs().rowwise().sum().maxCoeff(), 1e-300);
-    const double c = sys.C.cwiseAbs().rowwise().sum().maxCoeff();
-    const double b = sys.B.cwiseAbs().colwise().sum().maxCoeff();
-    scale = std::max(scale, c * std::pow(a, i - 1) * b);
-  }
-  return 1e-12 * scale;
-}
+// Leading indices are decided entry by entry: H^i_jl counts as nonzero when
+// it exceeds 1e-12 of the magnitudes of the terms that formed it,
+// T^i = |C| |A|^{i-1} |B| (T^0 = |D|), so that rounding in C A^{i-1} B is not
+// mistaken for structure. T^i is invariant under diagonal scalings of the
+// state (|C S| |S^-1 A S|^{i-1} |S^-1 B| = |C| |A|^{i-1} |B|) and scales with
+// time like H^i, so the decision does not depend on units: a stiff spring
+// (omega = 1e9) on another row of A does not drown E M^-1 E' (a bound
+// ||C|| ||A||^{i-1} ||B|| did, from omega ~ 1e6 on). tol_abs keeps exact zeros
+// zero when the terms vanish too.
+constexpr double kMarkovRel = 1e-12;
 
 // Markov parameters are computed one order at a time and the search stops
 // once every row (column) has found its leading index: mechanical models need
@@ -65,28 +62,32 @@ std::vector<int> leading_indices(const Lcs& sys, bool rows, MatrixXd* coefficien
   std::vector<int> idx(k, kInfiniteIndex);
   if (coefficients) *coefficients = MatrixXd::Zero(k, k);
   int found = 0;
-  std::vector<MatrixXd> H;  // H^0..H^i so far (markov_zero_tol reads H[i])
-  MatrixXd AiB = sys.B;
+  MatrixXd AiB = sys.B, AiB_abs = sys.B.cwiseAbs();
+  const MatrixXd A_abs = sys.A.cwiseAbs(), C_abs = sys.C.cwiseAbs();
   for (int i = 0; i <= n && found < k; ++i) {
+    MatrixXd H, T;
     if (i == 0) {
-      H.push_back(sys.D);
+      H = sys.D;
+      T = sys.D.cwiseAbs();
     } else {
-      H.push_back(sys.C * AiB);
+      H = sys.C * AiB;
+      T = C_abs * AiB_abs;
       AiB = sys.A * AiB;
+      AiB_abs = A_abs * AiB_abs;
     }
-    if (H[i].size() == 0) continue;
-    const double tol = markov_zero_tol(H, sys, i);
+    if (H.size() == 0) continue;
+    const Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> nonzero =
+        H.array().abs() > kMarkovRel * T.array() + std::numeric_limits<double>::min();
     for (int j = 0; j < k; ++j) {
       if (idx[j] != kInfiniteIndex) continue;
-      const double v = rows ? H[i].row(j).cwiseAbs().maxCoeff() : H[i].col(j).cwiseAbs().maxCoeff();
-      if (v > tol) {
+      if (rows ? nonzero.row(j).any() : nonzero.col(j).any()) {
         idx[j] = i;
         ++found;
         if (coefficients) {
           if (rows)
-            coefficients->row(j) = H[i].row(j);
+            coefficients->row(j) = H.row(j);
           else
-            coefficients->col(j) = H[i].col(j);
+            coefficients->col(j) = H.col(j);
         }
       }
     }

@@ -43,7 +43,10 @@ int numerical_rank(const MatrixXd& X);
 std::vector<MatrixXd> markov_parameters(const Lcs& sys, int count);
 
 // Leading indices (Definition 3.6.2); kInfiniteIndex when a row/column of all
-// H^0..H^n vanishes (the mode is then not autonomous, Lemma 3.6.5).
+// H^0..H^n vanishes (the mode is then not autonomous, Lemma 3.6.5). An entry
+// of H^i counts as nonzero when above 1e-12 |C| |A|^{i-1} |B| (the magnitudes
+// of its terms), so stiff models (omega up to 1e9 and beyond) get the index of
+// the unscaled theory.
 inline constexpr int kInfiniteIndex = -1;
 std::vector<int> leading_row_indices(const Lcs& sys);     // rho_i
 std::vector<int> leading_column_indices(const Lcs& sys);  // eta_j
@@ -165,8 +168,9 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
 //   (A, B_.I, C_I., D_II); they coincide with rho_i and script M_II of the full
 //   system whenever H^{rho_i}_{iI} != 0.
 // - is_regular_state: tol is relative. C_i A^j x counts as zero when
-//   |C_i A^j x| <= tol * ||C_i||_1 * a^j * ||x||_inf, a = largest absolute row
-//   sum of A (a bound on the terms summed). An infinite rho_i uses n terms.
+//   |C_i A^j x| <= tol * || |C_i| |A|^j ||_1 * ||x||_inf (entrywise
+//   magnitudes of the row's terms, so a stiff spring elsewhere in A does not
+//   inflate it as ||A||^j did). An infinite rho_i uses n terms.
 //   1e-9 is a sensible value for data accurate to ~1e-12.
 // - analyze_well_posedness, passivity (§7.2; K = K' > 0 with
 //   L(K) = [A'K+KA, KB-C'; B'K-C, -(D+D')] <= 0). Each necessary condition

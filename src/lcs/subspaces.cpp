@@ -300,23 +300,26 @@ bool is_regular_state(const Lcs& sys, const VectorXd& x, double tol) {
     throw std::invalid_argument("is_regular_state: state has size " + std::to_string(x.size()) +
                                 ", expected " + std::to_string(sys.n()));
   const std::vector<int> rho = leading_row_indices(sys);
-  // ||r A||_1 <= ||r||_1 * (largest absolute row sum of A) for a row vector r.
-  const double a_norm = sys.n() > 0 ? sys.A.cwiseAbs().rowwise().sum().maxCoeff() : 0.0;
+  // C_i A^j x counts as zero below tol * || |C_i| |A|^j ||_1 * ||x||_inf:
+  // the rounding of the state's entries (relative to its size) carried
+  // through the magnitudes of the row's terms. |A|^j, not ||A||^j: a stiff
+  // spring elsewhere in A does not inflate the bound of a row it is not on.
+  const MatrixXd A_abs = sys.A.cwiseAbs();
   const double x_norm = x.size() > 0 ? x.cwiseAbs().maxCoeff() : 0.0;
   for (int i = 0; i < sys.k(); ++i) {
     // With an infinite index y_i = C_i e^{At} x does not depend on u; by
     // Cayley–Hamilton its first n derivatives decide its sign near 0+.
     const int count = rho[i] == kInfiniteIndex ? sys.n() : rho[i];
     Eigen::RowVectorXd r = sys.C.row(i);
-    double bound = r.cwiseAbs().sum();  // bound on ||C_i A^j||_1
+    Eigen::RowVectorXd r_abs = r.cwiseAbs();
     for (int j = 0; j < count; ++j) {
       const double v = r.dot(x);
-      if (std::abs(v) > tol * bound * x_norm) {
+      if (std::abs(v) > tol * r_abs.sum() * x_norm) {
         if (v < 0.0) return false;
         break;  // lexicographically positive
       }
       r = r * sys.A;
-      bound *= a_norm;
+      r_abs = r_abs * A_abs;
     }
   }
   return true;

@@ -81,6 +81,26 @@ TEST(WellPosedness, TripleIntegratorIsRiskyForBackwardEuler) {
   EXPECT_EQ(r.passive, "no");
 }
 
+// Stiff oscillators, omega = 1e3 ... 1e12 rad/s: x = (q, v), q'' = -w^2 q + u,
+// y = q. H^1 = 0 and H^2 = 1 exactly at every omega, so rho = 2 and script
+// M = 1 (a P-matrix). A zero test scaled by ||C|| ||A|| ||B|| = w^2 called
+// H^2 zero from omega ~ 1e6 on; the terms of C A B are |C| |A| |B| = 1.
+// Also with the mass scaled (M = 1e-6, K = 1e6: the same omega = 1e6).
+TEST(WellPosedness, StiffOscillatorsKeepTheirIndex) {
+  for (const double mass : {1.0, 1e-6})
+    for (const double w : {1e3, 1e6, 1e9, 1e12}) {
+      Lcs sys;
+      sys.A = (Eigen::Matrix2d() << 0, 1, -w * w, 0).finished();
+      sys.B = Eigen::Vector2d(0, 1 / mass);
+      sys.C = Eigen::RowVector2d(1, 0);
+      sys.D = Eigen::MatrixXd::Zero(1, 1);
+      const auto r = analyze_well_posedness(sys);
+      EXPECT_EQ(r.rho, std::vector<int>{2}) << "omega " << w << ", mass " << mass;
+      EXPECT_DOUBLE_EQ(r.row_coefficients(0, 0), 1 / mass);
+      EXPECT_TRUE(r.locally_well_posed) << "omega " << w;
+    }
+}
+
 TEST(WellPosedness, NonPMatrixAndInfiniteIndex) {
   // script M = -1: not a P-matrix, Theorem 3.6.3 does not apply.
   auto r = analyze_well_posedness(scalar(-1, 1, -1, 0));
