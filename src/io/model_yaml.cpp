@@ -291,6 +291,17 @@ mech::MechanicalModel parse_mechanical(const YAML::Node& node, const std::string
   // fill_defaults leaves the zero-row E alone and sizes g and restitution to
   // k, so a model without constraints (E omitted or []) is complete as well.
   mech::fill_defaults(m);
+  // A zero row of E is the constraint 0 q + g >= 0: it never acts (g >= 0) or
+  // is never satisfiable (g < 0), and its multiplier has no leading index
+  // (no derivative of E_i q depends on u). Refused here rather than at t = 0.
+  if (k > 0) {
+    const Eigen::VectorXd row_norms = (m.E.cwiseAbs() * Eigen::VectorXd::Ones(N)).eval();
+    for (int i = 0; i < k; ++i)
+      if (!(row_norms(i) > 0.0))
+        fail(source, "mechanical.E[" + std::to_string(i) + "]",
+             "constraint '" + m.constraints[i] +
+                 "' has an all-zero row (it constrains no coordinate)");
+  }
   return m;
 }
 

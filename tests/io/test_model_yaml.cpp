@@ -244,6 +244,18 @@ TEST(ModelFileErrors, RestitutionOutsideUnitInterval) {
   EXPECT_EQ(error_of(two_dof("  restitution: [0]\n")), "(accepted)");
 }
 
+// A zero row of E constrains nothing; it used to pass loading and fail at
+// t = 0 with "leading row indices (inf)". Refused at load, naming the row.
+TEST(ModelFileErrors, ZeroRowOfE) {
+  EXPECT_EQ(error_of(kHead + "  M: [[1, 0], [0, 1]]\n  E: [[1, 0], [0, 0]]\n"),
+            "bad.yaml: mechanical.E[1]: constraint 'c2' has an all-zero row (it constrains no "
+            "coordinate)");
+  EXPECT_EQ(error_of(kHead + "  M: [[1, 0], [0, 1]]\n  E: {rows: 2, cols: 2, entries: [[0, 1, "
+                             "2]]}\n"),
+            "bad.yaml: mechanical.E[1]: constraint 'c2' has an all-zero row (it constrains no "
+            "coordinate)");
+}
+
 TEST(ModelFileErrors, NonPositiveHorizon) {
   EXPECT_EQ(error_of(two_dof("t_end: 0\n")), "bad.yaml: t_end: must be > 0 (got 0)");
   EXPECT_EQ(error_of(two_dof("t_end: -2.5\n")), "bad.yaml: t_end: must be > 0 (got -2.5)");
