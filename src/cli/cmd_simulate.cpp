@@ -22,7 +22,7 @@ struct SimulateArgs {
   double dt_out = 0.0;
   std::string out;
   bool json = false;
-  std::string impact = "moreau";
+  std::string impact = sim::Options{}.impact;  // the library's default
   std::string lcp = "pivot";
   double h = std::nan("");  // time-stepping step (s); NaN = sim::Options default
   bool h_given = false;
@@ -107,11 +107,15 @@ void run_simulate(const SimulateArgs& a) {
     std::cout << io::trajectory_json(model, tr).dump(2) << "\n";
   } else {
     std::printf("model %s, method %s, t_end %g\n", model.name.c_str(), tr.method.c_str(), tr.t_end);
+    if (!tr.impact_law.empty()) std::printf("impact law %s\n", tr.impact_law.c_str());
     for (const auto& e : tr.events) {
       std::printf("  t = %-20.15g %-12s %s -> %s  mode %s\n", e.t,
                   std::string(sim::to_string(e.type)).c_str(), fmt_vec(e.state_before).c_str(),
                   fmt_vec(e.state_after).c_str(), fmt_set(e.mode_after).c_str());
+      if (!e.note.empty()) std::printf("      (%s)\n", e.note.c_str());
     }
+    if (tr.events_not_recorded > 0)
+      std::printf("  ... and %ld more events, counted, not recorded\n", tr.events_not_recorded);
     std::printf("final state %s\n", fmt_vec(tr.final_state).c_str());
     if (model.is_mechanical())
       std::printf("energy %.12g -> %.12g\n", tr.energy_initial, tr.energy_final);
@@ -145,7 +149,7 @@ void setup(CLI::App& app) {
   cmd->add_option("--out", a->out, "Write the trajectory CSV here");
   cmd->add_flag("--json", a->json, "Print the run summary as JSON");
   cmd->add_option("--impact", a->impact,
-                  "Impact law (default moreau, with the model's restitution)");
+                  "Impact law (default moreau-restitution, with the model's restitution)");
   cmd->add_option("--lcp", a->lcp, "LCP solver: pivot, lemke, pgs, enum");
   cmd->callback([a, t_end, h] {
     // Given means given: --t-end nan is an error, not the model's horizon.

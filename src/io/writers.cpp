@@ -189,8 +189,12 @@ nlohmann::json trajectory_json(const mech::Model& model, const sim::Trajectory& 
                       {"state_after", to_json(e.state_after)},
                       {"mode_after", index_set_json(e.mode_after)},
                       {"impulse", to_json(e.impulse)}});
+    if (!e.note.empty()) events.back()["note"] = e.note;
   }
   j["events"] = std::move(events);
+  j["events_not_recorded"] = traj.events_not_recorded;
+  j["impact_law"] =
+      traj.impact_law.empty() ? nlohmann::json(nullptr) : nlohmann::json(traj.impact_law);
   // Energies are defined for mechanical models only (null for a general LCS).
   if (model.is_mechanical()) {
     j["energy_initial"] = traj.energy_initial;

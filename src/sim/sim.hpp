@@ -37,6 +37,10 @@ struct Event {
   VectorXd state_before, state_after;
   IndexSet mode_after;
   VectorXd impulse;  // u^0 (size k); zero when no jump
+  // How the event was resolved when that is not plain: for an accumulation,
+  // the contacts, the impacts seen and how the limit time and state were
+  // extrapolated. Empty otherwise.
+  std::string note;
 };
 
 enum class RunStatus { kCompleted, kFailed };
@@ -46,8 +50,13 @@ struct Trajectory {
   RunStatus status = RunStatus::kCompleted;
   std::string message;  // why it failed, or "" when completed
   double t_end = 0.0;
-  std::vector<Sample> samples;  // at a jump two samples share t (before, after)
-  std::vector<Event> events;
+  std::vector<Sample> samples;   // at a jump two samples share t (before, after)
+  std::vector<Event> events;     // the first Options::max_recorded_events of them
+  long events_not_recorded = 0;  // events past that cap: counted, not kept
+  // The impact law the run applied ("moreau-restitution", ...), as each
+  // method applies it: the event-driven method its Options::impact,
+  // Moreau–Jean the law inside its LCP, backward Euler the inelastic one.
+  std::string impact_law;
   VectorXd final_state;
   double energy_initial = 0.0, energy_final = 0.0;  // mechanical models only
   double max_violation = 0.0;                       // most negative gap over the run (0 if none)
@@ -62,11 +71,16 @@ struct Trajectory {
 };
 
 struct Options {
-  double t_end = 1.0;             // horizon (s)
-  double dt_out = 0.0;            // output grid (s); 0 = events only (plus start and end)
-  double h = 1e-3;                // time step of time-stepping methods (s)
-  double theta = 0.5;             // Moreau–Jean theta
-  std::string impact = "moreau";  // impact law name (src/impact)
+  double t_end = 1.0;   // horizon (s)
+  double dt_out = 0.0;  // output grid (s); 0 = events only (plus start and end)
+  double h = 1e-3;      // time step of time-stepping methods (s)
+  double theta = 0.5;   // Moreau–Jean theta
+  // Impact law name (src/impact). The default is Moreau–Jean's law,
+  // restitution inside the impact LCP: admissible by construction with several
+  // closed contacts (a resting contact never rebounds), and the same as
+  // "moreau" (Newton's (1+e) per contact) with one contact or e = 0
+  // (docs/impact-rules.md gives the evidence).
+  std::string impact = "moreau-restitution";
   std::string lcp_solver = "pivot";
   // Event-driven: extra root tolerance in time (s) and the cap on events per unit
   // time that ends a run that would loop forever (Zeno without limit).
@@ -74,9 +88,21 @@ struct Options {
   double event_time_tol = 0.0;
   double max_events_per_unit_time = 1e6;
   long max_events = 1000000;
-  // Accumulation (right-Zeno, Remark 3.4.11): when the gap between impacts
-  // falls below this, the limit state is taken and the run continues.
+  // Events kept in Trajectory::events; later ones are counted in
+  // Trajectory::events_not_recorded (with one warning), and their samples are
+  // not recorded, so output stays bounded whatever the run does.
+  long max_recorded_events = 100000;
+  // Event-driven livelock guard: this many consecutive events that each
+  // change the state by less than 1e-6 of its size, less than 1e-4 of the
+  // fastest time scale apart, end the run with a failure naming the contacts
+  // (a run that cannot make progress is never "completed").
+  int livelock_events = 64;
+  // Accumulation (right-Zeno, Remark 3.4.11), whatever the restitution:
+  // when the impacts of a contact come this close, or their intervals shrink
+  // geometrically with a tail (the time the remaining impacts take) below
+  // accumulation_tail * max(1, t), the limit is taken and the run continues.
   double accumulation_dt = 1e-10;
+  double accumulation_tail = 1e-6;
   bool record_samples = true;
   // Progress of a long run: when set, called with the time reached, every
   // kProgressSteps steps of a time-stepping method and once per sampling step

@@ -75,6 +75,8 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
   Trajectory tr;
   tr.method = "euler";
   tr.t_end = opt.t_end;
+  // Backward Euler's step LCP acts on positions: every impact is inelastic.
+  if (model.is_mechanical()) tr.impact_law = "moreau (e = 0: restitution ignored)";
   const bool mech = model.is_mechanical();
   const int N = mech ? model.mechanical->dofs() : 0;
   auto user = [&](const VectorXd& xa) -> VectorXd { return mech ? VectorXd(xa.head(2 * N)) : xa; };
@@ -588,6 +590,7 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
   Trajectory tr;
   tr.method = "moreau-jean";
   tr.t_end = opt.t_end;
+  tr.impact_law = "moreau-restitution";  // the law inside the velocity LCP
   if (!model.is_mechanical()) {
     tr.status = RunStatus::kFailed;
     tr.message = "moreau-jean: needs a mechanical model ('" + model.name +
