@@ -4,10 +4,16 @@
 Usage: plot_work_precision.py SWEEP.json OUT.png [--title TEXT] [--error final|max]
 
 SWEEP.json is {"rows": [{"method", "h", "error_final", "error_max", ...,
-"wall_time_s"}]}. One line per time-stepping method: error (against the exact
-event-driven solution) versus wall time, log-log, each point labelled with its
-step h. The event-driven run is exact, so it is drawn as a vertical line at its
-wall time. Agg backend: no display needed.
+"wall_time_s", "status", "reference_law", "warnings"}]}. One line per
+time-stepping method: error (against the exact event-driven run of its
+reference law, named in the legend) versus wall time, log-log, each point
+labelled with its step h; a point whose run warned is ringed. The event-driven
+run is exact, so it is drawn as a vertical line at its wall time. Rows that
+failed or were refused (status not "completed") have no error: they are drawn
+as crosses on a band at the top of the axes, at their h's place on the time
+axis if they have a time, else at the left edge, and listed in the legend with
+their status. The axes are fitted to the finite data with a margin. Agg
+backend: no display needed.
 
 The merged tables of bench/run_work_precision.sh use the same format with
 optional keys per row: "tool" ("lcsim" when absent; other tools, e.g.
@@ -49,37 +55,75 @@ def main():
         t = r.get("time_s", r.get("wall_time_s"))
         return t if t is not None else float("nan")
 
-    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    fig, ax = plt.subplots(figsize=(7.6, 5.0))
     markers = iter("os^vD<>phHd8*")
+    finite_pts, bad_rows = [], []
     for method, rows in methods.items():
         if rows[0]["method"] == "event":
             t = time_of(rows[0])
             if t > 0:
-                ax.axvline(t, color="k", ls=":", lw=1, label=f"{method} (exact)")
+                ax.axvline(t, color="k", ls=":", lw=1,
+                           label=f"{method} (exact, {rows[0].get('reference_law', '')})")
             continue
-        pts = [(time_of(r), r.get(key), r["h"]) for r in rows
-               if r.get(key) is not None and math.isfinite(r[key]) and r[key] > 0
+        bad_rows += [r for r in rows if r.get("status", "completed") != "completed"]
+        pts = [(time_of(r), r.get(key), r["h"], r.get("warnings", 0)) for r in rows
+               if r.get("status", "completed") == "completed"
+               and r.get(key) is not None and math.isfinite(r[key]) and r[key] > 0
                and time_of(r) > 0]
         if not pts:
             continue
         pts.sort()
+        finite_pts += pts
         dashed = r_tool(rows[0]) != "lcsim"
-        ax.loglog([p[0] for p in pts], [p[1] for p in pts], marker=next(markers, "o"),
-                  ls="--" if dashed else "-", mfc="none" if dashed else None,
-                  label=method)
-        for t, e, h in pts:
+        ref = rows[0].get("reference_law")
+        label = f"{method} vs {ref}" if ref else method
+        line, = ax.loglog([p[0] for p in pts], [p[1] for p in pts], marker=next(markers, "o"),
+                          ls="--" if dashed else "-", mfc="none" if dashed else None,
+                          label=label)
+        warned = [p for p in pts if p[3]]
+        if warned:
+            ax.loglog([p[0] for p in warned], [p[1] for p in warned], ls="none", marker="o",
+                      ms=12, mfc="none", mec=line.get_color(), mew=0.8)
+        for t, e, h, _ in pts:
             ax.annotate(f"h={h:g}", (t, e), textcoords="offset points", xytext=(4, 4),
                         fontsize=7)
+    if finite_pts:
+        ts = [p[0] for p in finite_pts]
+        es = [p[1] for p in finite_pts]
+        ax.set_xlim(min(ts) / 3, max(ts) * 3)
+        ax.set_ylim(min(es) / 5, max(es) * 20)
+    else:
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+    if any(r.get("warnings", 0) for rows in methods.values() for r in rows
+           if r["method"] != "event"):
+        ax.plot([], [], ls="none", marker="o", ms=10, mfc="none", mec="0.3",
+                label="ringed: the run warned")
+    if bad_rows:
+        # A band at the top: x in data coordinates (or the left edge), y in axes.
+        lo, hi = ax.get_xlim()
+        for kind, mk, col in (("failed", "x", "tab:red"), ("refused", "X", "tab:purple")):
+            sel = [r for r in bad_rows if r["status"].startswith(kind)]
+            if not sel:
+                continue
+            xs = [time_of(r) if time_of(r) > 0 else lo * 1.15 for r in sel]
+            ax.plot(xs, [0.96] * len(sel), ls="none", marker=mk, ms=9, color=col,
+                    transform=ax.get_xaxis_transform(), clip_on=False,
+                    label=f"{kind}: " + ", ".join(f"{r['method']} h={r['h']:g}" for r in sel))
+            for x, r in zip(xs, sel):
+                ax.annotate(f"{r['method']} h={r['h']:g}", (x, 0.96),
+                            xycoords=("data", "axes fraction"), textcoords="offset points",
+                            xytext=(5, -10), fontsize=6, color=col)
     merged = any("tool" in r for r in data["rows"])
     ax.set_xlabel("time per run (s, median; lcsim wall, Siconos loop CPU)" if merged
                   else "wall time per run (s, median)")
-    ax.set_ylabel(f"{a.error} state error (max abs) vs exact")
+    ax.set_ylabel(f"{a.error} state error (max abs) vs exact run")
     title = a.title or data.get("model", "")
-    ax.set_title(f"{title}: work-precision" if title else "work-precision")
+    ax.set_title(f"{title}: work-precision" if title else "work-precision", fontsize=10)
     ax.grid(True, which="both", ls=":", lw=0.5)
-    ax.legend(fontsize=7 if len(methods) > 6 else None)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     fig.tight_layout()
-    fig.savefig(a.png, dpi=120)
+    fig.savefig(a.png, dpi=120, bbox_inches="tight")
 
 
 if __name__ == "__main__":
