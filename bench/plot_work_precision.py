@@ -87,33 +87,44 @@ def main():
         for t, e, h, _ in pts:
             ax.annotate(f"h={h:g}", (t, e), textcoords="offset points", xytext=(4, 4),
                         fontsize=7)
+    times = [p[0] for p in finite_pts] + [time_of(r) for rows in methods.values()
+                                           for r in rows if time_of(r) > 0]
+    if times:  # at least a decade wide, so the log axis has labelled ticks
+        lo, hi = min(times) / 3, max(times) * 3
+        mid = math.sqrt(lo * hi)
+        ax.set_xscale("log")
+        ax.set_xlim(min(lo, mid / 10), max(hi, mid * 10))
+    ax.set_yscale("log")
     if finite_pts:
-        ts = [p[0] for p in finite_pts]
         es = [p[1] for p in finite_pts]
-        ax.set_xlim(min(ts) / 3, max(ts) * 3)
         ax.set_ylim(min(es) / 5, max(es) * 20)
     else:
-        ax.set_xscale("log")
-        ax.set_yscale("log")
+        ax.set_ylim(1e-12, 1.0)
+        ax.text(0.5, 0.5, "no completed row: no error to plot", transform=ax.transAxes,
+                ha="center", va="center", fontsize=9, color="0.4")
     if any(r.get("warnings", 0) for rows in methods.values() for r in rows
            if r["method"] != "event"):
         ax.plot([], [], ls="none", marker="o", ms=10, mfc="none", mec="0.3",
                 label="ringed: the run warned")
     if bad_rows:
-        # A band at the top: x in data coordinates (or the left edge), y in axes.
-        lo, hi = ax.get_xlim()
+        # A band at the top: x in data coordinates (or the left edge), y in
+        # axes fraction, one height per row so labels do not overlap.
+        lo, _ = ax.get_xlim()
+        height = iter(0.96 - 0.05 * i for i in range(len(bad_rows)))
         for kind, mk, col in (("failed", "x", "tab:red"), ("refused", "X", "tab:purple")):
             sel = [r for r in bad_rows if r["status"].startswith(kind)]
             if not sel:
                 continue
-            xs = [time_of(r) if time_of(r) > 0 else lo * 1.15 for r in sel]
-            ax.plot(xs, [0.96] * len(sel), ls="none", marker=mk, ms=9, color=col,
+            xs = [time_of(r) if time_of(r) > 0 else lo * 1.3 for r in sel]
+            ys = [next(height) for _ in sel]
+            ax.plot(xs, ys, ls="none", marker=mk, ms=9, color=col,
                     transform=ax.get_xaxis_transform(), clip_on=False,
-                    label=f"{kind}: " + ", ".join(f"{r['method']} h={r['h']:g}" for r in sel))
-            for x, r in zip(xs, sel):
-                ax.annotate(f"{r['method']} h={r['h']:g}", (x, 0.96),
+                    label=f"{kind} (no error): " + ", ".join(
+                        f"{r['method']} h={r['h']:g}" for r in sel))
+            for x, y, r in zip(xs, ys, sel):
+                ax.annotate(f"{r['method']} h={r['h']:g} {kind}", (x, y),
                             xycoords=("data", "axes fraction"), textcoords="offset points",
-                            xytext=(5, -10), fontsize=6, color=col)
+                            xytext=(7, -3), fontsize=7, color=col)
     merged = any("tool" in r for r in data["rows"])
     ax.set_xlabel("time per run (s, median; lcsim wall, Siconos loop CPU)" if merged
                   else "wall time per run (s, median)")

@@ -86,20 +86,19 @@ void check_options(const SweepOptions& o) {
   }
 }
 
-// The exact runs of the sweep, one model per distinct reference law, each
-// sampled on the grids the rows ask for (cached by dt_out).
+// The exact runs of the sweep, one per distinct reference law, each sampled
+// on the grids the rows ask for (cached by dt_out).
 class References {
  public:
   References(const mech::Model& model, const Eigen::VectorXd& x0, const sim::Options& base)
-      : model_(model), x0_(x0), base_(base), event_(sim::make_integrator("event")) {}
+      : model_(model), x0_(x0), base_(base) {}
 
   ReferenceRun& get(const ReferenceLaw& law) {
     for (auto& r : runs_)
       if (r.law == law) return r;
     ReferenceRun r;
     r.law = law;
-    models_.push_back(model_of(law));
-    r.run = event_->run(models_.back(), x0_, options(law, 0.0));
+    r.run = run_reference(model_, x0_, law, options(0.0));
     r.status = status_of(r.run);
     r.warnings = r.run.warnings;
     r.first_warning = first_of(r.run);
@@ -110,23 +109,17 @@ class References {
   const sim::Trajectory& on_grid(const ReferenceLaw& law, double dt_out) {
     size_t i = 0;
     while (!(runs_[i].law == law)) ++i;
-    auto key = std::make_pair(i, dt_out);
+    const auto key = std::make_pair(i, dt_out);
     auto it = grids_.find(key);
     if (it == grids_.end())
-      it = grids_.emplace(key, event_->run(models_[i], x0_, options(law, dt_out))).first;
+      it = grids_.emplace(key, run_reference(model_, x0_, law, options(dt_out))).first;
     return it->second;
   }
   std::vector<ReferenceRun> take() { return std::vector<ReferenceRun>(runs_.begin(), runs_.end()); }
 
  private:
-  mech::Model model_of(const ReferenceLaw& law) const {
-    mech::Model m = model_;
-    if (law.inelastic) m.mechanical->restitution.setZero();
-    return m;
-  }
-  sim::Options options(const ReferenceLaw& law, double dt_out) const {
+  sim::Options options(double dt_out) const {
     sim::Options o = base_;
-    o.impact = law.law;
     o.dt_out = dt_out;
     o.progress = nullptr;
     return o;
@@ -134,9 +127,7 @@ class References {
   const mech::Model& model_;
   Eigen::VectorXd x0_;
   sim::Options base_;
-  std::unique_ptr<sim::Integrator> event_;
-  std::deque<ReferenceRun> runs_;   // stable addresses
-  std::deque<mech::Model> models_;  // index-aligned with runs_
+  std::deque<ReferenceRun> runs_;  // stable addresses
   std::map<std::pair<size_t, double>, sim::Trajectory> grids_;
 };
 
@@ -255,6 +246,15 @@ ReferenceLaw reference_law(const std::string& method, const std::string& impact,
     r.reason = "assumed: the --impact law";
   }
   return r;
+}
+
+sim::Trajectory run_reference(const mech::Model& model, const Eigen::VectorXd& x0,
+                              const ReferenceLaw& law, sim::Options opt) {
+  opt.impact = law.law;
+  if (!law.inelastic) return sim::make_integrator("event")->run(model, x0, opt);
+  mech::Model m = model;
+  m.mechanical->restitution.setZero();
+  return sim::make_integrator("event")->run(m, x0, opt);
 }
 
 bool SweepResult::reference_failed() const {

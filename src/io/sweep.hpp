@@ -42,6 +42,11 @@ struct ReferenceLaw {
 ReferenceLaw reference_law(const std::string& method, const std::string& impact,
                            const mech::Model& model);
 
+// The exact event-driven run of `law` on `model` from x0: the model's
+// restitution set to zero when law.inelastic, Options::impact = law.law.
+sim::Trajectory run_reference(const mech::Model& model, const Eigen::VectorXd& x0,
+                              const ReferenceLaw& law, sim::Options opt);
+
 struct SweepOptions {
   std::vector<std::string> methods;  // integrator names (sim::make_integrator)
   std::vector<double> hs;            // step sizes (s), each in (0, t_end]
