@@ -209,14 +209,20 @@ nlohmann::json text_or_null(const std::string& s) {
 
 }  // namespace
 
-std::string ReferenceLaw::label() const { return inelastic ? law + ", e = 0" : law; }
+std::string ReferenceLaw::label() const {
+  if (lcs) return "exact (LCS)";
+  return inelastic ? law + ", e = 0" : law;
+}
 
 ReferenceLaw reference_law(const std::string& method, const std::string& impact,
                            const mech::Model& model) {
   ReferenceLaw r;
   if (!model.is_mechanical()) {
     r.law = impact;
-    r.reason = "LCS model: the exact event-driven run (no impact law)";
+    r.lcs = true;
+    r.reason =
+        "LCS model: the exact event-driven run (re-initialisation by projection, no "
+        "impact law)";
     return r;
   }
   const bool e = has_restitution(model);

@@ -35,6 +35,7 @@ struct ReferenceLaw {
   std::string law;         // impact law name of the exact run (src/impact)
   bool inelastic = false;  // the exact run uses a copy of the model with e = 0
   std::string reason;      // one sentence: why this law
+  bool lcs = false;        // an LCS model: no impact law, the label is "exact (LCS)"
   // "moreau-restitution", or "moreau, e = 0" when inelastic: the row's label.
   std::string label() const;
   bool operator==(const ReferenceLaw& o) const { return law == o.law && inelastic == o.inelastic; }
