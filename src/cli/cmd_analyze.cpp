@@ -5,6 +5,7 @@
 // LCS (Markov parameters (3.32), leading indices and coefficient matrices
 // (3.39), Theorem 3.6.3, passivity §7.2, backward Euler guard §7.3).
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -76,6 +77,13 @@ struct Coactive {
   mech::CoactiveWellPosedness wp;
 };
 
+// Theorem 3.6.3 holds on every set found (CoactiveWellPosedness::
+// locally_well_posed also asks that the enumeration be complete).
+bool all_found_pass(const Coactive& c) {
+  return std::all_of(c.wp.sets.begin(), c.wp.sets.end(),
+                     [](const auto& r) { return r.row_p_matrix && r.column_p_matrix; });
+}
+
 Coactive coactive(const mech::MechanicalModel& m) {
   Coactive c;
   c.sets = mech::coactive_sets(m);
@@ -113,7 +121,10 @@ nlohmann::json coactive_json(const mech::MechanicalModel& m, const Coactive& c) 
   j["complete"] = c.sets.complete;
   j["dependent"] = c.wp.dependent;
   j["delassus_p_matrix"] = c.wp.all_delassus_p;
-  j["locally_well_posed"] = c.wp.locally_well_posed;
+  // Undecided (null) when the enumeration was cut short and every set found passed.
+  j["locally_well_posed"] = !c.sets.complete && all_found_pass(c)
+                                ? nlohmann::json()
+                                : nlohmann::json(c.wp.locally_well_posed);
   j["note"] =
       "verdicts on the maximal sets of constraints that can be active together (some admissible "
       "q closes them all); other sets never reach an impact LCP or a mode";
@@ -138,8 +149,12 @@ std::string coactive_text(const mech::MechanicalModel& m, const Coactive& c) {
         << m.constraints[c.sets.exclusive_pairs[0].second] << "\n";
   if (!c.sets.never_active.empty())
     out << "  never active at all: " << names_text(m, c.sets.never_active) << "\n";
-  out << "  on these sets: Delassus P-matrix " << (c.wp.all_delassus_p ? "yes" : "no")
-      << ", Theorem 3.6.3 " << (c.wp.locally_well_posed ? "applies" : "does not apply")
+  const bool undecided = !c.sets.complete && all_found_pass(c);
+  out << "  on " << (c.sets.complete ? "these sets" : "the sets found") << ": Delassus P-matrix "
+      << (c.wp.all_delassus_p ? "yes" : "no") << ", Theorem 3.6.3 "
+      << (undecided                 ? "applies on them (not decided on the sets not enumerated)"
+          : c.wp.locally_well_posed ? "applies"
+                                    : "does not apply")
       << (c.wp.dependent ? "; some set has dependent rows (§4.6.1)" : "") << "\n";
   return out.str();
 }
@@ -180,9 +195,11 @@ void run_analyze(const AnalyzeArgs& args) {
     std::optional<Coactive> co;
     if (m.num_constraints() > 0 && m.num_constraints() <= kMaxCoactiveConstraints) co = coactive(m);
     if (rank_e < m.num_constraints())
-      out << (co && co->sets.complete && !co->wp.dependent
+      out << (!co || co->wp.dependent ? "  (dependent constraints)"
+              : co->sets.complete
                   ? "  (rows that cannot be active together, not dependent constraints)"
-                  : "  (dependent constraints)");
+                  : "  (rows that cannot be active together; dependent constraints in "
+                    "sets not enumerated not excluded)");
     out << "\n";
     if (m.num_constraints() > 0) {
       const MatrixXd W = mech::delassus(m);
@@ -259,7 +276,10 @@ void run_analyze(const AnalyzeArgs& args) {
       << (wp.locally_well_posed ? "applies" : "does not apply")
       << (j.contains("coactive") && !j["coactive"].is_null()
               ? std::string("; on the sets that can be active together: ") +
-                    (j["coactive"]["locally_well_posed"].get<bool>() ? "applies" : "does not apply")
+                    (j["coactive"]["locally_well_posed"].is_null()
+                         ? "not decided (enumeration cut short)"
+                     : j["coactive"]["locally_well_posed"].get<bool>() ? "applies"
+                                                                       : "does not apply")
               : std::string())
       << "\n"
       << "  passive (§7.2): " << wp.passive

@@ -34,7 +34,7 @@ VectorXd entries_of(const VectorXd& g, const std::vector<int>& J) {
 //    0 <= A A' l + b ⟂ l >= 0 is solvable (z = A' l). A A' is PSD, so Lemke's
 //    method either solves it or ends on a ray, which for a PSD (copositive-
 //    plus) matrix proves the LCP infeasible (Cottle-Pang-Stone, Thm 4.4.13).
-bool feasible(const MatrixXd& E, const VectorXd& g, const std::vector<int>& J) {
+bool feasible_exact(const MatrixXd& E, const VectorXd& g, const std::vector<int>& J) {
   const int k = static_cast<int>(E.rows()), N = static_cast<int>(E.cols());
   std::vector<int> K;
   for (int i = 0; i < k; ++i)
@@ -61,6 +61,34 @@ bool feasible(const MatrixXd& E, const VectorXd& g, const std::vector<int>& J) {
   const auto lemke = lcp::make_solver("lemke");
   const lcp::Result sol = lemke->solve(A * A.transpose(), b, lcp::Options{});
   return sol.ok();
+}
+
+// At most this many feasibility tests (each a small SVD and LCP, ~0.1 ms at
+// N = 20) per enumeration: about 2 s; `complete` is false beyond.
+constexpr long kMaxChecks = 20000;
+
+// feasible_exact, counted: beyond `left` checks the enumeration stops
+// (answering false, with `exhausted` set) so a model with many rows and
+// exponentially many sets cannot hang `analyze`.
+struct Checker {
+  const MatrixXd& E;
+  const VectorXd& g;
+  long left;
+  bool exhausted = false;
+  bool operator()(const std::vector<int>& J) {
+    if (left <= 0) {
+      exhausted = true;
+      return false;
+    }
+    --left;
+    return feasible_exact(E, g, J);
+  }
+};
+
+// P-property: for a symmetric matrix, positive definiteness (equivalent, and
+// one eigenvalue decomposition instead of 2^k minors); else all minors.
+bool p_matrix(const MatrixXd& M) {
+  return lcp::is_symmetric(M, 1e-12) ? lcp::is_positive_definite(M) : lcp::is_p_matrix(M);
 }
 
 // Bron-Kerbosch with pivoting: the maximal cliques of the graph `adj` among
@@ -95,18 +123,18 @@ void cliques(const std::vector<std::vector<bool>>& adj, std::vector<int> R, std:
 
 // The maximal feasible subsets of a clique that is not feasible as a whole
 // (pairwise compatibility does not imply joint): drop one index at a time.
-void feasible_subsets(const MatrixXd& E, const VectorXd& g, const std::vector<int>& C,
+void feasible_subsets(Checker& feasible, const std::vector<int>& C,
                       std::set<std::vector<int>>& seen, std::vector<std::vector<int>>& out,
                       size_t cap) {
-  if (!seen.insert(C).second || out.size() >= cap) return;
-  if (feasible(E, g, C)) {
+  if (!seen.insert(C).second || out.size() >= cap || feasible.exhausted) return;
+  if (feasible(C)) {
     out.push_back(C);
     return;
   }
   for (size_t i = 0; i < C.size(); ++i) {
     std::vector<int> D = C;
     D.erase(D.begin() + static_cast<std::ptrdiff_t>(i));
-    feasible_subsets(E, g, D, seen, out, cap);
+    feasible_subsets(feasible, D, seen, out, cap);
   }
 }
 
@@ -118,16 +146,17 @@ bool subset_of(const std::vector<int>& a, const std::vector<int>& b) {
 
 bool can_be_active_together(const MechanicalModel& m, std::vector<int> J) {
   std::sort(J.begin(), J.end());
-  return feasible(MatrixXd(m.E), m.g, J);
+  return feasible_exact(MatrixXd(m.E), m.g, J);
 }
 
 CoactiveSets coactive_sets(const MechanicalModel& m, size_t max_sets) {
   CoactiveSets out;
   const int k = m.num_constraints();
   const MatrixXd E(m.E);
+  Checker feasible{E, m.g, kMaxChecks};
   std::vector<int> single;
   for (int i = 0; i < k; ++i) {
-    if (feasible(E, m.g, {i}))
+    if (feasible({i}))
       single.push_back(i);
     else
       out.never_active.push_back(i);
@@ -136,7 +165,7 @@ CoactiveSets coactive_sets(const MechanicalModel& m, size_t max_sets) {
   for (size_t a = 0; a < single.size(); ++a)
     for (size_t b = a + 1; b < single.size(); ++b) {
       const int i = single[a], j = single[b];
-      if (feasible(E, m.g, {i, j}))
+      if (feasible({i, j}))
         adj[i][j] = adj[j][i] = true;
       else
         out.exclusive_pairs.emplace_back(i, j);
@@ -145,8 +174,8 @@ CoactiveSets coactive_sets(const MechanicalModel& m, size_t max_sets) {
   cliques(adj, {}, single, {}, cl, max_sets, out.complete);
   std::set<std::vector<int>> seen;
   std::vector<std::vector<int>> sets;
-  for (const auto& C : cl) feasible_subsets(E, m.g, C, seen, sets, max_sets);
-  if (sets.size() >= max_sets) out.complete = false;
+  for (const auto& C : cl) feasible_subsets(feasible, C, seen, sets, max_sets);
+  if (sets.size() >= max_sets || feasible.exhausted) out.complete = false;
   // Keep the maximal ones (a dropped-index subset may lie in another clique).
   for (const auto& S : sets) {
     const bool dominated = std::any_of(sets.begin(), sets.end(), [&](const auto& T) {
@@ -159,39 +188,62 @@ CoactiveSets coactive_sets(const MechanicalModel& m, size_t max_sets) {
   return out;
 }
 
+namespace {
+
+// Sub-matrix (J, J).
+MatrixXd principal(const MatrixXd& X, const std::vector<int>& J) {
+  const auto n = static_cast<Eigen::Index>(J.size());
+  MatrixXd S(n, n);
+  for (Eigen::Index a = 0; a < n; ++a)
+    for (Eigen::Index b = 0; b < n; ++b) S(a, b) = X(J[a], J[b]);
+  return S;
+}
+
+// The leading row (or column) coefficient matrix (3.39) of the LCS restricted
+// to J. Row i's leading index in the restricted system is never below the
+// full one's (lower Markov parameters vanish on every column) and equals it
+// when the full coefficient matrix has X(i, i) != 0; then the restricted
+// matrix is the principal submatrix X(J, J). Otherwise it is computed.
+MatrixXd restricted_coefficients(const lcs::Lcs& sys, const MatrixXd& X, const std::vector<int>& J,
+                                 bool rows) {
+  if (std::all_of(J.begin(), J.end(), [&](int i) { return X(i, i) != 0.0; }))
+    return principal(X, J);
+  const auto n = static_cast<Eigen::Index>(J.size());
+  lcs::Lcs sub;
+  sub.A = sys.A;
+  sub.B.resize(sys.n(), n);
+  sub.C.resize(n, sys.n());
+  for (Eigen::Index a = 0; a < n; ++a) {
+    sub.B.col(a) = sys.B.col(J[a]);
+    sub.C.row(a) = sys.C.row(J[a]);
+  }
+  sub.D = principal(sys.D, J);
+  const std::vector<int> idx =
+      rows ? lcs::leading_row_indices(sub) : lcs::leading_column_indices(sub);
+  if (std::any_of(idx.begin(), idx.end(), [](int i) { return i == lcs::kInfiniteIndex; }))
+    return MatrixXd::Zero(n, n);  // a zero row: not a P-matrix
+  return rows ? lcs::leading_row_coefficients(sub) : lcs::leading_column_coefficients(sub);
+}
+
+}  // namespace
+
 CoactiveWellPosedness coactive_well_posedness(const MechanicalModel& m, const CoactiveSets& s) {
   CoactiveWellPosedness out;
   const lcs::Lcs sys = to_lcs(m);
   const MatrixXd W = delassus(m);
   const MatrixXd E(m.E);
+  // Infinite indices leave zero rows (columns): X(i, i) = 0 sends those sets
+  // to the restricted computation.
+  const MatrixXd R = lcs::leading_row_coefficients(sys);
+  const MatrixXd Cc = lcs::leading_column_coefficients(sys);
   for (const auto& J : s.maximal) {
     CoactiveWellPosedness::Set r;
     r.indices = J;
-    const auto n = static_cast<Eigen::Index>(J.size());
-    MatrixXd WJ(n, n);
-    for (Eigen::Index a = 0; a < n; ++a)
-      for (Eigen::Index b = 0; b < n; ++b) WJ(a, b) = W(J[a], J[b]);
-    r.rank = n ? lcs::numerical_rank(rows_of(E, J)) : 0;
-    r.delassus_p_matrix = n == 0 || lcp::is_p_matrix(WJ);
-    lcs::Lcs sub;
-    sub.A = sys.A;
-    sub.B.resize(sys.n(), n);
-    sub.C.resize(n, sys.n());
-    sub.D.resize(n, n);
-    for (Eigen::Index a = 0; a < n; ++a) {
-      sub.B.col(a) = sys.B.col(J[a]);
-      sub.C.row(a) = sys.C.row(J[a]);
-      for (Eigen::Index b = 0; b < n; ++b) sub.D(a, b) = sys.D(J[a], J[b]);
-    }
-    const std::vector<int> rho = lcs::leading_row_indices(sub);
-    const std::vector<int> eta = lcs::leading_column_indices(sub);
-    const auto finite = [](const std::vector<int>& v) {
-      return std::none_of(v.begin(), v.end(), [](int i) { return i == lcs::kInfiniteIndex; });
-    };
-    r.row_p_matrix =
-        n == 0 || (finite(rho) && lcp::is_p_matrix(lcs::leading_row_coefficients(sub)));
-    r.column_p_matrix =
-        n == 0 || (finite(eta) && lcp::is_p_matrix(lcs::leading_column_coefficients(sub)));
+    const bool empty = J.empty();
+    r.rank = empty ? 0 : lcs::numerical_rank(rows_of(E, J));
+    r.delassus_p_matrix = empty || p_matrix(principal(W, J));
+    r.row_p_matrix = empty || p_matrix(restricted_coefficients(sys, R, J, true));
+    r.column_p_matrix = empty || p_matrix(restricted_coefficients(sys, Cc, J, false));
     out.sets.push_back(std::move(r));
   }
   out.all_delassus_p = std::all_of(out.sets.begin(), out.sets.end(),

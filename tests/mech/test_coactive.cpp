@@ -94,5 +94,26 @@ TEST(Coactive, InfeasibleRowsAreNeverActive) {
   EXPECT_TRUE(s.maximal.empty());
 }
 
+// The cart chain with stops (q_i >= -1) and hooks (q_{i+1} - q_i <= 0.5).
+// By hand: closed hooks split the carts into runs moved rigidly 0.5 m apart;
+// in a run only its leftmost cart's stop can close (closing cart j's stop puts
+// the carts to its left below -1), and an open hook cannot close without
+// joining two runs whose two closed stops then contradict. So each of the
+// 2^(n-1) hook patterns gives exactly one maximal set: 2048 for n = 12, each
+// a forest of rows (independent), so no set is dependent. For n = 20, 2^19
+// sets exceed the cap: the enumeration says it is incomplete.
+TEST(Coactive, CartChainHasOneMaximalSetPerHookPattern) {
+  ChainSpec spec;
+  spec.n = 12;
+  spec.hooks = true;
+  const Model chain = chain_model(spec);
+  const CoactiveSets s = coactive_sets(*chain.mechanical);
+  EXPECT_TRUE(s.complete);
+  EXPECT_EQ(s.maximal.size(), 2048u);
+  EXPECT_FALSE(coactive_well_posedness(*chain.mechanical, s).dependent);
+  spec.n = 20;
+  EXPECT_FALSE(coactive_sets(*chain_model(spec).mechanical).complete);
+}
+
 }  // namespace
 }  // namespace lcsim::mech
