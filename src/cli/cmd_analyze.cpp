@@ -5,9 +5,11 @@
 // LCS (Markov parameters (3.32), leading indices and coefficient matrices
 // (3.39), Theorem 3.6.3, passivity §7.2, backward Euler guard §7.3).
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -15,6 +17,7 @@
 #include "io/io.hpp"
 #include "lcp/lcp.hpp"
 #include "lcs/lcs.hpp"
+#include "mech/mech.hpp"
 
 namespace lcsim::cli {
 namespace {
@@ -64,6 +67,98 @@ nlohmann::json indices_json(const std::vector<int>& v) {
   return a;
 }
 
+// Sets of constraints that can be active together and the verdicts on them
+// (mech::coactive_sets): enumerated for at most this many constraints (pairs
+// are k^2 / 2 small LCPs; a 7-joint arm has 14 rows).
+constexpr int kMaxCoactiveConstraints = 64;
+
+struct Coactive {
+  mech::CoactiveSets sets;
+  mech::CoactiveWellPosedness wp;
+};
+
+// Theorem 3.6.3 holds on every set found (CoactiveWellPosedness::
+// locally_well_posed also asks that the enumeration be complete).
+bool all_found_pass(const Coactive& c) {
+  return std::all_of(c.wp.sets.begin(), c.wp.sets.end(),
+                     [](const auto& r) { return r.row_p_matrix && r.column_p_matrix; });
+}
+
+Coactive coactive(const mech::MechanicalModel& m) {
+  Coactive c;
+  c.sets = mech::coactive_sets(m);
+  c.wp = mech::coactive_well_posedness(m, c.sets);
+  return c;
+}
+
+std::string names_text(const mech::MechanicalModel& m, const std::vector<int>& J) {
+  std::string s = "{";
+  for (std::size_t i = 0; i < J.size(); ++i) s += (i ? ", " : "") + m.constraints[J[i]];
+  return s + "}";
+}
+
+nlohmann::json names_json(const mech::MechanicalModel& m, const std::vector<int>& J) {
+  nlohmann::json a = nlohmann::json::array();
+  for (int i : J) a.push_back(m.constraints[i]);
+  return a;
+}
+
+nlohmann::json coactive_json(const mech::MechanicalModel& m, const Coactive& c) {
+  nlohmann::json j;
+  nlohmann::json sets = nlohmann::json::array();
+  for (const auto& s : c.wp.sets)
+    sets.push_back({{"constraints", names_json(m, s.indices)},
+                    {"rank", s.rank},
+                    {"delassus_p_matrix", s.delassus_p_matrix},
+                    {"row_p_matrix", s.row_p_matrix},
+                    {"column_p_matrix", s.column_p_matrix}});
+  j["maximal_sets"] = std::move(sets);
+  nlohmann::json pairs = nlohmann::json::array();
+  for (const auto& [a, b] : c.sets.exclusive_pairs)
+    pairs.push_back({m.constraints[a], m.constraints[b]});
+  j["exclusive_pairs"] = std::move(pairs);
+  j["never_active"] = names_json(m, c.sets.never_active);
+  j["complete"] = c.sets.complete;
+  j["dependent"] = c.wp.dependent;
+  j["delassus_p_matrix"] = c.wp.all_delassus_p;
+  // Undecided (null) when the enumeration was cut short and every set found passed.
+  j["locally_well_posed"] = !c.sets.complete && all_found_pass(c)
+                                ? nlohmann::json()
+                                : nlohmann::json(c.wp.locally_well_posed);
+  j["note"] =
+      "verdicts on the maximal sets of constraints that can be active together (some admissible "
+      "q closes them all); other sets never reach an impact LCP or a mode";
+  return j;
+}
+
+std::string coactive_text(const mech::MechanicalModel& m, const Coactive& c) {
+  std::ostringstream out;
+  out << "  sets active together (some admissible q closes them all): " << c.wp.sets.size()
+      << " maximal" << (c.sets.complete ? "" : " (enumeration cut short)") << "\n";
+  constexpr std::size_t kShown = 8;
+  for (std::size_t i = 0; i < c.wp.sets.size() && i < kShown; ++i) {
+    const auto& s = c.wp.sets[i];
+    out << "    " << names_text(m, s.indices) << "  rank " << s.rank
+        << ", Delassus P: " << (s.delassus_p_matrix ? "yes" : "no") << ", Theorem 3.6.3: "
+        << (s.row_p_matrix && s.column_p_matrix ? "applies" : "does not apply") << "\n";
+  }
+  if (c.wp.sets.size() > kShown) out << "    ... (" << c.wp.sets.size() - kShown << " more)\n";
+  if (!c.sets.exclusive_pairs.empty())
+    out << "  never active together: " << c.sets.exclusive_pairs.size() << " pairs, e.g. "
+        << m.constraints[c.sets.exclusive_pairs[0].first] << " and "
+        << m.constraints[c.sets.exclusive_pairs[0].second] << "\n";
+  if (!c.sets.never_active.empty())
+    out << "  never active at all: " << names_text(m, c.sets.never_active) << "\n";
+  const bool undecided = !c.sets.complete && all_found_pass(c);
+  out << "  on " << (c.sets.complete ? "these sets" : "the sets found") << ": Delassus P-matrix "
+      << (c.wp.all_delassus_p ? "yes" : "no") << ", Theorem 3.6.3 "
+      << (undecided                 ? "applies on them (not decided on the sets not enumerated)"
+          : c.wp.locally_well_posed ? "applies"
+                                    : "does not apply")
+      << (c.wp.dependent ? "; some set has dependent rows (§4.6.1)" : "") << "\n";
+  return out.str();
+}
+
 void run_analyze(const AnalyzeArgs& args) {
   const mech::Model model = io::load_model(args.file);
   const std::vector<std::string> notes = io::model_notes(model);
@@ -96,8 +191,16 @@ void run_analyze(const AnalyzeArgs& args) {
         << " constraints, state (q, v) of size " << model.state_size() << "\n"
         << "M:           positive definite: smallest eigenvalue " << num(ev.minCoeff())
         << ", largest " << num(ev.maxCoeff()) << "\n"
-        << "rank E:      " << rank_e << " of " << m.num_constraints()
-        << (rank_e < m.num_constraints() ? "  (dependent constraints)" : "") << "\n";
+        << "rank E:      " << rank_e << " of " << m.num_constraints();
+    std::optional<Coactive> co;
+    if (m.num_constraints() > 0 && m.num_constraints() <= kMaxCoactiveConstraints) co = coactive(m);
+    if (rank_e < m.num_constraints())
+      out << (!co || co->wp.dependent ? "  (dependent constraints)"
+              : co->sets.complete
+                  ? "  (rows that cannot be active together, not dependent constraints)"
+                  : "  (rows that cannot be active together; dependent constraints in "
+                    "sets not enumerated not excluded)");
+    out << "\n";
     if (m.num_constraints() > 0) {
       const MatrixXd W = mech::delassus(m);
       const bool p = lcp::is_p_matrix(W);
@@ -108,6 +211,14 @@ void run_analyze(const AnalyzeArgs& args) {
           << (p ? "  (unique impulse)"
                 : "  (impulses may be non-unique; post-impact velocities still are, §4.6.1)")
           << "\n";
+      if (co) {
+        j["coactive"] = coactive_json(m, *co);
+        out << coactive_text(m, *co);
+      } else {
+        j["coactive"] = nullptr;
+        out << "  sets active together: not enumerated (k > " << kMaxCoactiveConstraints
+            << "); the verdicts below are on all k rows at once\n";
+      }
     } else {
       j["delassus"] = nlohmann::json::array();
       j["delassus_p_matrix"] = nullptr;
@@ -161,8 +272,16 @@ void run_analyze(const AnalyzeArgs& args) {
       << "  leading column coefficients (script N, (3.39)):\n"
       << matrix_text(wp.column_coefficients, "    ")
       << "    P-matrix: " << (wp.column_p_matrix ? "yes" : "no") << "\n"
-      << "  Theorem 3.6.3 (local well-posedness): "
-      << (wp.locally_well_posed ? "applies" : "does not apply") << "\n"
+      << "  Theorem 3.6.3 (local well-posedness), all k rows at once: "
+      << (wp.locally_well_posed ? "applies" : "does not apply")
+      << (j.contains("coactive") && !j["coactive"].is_null()
+              ? std::string("; on the sets that can be active together: ") +
+                    (j["coactive"]["locally_well_posed"].is_null()
+                         ? "not decided (enumeration cut short)"
+                     : j["coactive"]["locally_well_posed"].get<bool>() ? "applies"
+                                                                       : "does not apply")
+              : std::string())
+      << "\n"
       << "  passive (§7.2): " << wp.passive
       << (wp.passivity_reason.empty() ? "" : " (" + wp.passivity_reason + ")") << "\n"
       << "  backward Euler (§7.3): "

@@ -1,5 +1,7 @@
 // `lcsim compare MODEL --h H`: the model run in Bullet beside lcsim's exact
-// event-driven solution (bullet::compare_trajectories):
+// event-driven solution of the nearest exact law (io::reference_law: the
+// inelastic one when the model has restitution, which Bullet loses at the
+// scene's stop ERP) (bullet::compare_trajectories):
 //   deviation_max  largest max-abs state difference over the Bullet samples
 //                  (on a grid that is a multiple of h, at most ~2000 points;
 //                  the exact run is sampled on the same grid),
@@ -19,6 +21,7 @@
 #include "cli/command.hpp"
 #include "cli/run_inputs.hpp"
 #include "io/io.hpp"
+#include "io/sweep.hpp"
 #include "sim/sim.hpp"
 
 namespace lcsim::cli {
@@ -52,7 +55,10 @@ void run_compare(const CompareArgs& a) {
   // Comparison grid: a multiple of h, at most ~2000 points (as lcsim sweep).
   opt.dt_out = std::max(1.0, std::round(opt.t_end / (2000.0 * a.h))) * a.h;
 
-  const sim::Trajectory exact = sim::make_integrator("event")->run(model, x0, opt);
+  // Like with like (issue 13): Bullet loses restitution at the scene's stop
+  // ERP, so its exact counterpart is the nearest exact law (io::reference_law).
+  const io::ReferenceLaw law = io::reference_law("bullet", opt.impact, model);
+  const sim::Trajectory exact = io::run_reference(model, x0, law, opt);
   if (exact.status != sim::RunStatus::kCompleted)
     throw NumericalError("compare: the exact event-driven run failed: " + exact.message);
   if (!(a.stop_erp > 0.0 && a.stop_erp <= 1.0))
@@ -86,6 +92,8 @@ void run_compare(const CompareArgs& a) {
     j["unmatched_bullet_switches"] = c.unmatched_other;
     j["energy_drift"] = c.energy_drift;
     j["max_violation"] = c.max_violation;
+    j["reference_law"] = law.label();
+    j["reference_reason"] = law.reason;
     j["bullet_solver"] = bullet::solver_description(ws);
     j["stop_erp"] = ws.stop_erp;
     j["bullet_version"] = bullet::version_string();
@@ -97,6 +105,7 @@ void run_compare(const CompareArgs& a) {
   std::printf("model %s, t_end %g, h %g: %s, %s, stop ERP %g\n", model.name.c_str(), opt.t_end, a.h,
               bullet::version_string().c_str(), bullet::solver_description(ws).c_str(),
               ws.stop_erp);
+  std::printf("reference      exact run, %s (%s)\n", law.label().c_str(), law.reason.c_str());
   std::printf("deviation max  %.3e (at t = %.6g)\n", c.deviation_max, c.deviation_t);
   std::printf("error final    %.3e\n", c.error_final);
   std::printf("energy drift   %.3e J (Bullet's change minus the exact change)\n", c.energy_drift);

@@ -3,10 +3,12 @@
 //
 //   lcsim impacts MODEL [--x0 q,v] [--rules all|a,b] [--restitution e|e1,e2,..] [--json]
 //   lcsim impacts MODEL --map lo:hi[:n],lo:hi[:n] [--x0 q,v] [--plot map.png]  (q = 0 by default)
+//   lcsim impacts MODEL --map ... --closed a,b   (any model: the map over the
+//                                                 approach velocities of a, b)
 //
 // The closed set is the constraints with zero gap at q, with the integrator's
-// tolerance |gap| <= 1e-9 (|E_i||q| + |g_i|) + 1e-13. Exit 2 on bad input, 3
-// if a rule failed (the table is printed first).
+// tolerance |gap| <= 1e-9 (|E_i||q| + |g_i|) + 1e-13 (src/io/impact_map.hpp). Exit 2 on bad input,
+// 3 if a rule failed (the table is printed first).
 #include <unistd.h>
 
 #include <cmath>
@@ -21,6 +23,7 @@
 #include "cli/output.hpp"
 #include "cli/run_inputs.hpp"
 #include "impact/impact.hpp"
+#include "io/impact_map.hpp"
 #include "io/io.hpp"
 
 namespace lcsim::cli {
@@ -34,6 +37,7 @@ struct ImpactsArgs {
   bool json = false;
   std::string map;
   std::string plot;
+  std::string closed;
 };
 
 std::string fmt_vec(const Eigen::VectorXd& v) {
@@ -82,24 +86,6 @@ Eigen::VectorXd restitution(const ImpactsArgs& a, const mech::MechanicalModel& m
   return e;
 }
 
-// Closed set at q; an open-violated constraint is an input error.
-impact::IndexSet closed_set(const mech::MechanicalModel& m, const Eigen::VectorXd& q) {
-  const Eigen::VectorXd gap = m.E * q + m.g;
-  const Eigen::VectorXd scale = m.E.cwiseAbs() * q.cwiseAbs() + m.g.cwiseAbs();
-  impact::IndexSet closed;
-  for (int i = 0; i < m.num_constraints(); ++i) {
-    const bool zero = std::abs(gap(i)) <= 1e-9 * scale(i) + 1e-13;
-    if (!zero && gap(i) < 0.0) {
-      std::ostringstream msg;
-      msg << "--x0: constraint '" << m.constraints[i] << "' is violated (gap = " << gap(i)
-          << "): E q + g >= 0 must hold before an impact (thesis §3.8)";
-      throw io::InputError(msg.str());
-    }
-    if (zero) closed.push_back(i);
-  }
-  return closed;
-}
-
 std::vector<std::string> rule_list(const std::string& text) {
   if (text == "all") return impact::impact_law_names();
   std::vector<std::string> out = split(text, ',');
@@ -117,7 +103,7 @@ void run_compare(const ImpactsArgs& a, const mech::Model& model) {
   in.model = &m;
   in.q = x0.head(N);
   in.v = x0.tail(N);
-  in.closed = closed_set(m, in.q);
+  in.closed = io::closed_constraints(m, in.q, "--x0");
   in.restitution = restitution(a, m);
   const auto solver = lcp::make_solver("pivot");
   std::vector<std::pair<std::string, impact::ImpactResult>> results;
@@ -173,34 +159,6 @@ void run_compare(const ImpactsArgs& a, const mech::Model& model) {
   if (!failures.empty()) throw NumericalError(failures);
 }
 
-struct Range {
-  double lo, hi;
-  int n;
-};
-
-Range parse_range(const std::string& text) {
-  const std::vector<std::string> parts = split(text, ':');
-  const std::string what = "--map: range '" + text + "'";
-  if (parts.size() < 2 || parts.size() > 3)
-    throw io::InputError(what + ": expected lo:hi or lo:hi:n");
-  Range r{};
-  try {
-    size_t pos = 0;
-    r.lo = std::stod(parts[0], &pos);
-    if (pos != parts[0].size()) throw std::invalid_argument("");
-    r.hi = std::stod(parts[1], &pos);
-    if (pos != parts[1].size()) throw std::invalid_argument("");
-    r.n = parts.size() == 3 ? std::stoi(parts[2], &pos) : 41;
-    if (parts.size() == 3 && pos != parts[2].size()) throw std::invalid_argument("");
-  } catch (const std::exception&) {
-    throw io::InputError(what + ": not numbers");
-  }
-  if (!std::isfinite(r.lo) || !std::isfinite(r.hi) || !(r.lo < r.hi))
-    throw io::InputError(what + ": need finite lo < hi");
-  if (r.n < 2 || r.n > 2001) throw io::InputError(what + ": n must lie in [2, 2001]");
-  return r;
-}
-
 // bench/plot_impact_map.py (or $LCSIM_PLOT_IMPACT_MAP).
 std::filesystem::path impact_map_script() {
   return find_plot_script("plot_impact_map.py", "LCSIM_PLOT_IMPACT_MAP");
@@ -208,46 +166,36 @@ std::filesystem::path impact_map_script() {
 
 void run_map(const ImpactsArgs& a, const mech::Model& model) {
   const mech::MechanicalModel& m = *model.mechanical;
-  if (m.dofs() != 2)
-    throw io::InputError("--map: needs a model with two coordinates, '" + model.name + "' has " +
-                         std::to_string(m.dofs()));
+  const int N = m.dofs();
   const std::vector<std::string> ranges = split(a.map, ',');
   if (ranges.size() != 2) throw io::InputError("--map: expected v1range,v2range (lo:hi[:n] each)");
-  const Range r1 = parse_range(ranges[0]), r2 = parse_range(ranges[1]);
+  io::ImpactMapSpec spec;
+  spec.axis1 = io::parse_map_range(ranges[0], "--map");
+  spec.axis2 = io::parse_map_range(ranges[1], "--map");
+  if (!a.closed.empty()) spec.closed = io::parse_constraint_list(m, a.closed, "--closed");
   // Figure 3.5 is drawn at x1 = x2 = 0: q = 0 unless --x0 gives another q.
-  const Eigen::VectorXd x0 = a.x0.empty() ? Eigen::VectorXd::Zero(4) : initial_state(a, model);
-  impact::ImpactInput in;
-  in.model = &m;
-  in.q = x0.head(2);
-  in.closed = closed_set(m, in.q);
-  if (static_cast<int>(in.closed.size()) != m.num_constraints())
-    throw io::InputError("--map: every gap must be zero at q = " + fmt_vec(in.q) +
-                         " (Figure 3.5 is drawn at x1 = x2 = 0)");
-  in.restitution = restitution(a, m);
-  const auto law = impact::make_impact_law("moreau");
-  const auto solver = lcp::make_solver("pivot");
-  std::ostringstream csv;
-  csv.precision(10);
-  csv << "v1,v2,mode,v1+,v2+\n";
-  for (int i = 0; i < r1.n; ++i)
-    for (int j = 0; j < r2.n; ++j) {
-      in.v.resize(2);
-      in.v << r1.lo + (r1.hi - r1.lo) * i / (r1.n - 1), r2.lo + (r2.hi - r2.lo) * j / (r2.n - 1);
-      const impact::ImpactResult r = law->apply(in, *solver);
-      if (!r.ok)
-        throw NumericalError("--map: moreau failed at v = " + fmt_vec(in.v) + ": " + r.message);
-      csv << in.v(0) << "," << in.v(1) << "," << mode_text(m, r.mode, "+") << "," << r.v_after(0)
-          << "," << r.v_after(1) << "\n";
-    }
-  std::cout << csv.str();
+  // With --closed and no --x0, q is placed on the named contacts.
+  const Eigen::VectorXd x0 = a.x0.empty() ? Eigen::VectorXd::Zero(2 * N) : initial_state(a, model);
+  spec.q = x0.head(N);
+  spec.v0 = x0.tail(N);
+  if (a.x0.empty() && spec.closed.size() == 2)
+    spec.q = io::close_contacts(m, spec.q, spec.closed, "--closed");
+  spec.restitution = restitution(a, m);
+  const io::ImpactMap map = io::impact_map(m, spec);
+  if (!map.failure.empty()) throw NumericalError("--map: " + map.failure);
+  const std::string csv = io::impact_map_csv(m, map);
+  std::cout << csv;
   std::cout.flush();
   if (a.plot.empty()) return;
   const std::filesystem::path tmp = std::filesystem::temp_directory_path() /
                                     ("lcsim_impact_map_" + std::to_string(::getpid()) + ".csv");
-  io::write_file_atomic(tmp, csv.str());
+  io::write_file_atomic(tmp, csv);
+  const std::string title = spec.closed.empty()
+                                ? model.name + ": Moreau impact map (Figure 3.5)"
+                                : model.name + ": Moreau impact map, closed " + map.axes[0] +
+                                      " (x), " + map.axes[1] + " (y) at q = " + fmt_vec(spec.q);
   try {
-    draw_plot(impact_map_script(), tmp, a.plot, model.name + ": Moreau impact map (Figure 3.5)",
-              "--plot");
+    draw_plot(impact_map_script(), tmp, a.plot, title, "--plot");
   } catch (...) {
     std::filesystem::remove(tmp);
     throw;
@@ -261,6 +209,7 @@ void run_impacts(const ImpactsArgs& a) {
   if (!model.is_mechanical())
     throw io::InputError(a.model + ": impact rules need a mechanical model (M, E), not `lcs:`");
   if (!a.plot.empty() && a.map.empty()) throw io::InputError("--plot: only with --map");
+  if (!a.closed.empty() && a.map.empty()) throw io::InputError("--closed: only with --map");
   if (!a.plot.empty()) {  // checked before the map is computed, not after
     check_writable(a.plot);
     (void)impact_map_script();
@@ -286,6 +235,9 @@ void setup(CLI::App& app) {
   cmd->add_option(
       "--map", a->map,
       "Impact map of a two-coordinate model: v1lo:v1hi[:n],v2lo:v2hi[:n] (CSV on stdout)");
+  cmd->add_option("--closed", a->closed,
+                  "With --map: the two contacts to close, by name or 0-based index (a,b); the "
+                  "map is over their approach velocities");
   cmd->add_option("--plot", a->plot, "With --map: draw the map to this PNG (matplotlib)");
   cmd->callback([a] { run_impacts(*a); });
 }

@@ -1,22 +1,15 @@
 // `lcsim sweep MODEL`: the speed–accuracy trade, measured. Runs each method at
-// each step h and compares it with the exact event-driven solution:
-//   error_final    max-abs difference of the final states,
-//   error_max      largest max-abs state difference over the comparison grid
-//                  (the time-stepping samples at multiples of dt_cmp, a
-//                  multiple of h with at most ~2000 points per run, against the
-//                  event-driven run sampled exactly on the same grid; at a
-//                  jump the exact run has two samples, before and after, and
-//                  the nearer one counts),
-//   max_violation  the run's most negative gap,
-//   energy_drift   (E_final - E_initial) of the run minus that of the exact run,
-//   steps, lcp_solves, wall_time_s (median of --repeat runs without samples).
+// each step h and compares it with an exact event-driven run of the same
+// impact law, or of the nearest exact law where the method has none (the
+// computation, the reference laws and the row's fields: src/io/sweep.hpp).
+// Each row names its reference law and carries its run's warnings and the
+// reference's (count and first message).
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -26,6 +19,7 @@
 #include "cli/output.hpp"
 #include "cli/run_inputs.hpp"
 #include "io/io.hpp"
+#include "io/sweep.hpp"
 #include "sim/sim.hpp"
 
 namespace lcsim::cli {
@@ -44,6 +38,7 @@ struct SweepArgs {
   bool json = false;
   std::string plot;
   std::string lcp = "pivot";
+  std::string impact = sim::Options{}.impact;
 };
 
 std::vector<std::string> split_list(const std::string& s) {
@@ -55,186 +50,68 @@ std::vector<std::string> split_list(const std::string& s) {
   return out;
 }
 
-struct Row {
-  std::string method;
-  double h = 0.0;  // 0 for event
-  double error_final = 0.0, error_max = 0.0, max_violation = 0.0, energy_drift = 0.0;
-  long steps = 0, lcp_solves = 0;
-  double wall_time_s = 0.0;
-  std::string status = "completed";
-};
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+std::string warning_text(int count, const std::string& first) {
+  if (count == 0) return "0";
+  return std::to_string(count) + " (" + first + ")";
 }
 
-// Largest max-abs state error of the time-stepping samples against the exact
-// samples on the same grid (both sorted by time).
-double max_sample_error(const sim::Trajectory& ts, const sim::Trajectory& exact, double h) {
-  double worst = 0.0;
-  size_t e = 0;
-  for (const auto& s : ts.samples) {
-    const double tol = 1e-9 * std::max(h, std::abs(s.t) * 1e-6);
-    while (e < exact.samples.size() && exact.samples[e].t < s.t - tol) ++e;
-    double best = std::numeric_limits<double>::infinity();
-    for (size_t j = e; j < exact.samples.size() && exact.samples[j].t <= s.t + tol; ++j)
-      best = std::min(best, (s.x - exact.samples[j].x).cwiseAbs().maxCoeff());
-    if (std::isfinite(best)) worst = std::max(worst, best);
+void print_text(const io::SweepResult& s, const std::string& x0_from) {
+  std::printf("model %s, t_end %g, --impact %s, x0 from %s\n", s.model.c_str(), s.t_end,
+              s.impact.c_str(), x0_from.c_str());
+  std::printf("%-12s %-8s %-24s %-11s %-11s %-11s %-11s %-9s %-9s %-10s\n", "method", "h",
+              "reference law", "err_final", "err_max", "violation", "E_drift", "steps", "lcp",
+              "wall_s");
+  for (const auto& r : s.rows) {
+    char hbuf[32];
+    if (r.method == "event")
+      std::snprintf(hbuf, sizeof hbuf, "-");
+    else
+      std::snprintf(hbuf, sizeof hbuf, "%g", r.h);
+    std::printf("%-12s %-8s %-24s %-11.3e %-11.3e %-11.3e %-11.3e %-9ld %-9ld %-10.3e%s\n",
+                r.method.c_str(), hbuf, r.reference.label().c_str(), r.error_final, r.error_max,
+                r.max_violation, r.energy_drift, r.steps, r.lcp_solves, r.wall_time_s,
+                r.status == "completed" ? "" : ("  " + r.status).c_str());
+    if (r.warnings > 0)
+      std::printf("    warnings: %s\n", warning_text(r.warnings, r.first_warning).c_str());
+    if (r.method != "event" && r.reference_warnings > 0)
+      std::printf("    reference warnings: %s\n",
+                  warning_text(r.reference_warnings, r.reference_first_warning).c_str());
   }
-  return worst;
-}
-
-nlohmann::json rows_json(const std::string& model, const std::vector<Row>& rows) {
-  nlohmann::json j;
-  j["model"] = model;
-  j["rows"] = nlohmann::json::array();
-  for (const auto& r : rows) {
-    nlohmann::json o;
-    o["method"] = r.method;
-    o["h"] = r.method == "event" ? nlohmann::json(nullptr) : nlohmann::json(r.h);
-    o["error_final"] = r.error_final;
-    o["error_max"] = r.error_max;
-    o["max_violation"] = r.max_violation;
-    o["energy_drift"] = r.energy_drift;
-    o["steps"] = r.steps;
-    o["lcp_solves"] = r.lcp_solves;
-    o["wall_time_s"] = r.wall_time_s;
-    o["status"] = r.status;
-    j["rows"].push_back(o);
+  std::printf("reference laws:\n");
+  std::vector<std::string> seen;
+  for (const auto& r : s.rows) {
+    const std::string line = r.method + ": " + r.reference.label() + " -- " + r.reference.reason;
+    if (std::find(seen.begin(), seen.end(), line) != seen.end()) continue;
+    seen.push_back(line);
+    std::printf("  %s\n", line.c_str());
   }
-  return j;
 }
 
 void run_sweep(const SweepArgs& a) {
   const mech::Model model = io::load_model(a.model);
-  const std::vector<std::string> methods = split_list(a.methods);
-  if (methods.empty()) throw io::InputError("--methods: empty list");
-  std::vector<std::unique_ptr<sim::Integrator>> integrators;
-  for (const auto& m : methods) {
-    try {
-      integrators.push_back(sim::make_integrator(m));
-    } catch (const std::invalid_argument& e) {
-      throw io::InputError(std::string("--methods: ") + e.what());
-    }
-  }
-  (void)lcp::make_solver(a.lcp);
-  std::vector<double> hs;
-  for (const auto& tok : split_list(a.hs)) {
-    const Eigen::VectorXd v = io::parse_vector(tok, "--h");
-    hs.push_back(v(0));
-  }
-  if (hs.empty()) throw io::InputError("--h: empty list");
-
+  io::SweepOptions o;
+  o.methods = split_list(a.methods);
+  for (const auto& tok : split_list(a.hs)) o.hs.push_back(io::parse_vector(tok, "--h")(0));
+  o.repeat = a.repeat;
   const Eigen::VectorXd x0 = resolve_initial_state(model, a.model, a.x0);
-  sim::Options base;
-  base.t_end = resolve_horizon(model, a.model, a.t_end_given, a.t_end);
-  for (double h : hs)
-    if (!(h > 0.0) || !std::isfinite(h) || h > base.t_end)
-      throw io::InputError("--h: every step must be finite, > 0 and <= the horizon (got " +
-                           std::to_string(h) + ")");
-  if (a.repeat < 1) throw io::InputError("--repeat: must be >= 1");
-  if (!(a.theta >= 0.0 && a.theta <= 1.0)) throw io::InputError("--theta: must lie in [0, 1]");
-  base.theta = a.theta;
-  base.force = a.force;
-  base.lcp_solver = a.lcp;
+  o.base.t_end = resolve_horizon(model, a.model, a.t_end_given, a.t_end);
+  o.base.theta = a.theta;
+  o.base.force = a.force;
+  o.base.lcp_solver = a.lcp;
+  o.base.impact = a.impact;
+  o.progress = [](const std::string& line) { std::cerr << "sweep: " << line << "\n"; };
   // The plot's path and script are checked before the runs, not after.
   std::filesystem::path script;
   if (!a.plot.empty()) {
     check_writable(a.plot);
     script = find_plot_script("plot_work_precision.py", "LCSIM_PLOT_WORK_PRECISION");
   }
-
-  // The exact reference: event-driven, final state and energy change.
-  sim::Options ex_opt = base;
-  ex_opt.dt_out = 0.0;
-  const auto event = sim::make_integrator("event");
-  const sim::Trajectory exact = event->run(model, x0, ex_opt);
-  if (exact.status != sim::RunStatus::kCompleted)
-    throw NumericalError("sweep: the exact event-driven run failed: " + exact.message);
-  const double exact_drift = exact.energy_final - exact.energy_initial;
-
-  auto timed = [&](const sim::Integrator& integ, sim::Options opt) {
-    opt.record_samples = false;
-    opt.dt_out = 0.0;
-    std::vector<double> times;
-    for (int r = 0; r < a.repeat; ++r) times.push_back(integ.run(model, x0, opt).wall_time_s);
-    return median(times);
-  };
-
-  std::vector<Row> rows;
-  const size_t total = integrators.size() * hs.size();
-  size_t done = 0;
-  for (size_t mi = 0; mi < integrators.size(); ++mi) {
-    const sim::Integrator& integ = *integrators[mi];
-    if (methods[mi] == "event") {
-      Row r;
-      r.method = "event";
-      r.max_violation = exact.max_violation;
-      r.steps = exact.steps;
-      r.lcp_solves = exact.lcp_solves;
-      r.wall_time_s = timed(integ, ex_opt);
-      rows.push_back(r);
-      done += hs.size();
-      std::cerr << "sweep: [" << done << "/" << total << "] event done\n";
-      continue;
-    }
-    for (double h : hs) {
-      sim::Options opt = base;
-      opt.h = h;
-      // Comparison grid: a multiple of h, at most ~2000 points.
-      const double m = std::max(1.0, std::round(base.t_end / (2000.0 * h)));
-      opt.dt_out = m * h;
-      Row r;
-      r.method = methods[mi];
-      r.h = h;
-      const sim::Trajectory tr = integ.run(model, x0, opt);
-      if (tr.status != sim::RunStatus::kCompleted) {
-        r.status = "failed: " + tr.message;
-        r.error_final = r.error_max = std::numeric_limits<double>::infinity();
-      } else {
-        sim::Options eo = ex_opt;
-        eo.dt_out = opt.dt_out;
-        const sim::Trajectory ex_grid = event->run(model, x0, eo);
-        r.error_final = (tr.final_state - exact.final_state).cwiseAbs().maxCoeff();
-        r.error_max = ex_grid.status == sim::RunStatus::kCompleted
-                          ? max_sample_error(tr, ex_grid, h)
-                          : std::numeric_limits<double>::quiet_NaN();
-        r.error_max = std::max(r.error_max, r.error_final);
-        r.energy_drift = (tr.energy_final - tr.energy_initial) - exact_drift;
-        r.wall_time_s = timed(integ, opt);
-      }
-      r.max_violation = tr.max_violation;
-      r.steps = tr.steps;
-      r.lcp_solves = tr.lcp_solves;
-      rows.push_back(r);
-      ++done;
-      std::cerr << "sweep: [" << done << "/" << total << "] " << r.method << " h = " << h
-                << (r.status == "completed" ? "" : " (" + r.status + ")") << "\n";
-    }
-  }
-
-  const nlohmann::json j = rows_json(model.name, rows);
-  if (a.json) {
+  const io::SweepResult s = io::run_sweep(model, x0, o);
+  const nlohmann::json j = io::sweep_json(s);
+  if (a.json)
     std::cout << j.dump(2) << "\n";
-  } else {
-    std::printf("model %s, t_end %g, x0 from %s\n", model.name.c_str(), base.t_end,
-                a.x0.empty() ? "the model" : "--x0");
-    std::printf("%-12s %-8s %-11s %-11s %-11s %-11s %-9s %-9s %-10s\n", "method", "h", "err_final",
-                "err_max", "violation", "E_drift", "steps", "lcp", "wall_s");
-    for (const auto& r : rows) {
-      char hbuf[32];
-      if (r.method == "event")
-        std::snprintf(hbuf, sizeof hbuf, "-");
-      else
-        std::snprintf(hbuf, sizeof hbuf, "%g", r.h);
-      std::printf("%-12s %-8s %-11.3e %-11.3e %-11.3e %-11.3e %-9ld %-9ld %-10.3e%s\n",
-                  r.method.c_str(), hbuf, r.error_final, r.error_max, r.max_violation,
-                  r.energy_drift, r.steps, r.lcp_solves, r.wall_time_s,
-                  r.status == "completed" ? "" : ("  " + r.status).c_str());
-    }
-  }
+  else
+    print_text(s, a.x0.empty() ? "the model" : "--x0");
   std::cout.flush();
   if (!a.plot.empty()) {
     const std::filesystem::path tmp = std::filesystem::temp_directory_path() /
@@ -249,6 +126,10 @@ void run_sweep(const SweepArgs& a) {
     std::filesystem::remove(tmp);
     std::cerr << "work-precision diagram written to " << a.plot << "\n";
   }
+  for (const auto& ref : s.references)
+    if (ref.status != "completed")
+      throw NumericalError("sweep: the exact reference run (" + ref.law.label() + ") " +
+                           ref.status);
 }
 
 void setup(CLI::App& app) {
@@ -258,10 +139,14 @@ void setup(CLI::App& app) {
   cmd->add_option("model", a->model, "Model file (YAML)")->required();
   cmd->add_option("--x0", a->x0, "Initial state a,b,... (q then v); default: the model's");
   auto* t_end = cmd->add_option("--t-end", a->t_end, "Horizon (s); default: the model's t_end");
-  cmd->add_option("--methods", a->methods, "Comma-separated: event, euler, moreau-jean");
+  cmd->add_option("--methods", a->methods, "Comma-separated: event, euler, moreau-jean, bullet");
   cmd->add_option("--h", a->hs, "Comma-separated step sizes (s), e.g. 1e-2,1e-3,1e-4");
   cmd->add_option("--repeat", a->repeat, "Timing runs per point (median); default 3");
   cmd->add_option("--theta", a->theta, "Moreau–Jean theta in [0, 1]; default 0.5");
+  cmd->add_option("--impact", a->impact,
+                  "Impact law of the event method (and of the reference of methods without "
+                  "a law of their own); default " +
+                      sim::Options{}.impact);
   cmd->add_flag("--force", a->force, "Run backward Euler even where it is not consistent");
   cmd->add_option("--lcp", a->lcp, "LCP solver: pivot, lemke, pgs, enum");
   cmd->add_flag("--json", a->json, "Print {\"rows\": [...]} as JSON");

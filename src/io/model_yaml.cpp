@@ -410,7 +410,27 @@ std::vector<std::string> model_notes(const mech::Model& model) {
       notes.push_back("no unilateral constraints: the model is a free linear system");
     } else {
       const int rank = mech::constraint_rank(m);
-      if (rank < k)
+      // Rows that can never be active together (the two limits of one joint)
+      // lower the rank of E without being dependent constraints: checked on
+      // the sets that can be active together when there are few rows.
+      bool dependent = rank < k;
+      if (dependent && k <= 64) {
+        const mech::CoactiveSets sets = mech::coactive_sets(m);
+        const Eigen::MatrixXd E(m.E);
+        dependent = !sets.complete ||
+                    std::any_of(sets.maximal.begin(), sets.maximal.end(), [&](const auto& J) {
+                      Eigen::MatrixXd EJ(J.size(), E.cols());
+                      for (size_t i = 0; i < J.size(); ++i) EJ.row(i) = E.row(J[i]);
+                      return lcs::numerical_rank(EJ) < static_cast<int>(J.size());
+                    });
+        if (!dependent)
+          notes.push_back("E (" + std::to_string(k) + " x " + std::to_string(m.dofs()) +
+                          ") has rank " + std::to_string(rank) + " < " + std::to_string(k) +
+                          " only through rows that cannot be active together (e.g. both limits "
+                          "of one joint): every set that can be active together has "
+                          "independent rows, so no constraints are dependent");
+      }
+      if (dependent)
         notes.push_back("dependent constraints: E (" + std::to_string(k) + " x " +
                         std::to_string(m.dofs()) + ") has rank " + std::to_string(rank) + " < " +
                         std::to_string(k) +

@@ -147,3 +147,57 @@ inline constexpr double kChainHookGap = 0.5;  // m
 Model chain_model(const ChainSpec& spec);
 
 }  // namespace lcsim::mech
+
+namespace lcsim::mech {
+
+// Index sets of constraints that can be active together (src/mech/coactive.cpp).
+//
+// A set J can be active together when some configuration closes all of J and
+// violates nothing: { q : E_J q + g_J = 0, E q + g >= 0 } is non-empty. The
+// two limits of one joint (rows e and -e with lower < upper) never can. Such
+// rows make E rank deficient without being dependent constraints in the sense
+// of §4.6.1 (an impulse split among rows that act together): they are never
+// in one LCP. Decided exactly (up to the zero test of a gap) by a least-squares
+// solve of the equalities and, on their solution set, Lemke's method on the
+// PSD LCP of the inequalities (see coactive.cpp); not by a test of opposite
+// parallel rows alone, which misses three or more rows that are pairwise but
+// not jointly closable.
+bool can_be_active_together(const MechanicalModel& m, std::vector<int> J);
+
+// The maximal sets that can be active together, found as the maximal cliques
+// of the pairwise graph (Bron-Kerbosch), each verified as a whole and split
+// into its maximal feasible subsets if it fails. Pairs and singletons are
+// tested exactly. At most `max_sets` sets (complete = false beyond: the
+// verdicts below then do not cover every set). Exponential in the worst case
+// (2^j sets for j joints with two limits each; 128 for a 7-joint arm).
+struct CoactiveSets {
+  std::vector<std::vector<int>> maximal;             // sorted, 0-based constraint indices
+  std::vector<std::pair<int, int>> exclusive_pairs;  // i < j never active together
+  std::vector<int> never_active;                     // no admissible q closes it
+  bool complete = true;
+};
+CoactiveSets coactive_sets(const MechanicalModel& m, size_t max_sets = 4096);
+
+// Theorem 3.6.3 and the P-property of the Delassus matrix evaluated on each
+// maximal set J that can be active together: the LCS (3.65) restricted to the
+// constraints J (B_.J, C_J., D_JJ), its leading row and column coefficient
+// matrices (3.39), and E_J M^{-1} E_J'. Near an admissible state only the
+// constraints with zero gap can switch, and they form such a J (or a subset:
+// principal submatrices of a P-matrix are P-matrices), so these verdicts are
+// the ones that matter for admissible initial states; the theorem applied to
+// all k rows at once asks for more (a state closing both limits of a joint)
+// than any admissible state can reach.
+struct CoactiveWellPosedness {
+  struct Set {
+    std::vector<int> indices;
+    int rank = 0;  // numerical rank of E_J (lcs::numerical_rank)
+    bool delassus_p_matrix = true, row_p_matrix = true, column_p_matrix = true;
+  };
+  std::vector<Set> sets;
+  bool all_delassus_p = true;      // every E_J M^{-1} E_J' a P-matrix (unique impulses)
+  bool locally_well_posed = true;  // Theorem 3.6.3 on every set (and the sets complete)
+  bool dependent = false;          // some set has rank E_J < |J|: truly dependent rows
+};
+CoactiveWellPosedness coactive_well_posedness(const MechanicalModel& m, const CoactiveSets& s);
+
+}  // namespace lcsim::mech

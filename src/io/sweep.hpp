@@ -1,0 +1,114 @@
+// The work-precision sweep (`lcsim sweep`): each method at each step h,
+// measured against an exact event-driven run of the same impact law, or of
+// the nearest exact law where the method has none of its own (issue 13).
+//
+// Part of the public face of src/io (above sim: it runs integrators by name,
+// so the Bullet layer's registered "bullet" takes part without io naming it).
+#pragma once
+
+#include <Eigen/Dense>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "mech/mech.hpp"
+#include "sim/sim.hpp"
+
+namespace lcsim::io {
+
+// The exact law a method is measured against.
+//   event        the run's own law (sim::Options::impact): it is the reference;
+//   moreau-jean  "moreau-restitution": restitution inside its step LCP is that
+//                law (src/sim/time_stepping.cpp), whatever Options::impact says;
+//   euler        "moreau" with every restitution set to zero: backward Euler
+//                ignores restitution (every impact inelastic), so the nearest
+//                exact law is the inelastic one;
+//   bullet       the same inelastic law: Bullet 3.24 applies a limit's bounce
+//                only near stop ERP 1 and lcsim's scene uses 0.2, where nothing
+//                rebounds (docs/bullet-comparison.md);
+//   other names  Options::impact, said to be assumed.
+// On a model without restitution (every e = 0) the inelastic flag is dropped:
+// the laws coincide. LCS models have no impact law; the reference is the
+// event-driven run with Options::impact (unused there).
+struct ReferenceLaw {
+  std::string law;         // impact law name of the exact run (src/impact)
+  bool inelastic = false;  // the exact run uses a copy of the model with e = 0
+  std::string reason;      // one sentence: why this law
+  bool lcs = false;        // an LCS model: no impact law, the label is "exact (LCS)"
+  // "moreau-restitution", or "moreau, e = 0" when inelastic: the row's label.
+  std::string label() const;
+  bool operator==(const ReferenceLaw& o) const { return law == o.law && inelastic == o.inelastic; }
+};
+ReferenceLaw reference_law(const std::string& method, const std::string& impact,
+                           const mech::Model& model);
+
+// The exact event-driven run of `law` on `model` from x0: the model's
+// restitution set to zero when law.inelastic, Options::impact = law.law.
+sim::Trajectory run_reference(const mech::Model& model, const Eigen::VectorXd& x0,
+                              const ReferenceLaw& law, sim::Options opt);
+
+struct SweepOptions {
+  std::vector<std::string> methods;  // integrator names (sim::make_integrator)
+  std::vector<double> hs;            // step sizes (s), each in (0, t_end]
+  int repeat = 3;                    // timing runs per point (median), >= 1
+  sim::Options base;                 // t_end, impact, theta, force, lcp_solver, ...
+  // Called after each row with "[i/n] method h = ..." (progress for a log).
+  std::function<void(const std::string&)> progress;
+};
+
+// One exact reference run (one per distinct ReferenceLaw).
+struct ReferenceRun {
+  ReferenceLaw law;
+  std::string status = "completed";  // or "failed: <message>"
+  sim::Trajectory run;               // events only (dt_out = 0)
+  int warnings = 0;
+  std::string first_warning;  // "" when none
+};
+
+// A row: one method at one h (the event method has one row, h = 0).
+//   error_final    max-abs difference of the final states,
+//   error_max      largest max-abs state difference over the comparison grid
+//                  (the run's samples at multiples of dt_cmp, a multiple of h
+//                  with at most ~2000 points, against the reference sampled
+//                  on the same grid; at a jump the reference has two samples
+//                  and the nearer one counts), at least error_final,
+//   max_violation  the run's most negative gap,
+//   energy_drift   (E_final - E_initial) of the run minus the reference's (J).
+// Errors are +inf when the run or its reference failed.
+struct SweepRow {
+  std::string method;
+  double h = 0.0;  // 0 for event
+  ReferenceLaw reference;
+  std::string status = "completed";  // "completed", "failed: ..." or "refused: ..."
+  double error_final = 0.0, error_max = 0.0, max_violation = 0.0, energy_drift = 0.0;
+  long steps = 0, lcp_solves = 0;
+  double wall_time_s = 0.0;  // median of `repeat` runs without samples; 0 if not completed
+  int warnings = 0;          // the run's
+  std::string first_warning;
+  int reference_warnings = 0;  // the reference run's
+  std::string reference_first_warning;
+};
+
+struct SweepResult {
+  std::string model;
+  double t_end = 0.0;
+  std::string impact;  // Options::impact of the sweep
+  std::vector<ReferenceRun> references;
+  std::vector<SweepRow> rows;
+  // True if some reference run failed (its rows carry the failure): the
+  // caller reports numerical trouble after printing the table.
+  bool reference_failed() const;
+};
+
+// Checks the options (io::InputError naming the option: --methods, --h,
+// --repeat, --theta, --impact, --lcp), then runs the sweep. Runs that fail
+// give rows with their status; nothing throws for numerical trouble.
+SweepResult run_sweep(const mech::Model& model, const Eigen::VectorXd& x0, const SweepOptions& opt);
+
+// {"model", "t_end", "impact", "references": [...], "rows": [...]}; rows as
+// SweepRow with "h": null for event, non-finite numbers as null, and
+// "reference_law", "reference_inelastic", "reference_reason".
+nlohmann::json sweep_json(const SweepResult& r);
+
+}  // namespace lcsim::io
