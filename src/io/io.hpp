@@ -184,8 +184,11 @@ std::optional<Scene> load_scene_details(const std::filesystem::path& path);
 // model); the linear model has M0 = M(q0) and L(q) = f - K q. Velocity
 // terms (Coriolis and centrifugal forces, quadratic in v) are not measured.
 //   mass error   e_M(q) = ||M(q) - M0||_F / ||M0||_F
-//   force error  e_F(q) = ||F(q) - L(q)||_2 / max(||F(q)||_2, ||L(q)||_2)
-//                (0 where both forces vanish), F(q) - L(q) = tau_g(q) - tau_g(q0) + K_g (q - q0)
+//   force error  e_F(q) = ||F(q) - L(q)||_2 / max(||F(q)||_2, ||L(q)||_2, ||K (q - q0)||_2)
+//                (0 where all vanish), F(q) - L(q) = tau_g(q) - tau_g(q0) + K_g (q - q0);
+//                the last term of the scale, the linear model's change of force
+//                since q0, keeps rounding noise from counting where both forces
+//                vanish (a spring at its rest length, gravity along no joint)
 //   error        e(q) = max(e_M(q), e_F(q))
 // For a pendulum about its hanging equilibrium, e_F = |theta - sin theta| / |theta| ~ theta^2/6.
 struct LinearisationCheck {

@@ -41,7 +41,7 @@ struct Evaluator {
     e.mass = (dyn.mass_matrix(q) - M0).norm() / M0.norm();
     const VectorXd L = f - K * q;
     const VectorXd d = dyn.gravity_force(q) - scene.lin.tau_g + scene.lin.K_g * (q - q0);
-    const double scale = std::max((L + d).norm(), L.norm());
+    const double scale = std::max({(L + d).norm(), L.norm(), (K * (q - q0)).norm()});
     e.force = scale > 0.0 ? d.norm() / scale : 0.0;
     return e;
   }

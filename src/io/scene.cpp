@@ -372,17 +372,11 @@ mech::Model parse_scene(const std::string& yaml_text, const std::string& source)
 }
 
 std::optional<Scene> load_scene_details(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw InputError(path.string() + ": cannot open: no such file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string() + ": cannot open: unreadable");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  const YAML::Node root = load(ss.str(), path.string());
+  const std::string text = read_file(path);
+  const YAML::Node root = load(text, path.string());
   if (!root.IsMap() || !root["urdf"]) return std::nullopt;
   try {
-    return read_scene(ss.str(), path.string());
+    return read_scene(text, path.string());
   } catch (const InputError& e) {
     throw InputError(one_line(e.what()));  // as load_model: URDF names may hold newlines
   }
