@@ -14,6 +14,7 @@
 #include <string>
 
 #include "cli/command.hpp"
+#include "cli/output.hpp"
 #include "io/io.hpp"
 #include "lcp/lcp.hpp"
 #include "lcs/lcs.hpp"
@@ -27,6 +28,8 @@ using Eigen::MatrixXd;
 struct AnalyzeArgs {
   std::string file;
   bool json = false;
+  std::string model_out;  // --model-out: the linear model as YAML
+  double linearisation_threshold = io::kLinearisationThreshold;
 };
 
 std::string num(double x) {
@@ -159,8 +162,28 @@ std::string coactive_text(const mech::MechanicalModel& m, const Coactive& c) {
   return out.str();
 }
 
+// Scenes: where the linear model holds, per simulated joint (io::linear_ranges).
+void linear_ranges_section(const std::optional<io::Scene>& scene, double threshold,
+                           nlohmann::json& j, std::ostringstream& out) {
+  if (!scene) {
+    j["linear_ranges"] = nullptr;
+    return;
+  }
+  const std::vector<io::LinearRange> ranges = io::linear_ranges(*scene, threshold);
+  j["linear_ranges"] = io::to_json(ranges);
+  j["linearisation_threshold"] = threshold;
+  out << "linear model: error <= " << num(100.0 * threshold)
+      << " % (mass and forces, docs/model-format.md) for q in, each joint alone:\n";
+  for (const auto& r : ranges)
+    out << "  " << r.joint << ": [" << num(r.lower) << ", " << num(r.upper) << "] " << r.unit
+        << "  (q0 = " << num(r.q0) << "; ends: " << r.lower_end << ", " << r.upper_end << ")\n";
+}
+
 void run_analyze(const AnalyzeArgs& args) {
-  const mech::Model model = io::load_model(args.file);
+  io::check_linearisation_threshold(args.linearisation_threshold);
+  if (!args.model_out.empty()) check_writable(args.model_out);
+  const std::optional<io::Scene> scene = io::load_scene_details(args.file);
+  const mech::Model model = scene ? scene->model : io::load_model(args.file);
   const std::vector<std::string> notes = io::model_notes(model);
   const lcs::Lcs sys = model.as_lcs();
   const lcs::WellPosednessReport wp = lcs::analyze_well_posedness(sys);
@@ -290,6 +313,14 @@ void run_analyze(const AnalyzeArgs& args) {
               : "no relative degree >= 3")
       << "\n";
 
+  linear_ranges_section(scene, args.linearisation_threshold, j, out);
+  if (!args.model_out.empty()) {
+    io::write_file_atomic(args.model_out,
+                          io::model_yaml(model, "The linear model of " + model.source +
+                                                    ", written by lcsim analyze --model-out"));
+    out << "model written to " << args.model_out << "\n";
+  }
+
   if (args.json)
     std::cout << j.dump(2) << "\n";
   else
@@ -304,6 +335,10 @@ LCSIM_REGISTER_COMMAND([](CLI::App& app) {
       "analyze", "Describe a model and check the well-posedness conditions before simulating");
   cmd->add_option("model", args->file, "model file (YAML)")->required();
   cmd->add_flag("--json", args->json, "print one JSON object");
+  cmd->add_option("--model-out", args->model_out,
+                  "write the model (a scene: its linearisation) as a YAML model file");
+  cmd->add_option("--linearisation-threshold", args->linearisation_threshold,
+                  "scenes: relative error of the linear model for the ranges (default 0.01)");
   cmd->callback([args] { run_analyze(*args); });
 });
 

@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <vector>
 
 #include "cli/command.hpp"
 #include "cli/output.hpp"
@@ -31,6 +33,7 @@ struct SimulateArgs {
   bool project = false;      // move an infeasible q0 onto E q + g >= 0 first
   bool progress = false;     // --progress: progress lines on stderr even when not a terminal
   bool no_progress = false;  // --no-progress
+  double linearisation_threshold = io::kLinearisationThreshold;  // scenes: warn above it
 };
 
 std::string fmt_vec(const Eigen::VectorXd& v) {
@@ -50,7 +53,9 @@ std::string fmt_set(const std::vector<int>& s) {
 }
 
 void run_simulate(const SimulateArgs& a) {
-  const mech::Model model = io::load_model(a.model);
+  io::check_linearisation_threshold(a.linearisation_threshold);
+  const std::optional<io::Scene> scene = io::load_scene_details(a.model);
+  const mech::Model model = scene ? scene->model : io::load_model(a.model);
   // Names are checked before anything runs, so a typo fails at once.
   auto integrator = sim::make_integrator(a.method);
   (void)impact::make_impact_law(a.impact);
@@ -92,6 +97,15 @@ void run_simulate(const SimulateArgs& a) {
   // Samples feed only the CSV; a run without --out keeps none (at N = 10000
   // they were 64 MB of a 140 MB process).
   opt.record_samples = !a.out.empty();
+  // A scene's linear model is checked at the visited states
+  // (io::check_linearisation): keep the samples, on a grid of
+  // io::kLinearisationStates points when no output grid was asked for and no
+  // CSV is written (the CSV keeps the grid the user chose).
+  if (scene) {
+    opt.record_samples = true;
+    if (opt.dt_out == 0.0 && a.out.empty())
+      opt.dt_out = opt.t_end / static_cast<double>(io::kLinearisationStates);
+  }
   // An unwritable --out fails now, not after the run.
   if (!a.out.empty()) check_writable(a.out);
 
@@ -103,8 +117,17 @@ void run_simulate(const SimulateArgs& a) {
   if (tr.status == sim::RunStatus::kCompleted) progress.done();
   const bool failed = tr.status != sim::RunStatus::kCompleted;
   if (!failed && !a.out.empty()) io::write_file_atomic(a.out, io::trajectory_csv(model, tr));
+  std::optional<io::LinearisationCheck> lin;
+  if (scene) {
+    std::vector<Eigen::VectorXd> states;
+    for (const auto& s : tr.samples) states.push_back(s.x);
+    lin = io::check_linearisation(*scene, states);
+  }
   if (a.json) {
-    std::cout << io::trajectory_json(model, tr).dump(2) << "\n";
+    nlohmann::json j = io::trajectory_json(model, tr);
+    j["linearisation_error"] = lin ? nlohmann::json(lin->error) : nlohmann::json(nullptr);
+    j["linearisation_check"] = lin ? io::to_json(*lin) : nlohmann::json(nullptr);
+    std::cout << j.dump(2) << "\n";
   } else {
     std::printf("model %s, method %s, t_end %g\n", model.name.c_str(), tr.method.c_str(), tr.t_end);
     if (!tr.impact_law.empty()) std::printf("impact law %s\n", tr.impact_law.c_str());
@@ -121,7 +144,15 @@ void run_simulate(const SimulateArgs& a) {
       std::printf("energy %.12g -> %.12g\n", tr.energy_initial, tr.energy_final);
     std::printf("max violation %.3g, LCP solves %ld, warnings %d, wall time %.3g s\n",
                 tr.max_violation, tr.lcp_solves, tr.warnings, tr.wall_time_s);
+    if (lin)
+      std::printf("linearisation error %.3g %% (mass %.3g %%, forces %.3g %%) over %zu states\n",
+                  100.0 * lin->error, 100.0 * lin->mass_error, 100.0 * lin->force_error,
+                  lin->states);
     if (!a.out.empty() && !failed) std::printf("trajectory written to %s\n", a.out.c_str());
+  }
+  if (lin) {
+    const std::string w = io::linearisation_warning(*lin, a.linearisation_threshold);
+    if (!w.empty()) std::cerr << "lcsim: warning: " << w << "\n";
   }
   for (const auto& w : tr.warning_messages) std::cerr << "lcsim: warning: " << w << "\n";
   if (failed) throw NumericalError(tr.message);
@@ -148,6 +179,9 @@ void setup(CLI::App& app) {
   cmd->add_option("--dt-out", a->dt_out, "Output grid step (s); 0 = events only");
   cmd->add_option("--out", a->out, "Write the trajectory CSV here");
   cmd->add_flag("--json", a->json, "Print the run summary as JSON");
+  cmd->add_option("--linearisation-threshold", a->linearisation_threshold,
+                  "Scenes: warn when the linear model is off by more than this (relative; "
+                  "default 0.01)");
   cmd->add_option("--impact", a->impact,
                   "Impact law (default moreau-restitution, with the model's restitution)");
   cmd->add_option("--lcp", a->lcp, "LCP solver: pivot, lemke, pgs, enum");

@@ -2,7 +2,10 @@
 #pragma once
 
 #include <cstddef>
+#include <filesystem>
 #include <string>
+
+#include "io/io.hpp"
 
 namespace lcsim::io {
 
@@ -13,5 +16,14 @@ std::string format_number(double x);
 // a YAML scalar or a yaml-cpp message) become escapes such as \n or \x01,
 // and anything beyond `max_chars` is cut to "...".
 std::string one_line(const std::string& text, std::size_t max_chars = 1000);
+
+// The whole text of a model file; InputError "<path>: cannot open: no such
+// file" (or "is a directory", "permission denied or unreadable").
+std::string read_file(const std::filesystem::path& path);
+
+// Why a mimic joint cannot be simulated: "mimics joint 'J' (<mimic>: q =
+// a * q_J + b), so it is not a degree of freedom: ..." with what to do
+// instead (simulate J alone when `leader_simulated`, else J or neither).
+std::string mimic_refusal(const std::string& name, const Mimic& mimic, bool leader_simulated);
 
 }  // namespace lcsim::io

@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -102,10 +103,52 @@ struct UrdfLinearisation {
   VectorXd damping;  // <dynamics damping> of each simulated joint (N s/m or N m s/rad)
 };
 
+// <mimic joint="J" multiplier="a" offset="b"> on joint m: q_m = a q_J + b
+// (urdfdom's defaults a = 1, b = 0). Chains are followed to the first joint
+// that mimics nothing, composing the maps: the result's `leader` is never a
+// mimic itself. Returns every revolute, continuous or prismatic joint that
+// carries a <mimic> (a <mimic> on a fixed joint means nothing and is
+// skipped). InputError naming the joint when a leader is missing or has no
+// position (fixed, floating, planar), and for a cycle of mimics.
+struct Mimic {
+  std::string leader;
+  double multiplier = 1.0;
+  double offset = 0.0;
+};
+std::map<std::string, Mimic> mimic_joints(const urdf::ModelInterface& model,
+                                          const std::string& source);
+
+// The exact (nonlinear) joint-space dynamics of a scene's URDF as functions
+// of the coordinates q (the simulated joints, in the order of `joints`):
+// every other joint sits at its `q0` (0 if not named), fixed joints are
+// merged, and a mimic joint follows its leader (q_m = a q_J + b; when J is
+// frozen, m is frozen there too). A mimic of a simulated joint moves with it:
+// its motion enters the Jacobian of every body below it, so its mass,
+// gravity and damping act through J. A simulated joint that is itself a
+// mimic is refused (InputError naming both joints). `model` must outlive
+// this object. Errors as linearise_urdf.
+class UrdfDynamics {
+ public:
+  UrdfDynamics(const urdf::ModelInterface& model, const std::vector<std::string>& joints,
+               const std::map<std::string, double>& q0, const Eigen::Vector3d& gravity,
+               const std::string& source);
+  const std::vector<std::string>& joints() const { return joints_; }
+  VectorXd reference() const;                       // q0 of the simulated joints
+  MatrixXd mass_matrix(const VectorXd& q) const;    // M(q), composite-rigid-body algorithm
+  VectorXd gravity_force(const VectorXd& q) const;  // tau_g(q) (N or N m)
+  VectorXd damping() const;                         // diagonal of T' diag(<dynamics damping>) T
+  struct Impl;
+
+ private:
+  std::vector<std::string> joints_;
+  std::shared_ptr<const Impl> impl_;
+};
+
 // Linearises `model` about q0 (positions by joint name; joints not named sit
-// at 0). Every joint not in `joints` is frozen at its q0; fixed joints are
-// merged. `gravity` in the URDF root frame (m/s^2). `source` names the URDF in
-// messages. K_g by central differences of tau_g, step 6e-6 (see urdf_model.cpp).
+// at 0) through UrdfDynamics: every joint not in `joints` is frozen at its
+// q0, fixed joints are merged, mimics follow their leaders. `gravity` in the URDF root frame
+// (m/s^2). `source` names the URDF in messages. K_g by central differences of tau_g, step 6e-6 (see
+// urdf_model.cpp).
 UrdfLinearisation linearise_urdf(const urdf::ModelInterface& model,
                                  const std::vector<std::string>& joints,
                                  const std::map<std::string, double>& q0,
@@ -118,5 +161,77 @@ UrdfLinearisation linearise_urdf(const urdf::ModelInterface& model,
 // linearisation in docs/model-format.md, "Scenes".
 mech::Model load_scene(const std::filesystem::path& path);
 mech::Model parse_scene(const std::string& yaml_text, const std::string& source);
+
+// A scene's model with what it was linearised from, so that the exact
+// dynamics can be evaluated away from q0 (check_linearisation).
+struct Scene {
+  mech::Model model;
+  std::shared_ptr<urdf::ModelInterface> urdf;
+  std::string urdf_source;           // the URDF's path, for messages
+  std::map<std::string, double> q0;  // as the scene gives it (joints not named: 0)
+  Eigen::Vector3d gravity;           // m/s^2, URDF root frame
+  UrdfLinearisation lin;             // M, tau_g, K_g, damping at q0 (coordinates: lin.joints)
+};
+Scene read_scene(const std::string& yaml_text, const std::string& source);
+// The scene in `path`, or nullopt when the file is a model, not a scene (no
+// top-level `urdf:` key). Errors as load_model.
+std::optional<Scene> load_scene_details(const std::filesystem::path& path);
+
+// ---- How far the linear model holds (src/io/linearisation.cpp) ----
+//
+// At coordinates q the exact model has the mass matrix M(q) and the force
+// F(q) = tau_g(q) + springs(q) (springs are linear in q, so exact in the
+// model); the linear model has M0 = M(q0) and L(q) = f - K q. Velocity
+// terms (Coriolis and centrifugal forces, quadratic in v) are not measured.
+//   mass error   e_M(q) = ||M(q) - M0||_F / ||M0||_F
+//   force error  e_F(q) = ||F(q) - L(q)||_2 / max(||F(q)||_2, ||L(q)||_2, ||K (q - q0)||_2)
+//                (0 where all vanish), F(q) - L(q) = tau_g(q) - tau_g(q0) + K_g (q - q0);
+//                the last term of the scale, the linear model's change of force
+//                since q0, keeps rounding noise from counting where both forces
+//                vanish (a spring at its rest length, gravity along no joint)
+//   error        e(q) = max(e_M(q), e_F(q))
+// For a pendulum about its hanging equilibrium, e_F = |theta - sin theta| / |theta| ~ theta^2/6.
+struct LinearisationCheck {
+  double error = 0.0;        // max over the states of e(q)
+  double mass_error = 0.0;   // max of e_M
+  double force_error = 0.0;  // max of e_F
+  VectorXd worst_q;          // the state where e(q) was largest
+  std::size_t states = 0;    // how many states were evaluated
+};
+constexpr std::size_t kLinearisationStates = 200;  // states evaluated at most
+constexpr double kLinearisationThreshold = 0.01;   // default warning threshold (1 %)
+
+// e(q) at the given coordinates (size N each; the first N entries of a full
+// state are used, so trajectory states (q, v) may be passed as they are).
+// More than kLinearisationStates states are subsampled evenly, first and last
+// kept. std::invalid_argument for a wrong size.
+LinearisationCheck check_linearisation(const Scene& scene, const std::vector<VectorXd>& states);
+
+// "" when check.error <= threshold, else the warning line. InputError
+// ("--linearisation-threshold: ...") unless threshold is finite and > 0.
+std::string linearisation_warning(const LinearisationCheck& check, double threshold);
+void check_linearisation_threshold(double threshold);
+
+// Per simulated joint, the interval of q about q0 (other joints at q0) in
+// which e(q) <= threshold: from q0 outwards in 64 steps to the joint's limit
+// (or pi rad / 1 m when it has none), then 50 bisections where e first
+// exceeds the threshold (each coordinate alone; e need not be monotone, the
+// scan stops at the first crossing it sees).
+struct LinearRange {
+  std::string joint;
+  std::string unit;  // "rad" (revolute) or "m" (prismatic)
+  double q0 = 0.0;
+  double lower = 0.0, upper = 0.0;  // rad or m, absolute joint positions
+  // What ends each side: "threshold" (e crosses it there), "limit" (the
+  // joint's limit, no crossing before it) or "search" (no limit on that
+  // side: the scan stopped at pi rad or 1 m without a crossing).
+  std::string lower_end, upper_end;
+};
+std::vector<LinearRange> linear_ranges(const Scene& scene, double threshold);
+
+// JSON of the two: {error, mass_error, force_error, worst_q, states} and
+// [{joint, unit, q0, lower, upper, lower_end, upper_end}, ...].
+nlohmann::json to_json(const LinearisationCheck& check);
+nlohmann::json to_json(const std::vector<LinearRange>& ranges);
 
 }  // namespace lcsim::io

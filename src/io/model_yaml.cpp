@@ -332,6 +332,8 @@ lcs::Lcs parse_lcs(const YAML::Node& node, const std::string& source) {
   return s;
 }
 
+}  // namespace
+
 std::string read_file(const std::filesystem::path& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec))
@@ -345,8 +347,6 @@ std::string read_file(const std::filesystem::path& path) {
   if (in.bad()) throw InputError(path.string() + ": read error");
   return ss.str();
 }
-
-}  // namespace
 
 mech::Model parse_model(const std::string& yaml_text, const std::string& source) {
   const YAML::Node root = load(yaml_text, source);

@@ -56,9 +56,53 @@ std::map<std::string, double> by_joint(
   return out;
 }
 
+std::vector<std::string> stop_list(const YAML::Node& s, const std::string& source,
+                                   const std::string& key) {
+  if (!s.IsSequence())
+    fail(source, key, "expected a list of lower/upper (got " + describe(s) + ")");
+  std::vector<std::string> st;
+  for (std::size_t m = 0; m < s.size(); ++m) {
+    const std::string sk = key + "[" + std::to_string(m) + "]";
+    const std::string v = name_of(s[m], source, sk);
+    if (v != "lower" && v != "upper") fail(source, sk, "expected lower or upper (got '" + v + "')");
+    if (std::count(st.begin(), st.end(), v)) fail(source, sk, "duplicate '" + v + "'");
+    st.push_back(v);
+  }
+  return st;
+}
+
+// The limits of each mimic m of simulated joint `leader` (coordinate i) as
+// stops on the leader through q_m = a q_i + b: lower <= a q_i + b <= upper
+// gives the rows a e_i (gap b - lower) and -a e_i (gap upper - b), named
+// m_lower and m_upper. A row and gap equal to one already present (the
+// Panda's fingers: multiplier 1, equal limits) says nothing new and is not
+// repeated; a mimic with multiplier 0 or no <limit> adds none.
+void add_mimic_stops(const urdf::ModelInterface& um, const std::map<std::string, Mimic>& mimics,
+                     const std::string& leader, Eigen::Index i, Eigen::Index n,
+                     const std::vector<std::string>& which, std::vector<VectorXd>& rows,
+                     std::vector<double>& gaps, std::vector<std::string>& names) {
+  for (const auto& [name, mm] : mimics) {
+    const auto j = um.getJoint(name);
+    if (mm.leader != leader || !j->limits || j->type == urdf::Joint::CONTINUOUS ||
+        mm.multiplier == 0.0)
+      continue;
+    for (const auto& s : which) {
+      const double sign = s == "lower" ? 1.0 : -1.0;
+      VectorXd r = VectorXd::Zero(n);
+      r(i) = sign * mm.multiplier;
+      const double gap = s == "lower" ? mm.offset - j->limits->lower : j->limits->upper - mm.offset;
+      bool repeated = false;
+      for (std::size_t k = 0; k < rows.size(); ++k) repeated |= rows[k] == r && gaps[k] == gap;
+      if (repeated) continue;
+      rows.push_back(r);
+      gaps.push_back(gap);
+      names.push_back(name + "_" + s);
+    }
+  }
+}
 }  // namespace
 
-mech::Model parse_scene(const std::string& yaml_text, const std::string& source) {
+Scene read_scene(const std::string& yaml_text, const std::string& source) {
   const YAML::Node root = load(yaml_text, source);
   const Keys keys = mapping(root, source, "",
                             {"name", "urdf", "joints", "q0", "gravity", "springs", "constraints",
@@ -90,29 +134,18 @@ mech::Model parse_scene(const std::string& yaml_text, const std::string& source)
   if (!jn.IsSequence() || jn.size() == 0)
     fail(source, "joints", "expected a non-empty list of joint names (got " + describe(jn) + ")");
   std::vector<std::string> joints;
-  std::vector<std::vector<std::string>> stops;
+  std::vector<std::vector<std::string>> stops, mimic_stops;
   for (std::size_t i = 0; i < jn.size(); ++i) {
     const std::string k = "joints[" + std::to_string(i) + "]";
     std::string name;
-    std::vector<std::string> st{"lower", "upper"};
+    std::vector<std::string> st{"lower", "upper"}, mst{"lower", "upper"};
     if (jn[i].IsMap()) {
-      const Keys jk = mapping(jn[i], source, k, {"name", "stops"});
+      const Keys jk = mapping(jn[i], source, k, {"name", "stops", "mimic_stops"});
       if (!jk.count("name")) fail(source, k + ".name", "missing");
       name = name_of(jk.at("name"), source, k + ".name");
-      if (jk.count("stops")) {
-        const YAML::Node& s = jk.at("stops");
-        if (!s.IsSequence())
-          fail(source, k + ".stops", "expected a list of lower/upper (got " + describe(s) + ")");
-        st.clear();
-        for (std::size_t m = 0; m < s.size(); ++m) {
-          const std::string sk = k + ".stops[" + std::to_string(m) + "]";
-          const std::string v = name_of(s[m], source, sk);
-          if (v != "lower" && v != "upper")
-            fail(source, sk, "expected lower or upper (got '" + v + "')");
-          if (std::count(st.begin(), st.end(), v)) fail(source, sk, "duplicate '" + v + "'");
-          st.push_back(v);
-        }
-      }
+      if (jk.count("stops")) st = stop_list(jk.at("stops"), source, k + ".stops");
+      if (jk.count("mimic_stops"))
+        mst = stop_list(jk.at("mimic_stops"), source, k + ".mimic_stops");
     } else {
       name = name_of(jn[i], source, k);
     }
@@ -129,13 +162,24 @@ mech::Model parse_scene(const std::string& yaml_text, const std::string& source)
       fail(source, k, "joint '" + name + "' has no <limit> in " + us + " (write stops: [])");
     joints.push_back(name);
     stops.push_back(st);
+    mimic_stops.push_back(mst);
   }
+  const std::map<std::string, Mimic> mimics = mimic_joints(um, us);
+  for (std::size_t i = 0; i < joints.size(); ++i)
+    if (const auto it = mimics.find(joints[i]); it != mimics.end())
+      fail(source, "joints[" + std::to_string(i) + "]",
+           "joint '" + joints[i] + "' " +
+               mimic_refusal(joints[i], it->second,
+                             std::count(joints.begin(), joints.end(), it->second.leader) > 0));
   const auto N = static_cast<Eigen::Index>(joints.size());
   const auto coord = [&](const std::string& n) -> Eigen::Index {
     return std::find(joints.begin(), joints.end(), n) - joints.begin();
   };
   const auto simulated = [&](const std::string& n) -> std::string {
     if (!um.getJoint(n)) return "no joint '" + n + "' in " + us;
+    if (mimics.count(n))
+      return "joint '" + n + "' mimics '" + mimics.at(n).leader +
+             "' (it follows its leader and is not a coordinate)";
     if (coord(n) == N)
       return "joint '" + n +
              "' is frozen (not in joints:); only simulated joints can carry springs, constraints "
@@ -151,6 +195,9 @@ mech::Model parse_scene(const std::string& yaml_text, const std::string& source)
       if (j->type != urdf::Joint::REVOLUTE && j->type != urdf::Joint::PRISMATIC &&
           j->type != urdf::Joint::CONTINUOUS)
         return "joint '" + n + "' has no position (not revolute, continuous or prismatic)";
+      if (mimics.count(n))
+        return "joint '" + n + "' mimics '" + mimics.at(n).leader +
+               "': its position follows the leader's; give q0 for '" + mimics.at(n).leader + "'";
       return "";
     });
 
@@ -228,6 +275,8 @@ mech::Model parse_scene(const std::string& yaml_text, const std::string& source)
       rows.push_back(r);
       m.constraints.push_back(joints[i] + "_" + s);
     }
+    add_mimic_stops(um, mimics, joints[i], static_cast<Eigen::Index>(i), N, mimic_stops[i], rows,
+                    gaps, m.constraints);
   }
   if (keys.count("constraints")) {
     const YAML::Node& cn = keys.at("constraints");
@@ -314,7 +363,23 @@ mech::Model parse_scene(const std::string& yaml_text, const std::string& source)
   }
   mech::fill_defaults(m);
   model.mechanical = m;
-  return model;
+  Scene scene{std::move(model), urdf_model, us, q0, gravity, lin};
+  return scene;
+}
+
+mech::Model parse_scene(const std::string& yaml_text, const std::string& source) {
+  return read_scene(yaml_text, source).model;
+}
+
+std::optional<Scene> load_scene_details(const std::filesystem::path& path) {
+  const std::string text = read_file(path);
+  const YAML::Node root = load(text, path.string());
+  if (!root.IsMap() || !root["urdf"]) return std::nullopt;
+  try {
+    return read_scene(text, path.string());
+  } catch (const InputError& e) {
+    throw InputError(one_line(e.what()));  // as load_model: URDF names may hold newlines
+  }
 }
 
 mech::Model load_scene(const std::filesystem::path& path) {

@@ -19,6 +19,7 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -135,28 +136,42 @@ void check_urdf(const urdf::ModelInterface& m, const std::string& source) {
         fail(source, el + ": <limit>",
              "lower > upper (got lower=" + num(l.lower) + ", upper=" + num(l.upper) + ")");
     }
+    if (joint->mimic &&
+        (!std::isfinite(joint->mimic->multiplier) || !std::isfinite(joint->mimic->offset)))
+      fail(source, el + ": <mimic>",
+           "multiplier and offset must be finite (got multiplier=" + num(joint->mimic->multiplier) +
+               ", offset=" + num(joint->mimic->offset) + ")");
     if (joint->dynamics) {
       const double d = joint->dynamics->damping;
       if (!std::isfinite(d) || d < 0.0)
         fail(source, el + ": <dynamics damping>", "must be finite and >= 0 (got " + num(d) + ")");
     }
   }
+  (void)mimic_joints(m, source);  // every leader exists, has a position, no cycles
 }
 
-// The scene's tree: every link, its world pose at a configuration and the
-// simulated joint that moves it as a rigid part of its body (-1: the world).
+// The scene's tree. Its moving joints are the simulated joints (coordinate
+// order) and then the mimic joints that follow them; joint velocities are
+// T times the coordinate velocities (T = [1; rows with the mimics'
+// multipliers]), so M = T' M_moving T and tau = T' tau_moving: the mimics'
+// motion enters every body's Jacobian. Each link is owned by the moving
+// joint that moves it as a rigid part of its body (-1: the world).
 struct Tree {
   const urdf::ModelInterface& model;
-  std::vector<std::string> joints;      // simulated, coordinate order
-  std::map<std::string, int> index;     // simulated joint -> coordinate
-  std::vector<int> parent;              // parent coordinate of each (-1: world)
-  std::map<std::string, int> owner;     // link -> coordinate moving it rigidly
+  std::vector<std::string> joints;      // moving joints: simulated, then their mimics
+  std::size_t n = 0;                    // coordinates (simulated joints)
+  std::vector<int> coord;               // coordinate of each moving joint
+  MatrixXd T;                           // moving joint velocities = T * coordinate velocities
+  std::map<std::string, int> index;     // moving joint -> its position in `joints`
+  std::vector<int> parent;              // parent moving joint of each (-1: world)
+  std::map<std::string, int> owner;     // link -> moving joint moving it rigidly
   std::vector<std::string> link_order;  // root first (depth first)
+  std::map<std::string, Mimic> mimics;  // every mimic joint of the URDF, resolved
 };
 
 Tree make_tree(const urdf::ModelInterface& model, const std::vector<std::string>& joints,
                const std::string& source) {
-  Tree t{model, joints, {}, {}, {}, {}};
+  Tree t{model, joints, joints.size(), {}, {}, {}, {}, {}, {}, mimic_joints(model, source)};
   if (!model.getRoot()) fail(source, "<robot>", "no root link");
   for (std::size_t i = 0; i < joints.size(); ++i) {
     const auto j = model.getJoint(joints[i]);
@@ -166,8 +181,27 @@ Tree make_tree(const urdf::ModelInterface& model, const std::vector<std::string>
            "unsupported type for a simulated joint (only revolute and prismatic joints can be "
            "simulated; freeze it by leaving it out of the scene)");
     t.index[joints[i]] = static_cast<int>(i);
+    t.coord.push_back(static_cast<int>(i));
   }
-  t.parent.assign(joints.size(), -1);
+  for (std::size_t i = 0; i < joints.size(); ++i)
+    if (const auto it = t.mimics.find(joints[i]); it != t.mimics.end())
+      fail(source, "joint '" + joints[i] + "'",
+           mimic_refusal(joints[i], it->second, t.index.count(it->second.leader) > 0));
+  std::vector<std::pair<int, double>> follow;  // (coordinate, multiplier) of each mimic
+  for (const auto& [name, mm] : t.mimics) {
+    const auto it = t.index.find(mm.leader);
+    if (it == t.index.end() || it->second >= static_cast<int>(t.n)) continue;
+    t.index[name] = static_cast<int>(t.joints.size());
+    t.joints.push_back(name);
+    t.coord.push_back(it->second);
+    follow.emplace_back(it->second, mm.multiplier);
+  }
+  const auto n = static_cast<Eigen::Index>(t.n);
+  t.T = MatrixXd::Zero(static_cast<Eigen::Index>(t.joints.size()), n);
+  t.T.topRows(n).setIdentity();
+  for (std::size_t k = 0; k < follow.size(); ++k)
+    t.T(n + static_cast<Eigen::Index>(k), follow[k].first) = follow[k].second;
+  t.parent.assign(t.joints.size(), -1);
   std::function<void(const urdf::Link&, int)> walk = [&](const urdf::Link& link, int owner) {
     t.owner[link.name] = owner;
     t.link_order.push_back(link.name);
@@ -183,6 +217,19 @@ Tree make_tree(const urdf::ModelInterface& model, const std::vector<std::string>
   };
   walk(*model.getRoot(), -1);
   return t;
+}
+
+// Every joint position at coordinates q: the simulated joints from q, the
+// frozen ones from q0 (0 if absent), each mimic from its leader.
+std::map<std::string, double> positions(const Tree& t, const std::map<std::string, double>& q0,
+                                        const VectorXd& q) {
+  std::map<std::string, double> p = q0;
+  for (std::size_t i = 0; i < t.n; ++i) p[t.joints[i]] = q(static_cast<Eigen::Index>(i));
+  for (const auto& [name, mm] : t.mimics) {
+    const auto it = p.find(mm.leader);
+    p[name] = mm.multiplier * (it == p.end() ? 0.0 : it->second) + mm.offset;
+  }
+  return p;
 }
 
 // World pose of every link with simulated and frozen joints at q (by name).
@@ -262,7 +309,7 @@ MatrixXd crba(const Tree& t, const std::map<std::string, double>& q) {
     up(t, static_cast<int>(i),
        [&](int j) { M(i, j) = M(j, i) = S[static_cast<std::size_t>(j)].dot(F); });
   }
-  return M;
+  return t.T.transpose() * M * t.T;
 }
 
 // tau_g,i = S_i . (sum of the gravity wrenches (c x m g, m g) of the bodies
@@ -283,7 +330,7 @@ VectorXd gravity_force(const Tree& t, const std::map<std::string, double>& q,
   VectorXd tau(static_cast<Eigen::Index>(t.joints.size()));
   for (std::size_t i = 0; i < t.joints.size(); ++i)
     tau(static_cast<Eigen::Index>(i)) = subspace(t, t.joints[i], X).dot(F[i]);
-  return tau;
+  return t.T.transpose() * tau;
 }
 
 // Collects urdfdom's messages (sent through console_bridge) while it
@@ -363,18 +410,66 @@ std::shared_ptr<urdf::ModelInterface> parse_urdf(const std::string& xml,
   return one_line_errors([&] { return parse_urdf_unfolded(xml, source); });
 }
 
-static UrdfLinearisation linearise_urdf_unfolded(const urdf::ModelInterface& model,
-                                                 const std::vector<std::string>& joints,
-                                                 const std::map<std::string, double>& q0,
-                                                 const Eigen::Vector3d& gravity,
-                                                 const std::string& source) {
-  const Tree t = make_tree(model, joints, source);
-  // A simulated joint must move some mass: its body (its child link and the
-  // links frozen to it) needs an <inertial> with mass > 0.
+std::string mimic_refusal(const std::string& name, const Mimic& mm, bool leader_simulated) {
+  return "mimics joint '" + mm.leader + "' (<mimic>: q = " + num(mm.multiplier) + " * q_" +
+         mm.leader + " + " + num(mm.offset) + "), so it is not a degree of freedom: " +
+         (leader_simulated ? "simulate '" + mm.leader + "' alone, '" + name + "' follows it"
+                           : "simulate '" + mm.leader + "' and leave '" + name +
+                                 "' out, or leave both out to freeze them");
+}
+
+std::map<std::string, Mimic> mimic_joints(const urdf::ModelInterface& model,
+                                          const std::string& source) {
+  std::map<std::string, Mimic> out;
+  for (const auto& [name, joint] : model.joints_) {
+    if (!joint->mimic || !moves(*joint)) continue;
+    Mimic mm{name, 1.0, 0.0};
+    std::vector<std::string> chain{name};
+    for (std::shared_ptr<const urdf::Joint> j = joint; j->mimic;) {
+      const std::string el =
+          "joint '" + j->name + "': <mimic joint='" + j->mimic->joint_name + "'>";
+      const auto leader = model.getJoint(j->mimic->joint_name);
+      if (!leader) fail(source, el, "no joint '" + j->mimic->joint_name + "' in the URDF");
+      if (!moves(*leader))
+        fail(source, el,
+             "joint '" + leader->name +
+                 "' has no position to follow (only revolute, continuous and prismatic joints)");
+      // q_m = a q_j + b and q_j = a' q_leader + b'  =>  q_m = a a' q_leader + (a b' + b)
+      mm.offset += mm.multiplier * j->mimic->offset;
+      mm.multiplier *= j->mimic->multiplier;
+      mm.leader = leader->name;
+      if (std::count(chain.begin(), chain.end(), leader->name)) {
+        std::string c;
+        for (const auto& x : chain) c += x + " -> ";
+        fail(source, "joint '" + name + "': <mimic>", "a cycle of mimics: " + c + leader->name);
+      }
+      chain.push_back(leader->name);
+      j = leader;
+    }
+    out[name] = mm;
+  }
+  return out;
+}
+
+struct UrdfDynamics::Impl {
+  Tree tree;
+  std::map<std::string, double> q0;
+  Eigen::Vector3d gravity;
+};
+
+static std::shared_ptr<const UrdfDynamics::Impl> make_dynamics(
+    const urdf::ModelInterface& model, const std::vector<std::string>& joints,
+    const std::map<std::string, double>& q0, const Eigen::Vector3d& gravity,
+    const std::string& source) {
+  Tree t = make_tree(model, joints, source);
+  // A simulated joint must move some mass: its body (its child link, the
+  // links frozen to it and those its mimics move) needs an <inertial> with
+  // mass > 0.
   for (std::size_t i = 0; i < joints.size(); ++i) {
     double mass = 0.0;
     for (const auto& [name, o] : t.owner)
-      if (o == static_cast<int>(i) && model.getLink(name)->inertial)
+      if (o >= 0 && t.coord[static_cast<std::size_t>(o)] == static_cast<int>(i) &&
+          model.getLink(name)->inertial)
         mass += model.getLink(name)->inertial->mass;
     if (!(mass > 0.0))
       fail(source, "link '" + model.getJoint(joints[i])->child_link_name + "'",
@@ -383,10 +478,54 @@ static UrdfLinearisation linearise_urdf_unfolded(const urdf::ModelInterface& mod
                "(got total mass " +
                num(mass) + ")");
   }
+  return std::make_shared<const UrdfDynamics::Impl>(UrdfDynamics::Impl{std::move(t), q0, gravity});
+}
+
+UrdfDynamics::UrdfDynamics(const urdf::ModelInterface& model,
+                           const std::vector<std::string>& joints,
+                           const std::map<std::string, double>& q0, const Eigen::Vector3d& gravity,
+                           const std::string& source)
+    : joints_(joints),
+      impl_(one_line_errors([&] { return make_dynamics(model, joints, q0, gravity, source); })) {}
+
+VectorXd UrdfDynamics::reference() const {
+  VectorXd q(static_cast<Eigen::Index>(joints_.size()));
+  for (std::size_t i = 0; i < joints_.size(); ++i) {
+    const auto it = impl_->q0.find(joints_[i]);
+    q(static_cast<Eigen::Index>(i)) = it == impl_->q0.end() ? 0.0 : it->second;
+  }
+  return q;
+}
+
+MatrixXd UrdfDynamics::mass_matrix(const VectorXd& q) const {
+  return crba(impl_->tree, positions(impl_->tree, impl_->q0, q));
+}
+
+VectorXd UrdfDynamics::gravity_force(const VectorXd& q) const {
+  return io::gravity_force(impl_->tree, positions(impl_->tree, impl_->q0, q), impl_->gravity);
+}
+
+VectorXd UrdfDynamics::damping() const {
+  // A mimic's damper acts through its leader: d_J + sum a_m^2 d_m (T' D T).
+  const Tree& t = impl_->tree;
+  VectorXd d = VectorXd::Zero(static_cast<Eigen::Index>(t.joints.size()));
+  for (std::size_t i = 0; i < t.joints.size(); ++i) {
+    const auto j = t.model.getJoint(t.joints[i]);
+    if (j->dynamics) d(static_cast<Eigen::Index>(i)) = j->dynamics->damping;
+  }
+  return (t.T.transpose() * d.asDiagonal() * t.T).diagonal();
+}
+
+UrdfLinearisation linearise_urdf(const urdf::ModelInterface& model,
+                                 const std::vector<std::string>& joints,
+                                 const std::map<std::string, double>& q0,
+                                 const Eigen::Vector3d& gravity, const std::string& source) {
+  const UrdfDynamics dyn(model, joints, q0, gravity, source);
+  const VectorXd q = dyn.reference();
   UrdfLinearisation lin;
   lin.joints = joints;
-  lin.M = crba(t, q0);
-  lin.tau_g = gravity_force(t, q0, gravity);
+  lin.M = dyn.mass_matrix(q);
+  lin.tau_g = dyn.gravity_force(q);
   // Gravity stiffness by central differences: tau_g is a sum of products of
   // sines and cosines (revolute) and polynomials of degree <= 1 (prismatic)
   // of q, so the error is h^2/6 |tau'''| (truncation) + eps |tau| / h
@@ -395,30 +534,17 @@ static UrdfLinearisation linearise_urdf_unfolded(const urdf::ModelInterface& mod
   // h is absolute, in rad or m). The result is symmetrised (it is minus the
   // Hessian of the potential energy), which does not increase that error.
   const double h = 6e-6;
-  const auto n = static_cast<Eigen::Index>(joints.size());
+  const auto n = q.size();
   lin.K_g = MatrixXd::Zero(n, n);
   for (Eigen::Index j = 0; j < n; ++j) {
-    auto qp = q0, qm = q0;
-    const std::string& name = joints[static_cast<std::size_t>(j)];
-    qp[name] = (q0.count(name) ? q0.at(name) : 0.0) + h;
-    qm[name] = (q0.count(name) ? q0.at(name) : 0.0) - h;
-    lin.K_g.col(j) = -(gravity_force(t, qp, gravity) - gravity_force(t, qm, gravity)) / (2 * h);
+    VectorXd qp = q, qm = q;
+    qp(j) += h;
+    qm(j) -= h;
+    lin.K_g.col(j) = -(dyn.gravity_force(qp) - dyn.gravity_force(qm)) / (2 * h);
   }
   lin.K_g = (0.5 * (lin.K_g + lin.K_g.transpose())).eval();
-  lin.damping = VectorXd::Zero(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const auto j = model.getJoint(joints[static_cast<std::size_t>(i)]);
-    if (j->dynamics) lin.damping(i) = j->dynamics->damping;
-  }
+  lin.damping = dyn.damping();
   return lin;
-}
-
-UrdfLinearisation linearise_urdf(const urdf::ModelInterface& model,
-                                 const std::vector<std::string>& joints,
-                                 const std::map<std::string, double>& q0,
-                                 const Eigen::Vector3d& gravity, const std::string& source) {
-  return one_line_errors(
-      [&] { return linearise_urdf_unfolded(model, joints, q0, gravity, source); });
 }
 
 }  // namespace lcsim::io
