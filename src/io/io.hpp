@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -118,5 +119,23 @@ UrdfLinearisation linearise_urdf(const urdf::ModelInterface& model,
 // linearisation in docs/model-format.md, "Scenes".
 mech::Model load_scene(const std::filesystem::path& path);
 mech::Model parse_scene(const std::string& yaml_text, const std::string& source);
+
+// What a scene's model keeps only in linearised form, for building the scene
+// again from its URDF (src/bullet): the URDF and its path, the q0 of every
+// joint the scene names (frozen joints sit there), gravity (m/s^2, URDF root
+// frame), and the linearisation whose tau_g and K_g went into f and K (the
+// rest of K and f, and all of D, are the springs' and the joints' dampers).
+struct SceneSetup {
+  std::shared_ptr<urdf::ModelInterface> urdf;
+  std::string urdf_path;
+  std::map<std::string, double> q0;
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
+  UrdfLinearisation linearisation;
+};
+// The setup of the scene `model` was loaded from (model.source, read again);
+// std::nullopt when model.source is not a readable, valid scene file or when
+// `model` is not what that file gives (changed after loading: M, D, K, E, g,
+// f, restitution or the names differ).
+std::optional<SceneSetup> scene_setup(const mech::Model& model);
 
 }  // namespace lcsim::io

@@ -58,7 +58,10 @@ std::map<std::string, double> by_joint(
 
 }  // namespace
 
-mech::Model parse_scene(const std::string& yaml_text, const std::string& source) {
+namespace {
+
+// parse_scene, and with `setup` also what scene_setup returns.
+mech::Model parse(const std::string& yaml_text, const std::string& source, SceneSetup* setup) {
   const YAML::Node root = load(yaml_text, source);
   const Keys keys = mapping(root, source, "",
                             {"name", "urdf", "joints", "q0", "gravity", "springs", "constraints",
@@ -165,6 +168,7 @@ mech::Model parse_scene(const std::string& yaml_text, const std::string& source)
   }
 
   const UrdfLinearisation lin = linearise_urdf(um, joints, q0, gravity, us);
+  if (setup) *setup = SceneSetup{urdf_model, us, q0, gravity, lin};
   VectorXd q0v = VectorXd::Zero(N);
   for (Eigen::Index i = 0; i < N; ++i)
     if (q0.count(joints[static_cast<std::size_t>(i)]))
@@ -317,7 +321,7 @@ mech::Model parse_scene(const std::string& yaml_text, const std::string& source)
   return model;
 }
 
-mech::Model load_scene(const std::filesystem::path& path) {
+std::string read_text(const std::filesystem::path& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     throw InputError(path.string() + ": cannot open: no such file");
@@ -325,7 +329,44 @@ mech::Model load_scene(const std::filesystem::path& path) {
   if (!in) throw InputError(path.string() + ": cannot open: unreadable");
   std::ostringstream ss;
   ss << in.rdbuf();
-  return parse_scene(ss.str(), path.string());
+  return ss.str();
+}
+
+bool same_matrix(const mech::SparseMatrix& a, const mech::SparseMatrix& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() && MatrixXd(a) == MatrixXd(b);
+}
+
+bool same_vector(const VectorXd& a, const VectorXd& b) { return a.size() == b.size() && a == b; }
+
+bool same_model(const mech::MechanicalModel& a, const mech::MechanicalModel& b) {
+  return same_matrix(a.M, b.M) && same_matrix(a.D, b.D) && same_matrix(a.K, b.K) &&
+         same_matrix(a.E, b.E) && same_vector(a.g, b.g) && same_vector(a.f, b.f) &&
+         same_vector(a.restitution, b.restitution) && a.coordinates == b.coordinates &&
+         a.constraints == b.constraints;
+}
+
+}  // namespace
+
+mech::Model parse_scene(const std::string& yaml_text, const std::string& source) {
+  return parse(yaml_text, source, nullptr);
+}
+
+std::optional<SceneSetup> scene_setup(const mech::Model& model) {
+  if (!model.is_mechanical()) return std::nullopt;
+  SceneSetup setup;
+  try {
+    const std::string text = read_text(model.source);
+    if (!load(text, model.source)["urdf"]) return std::nullopt;
+    const mech::Model again = parse(text, model.source, &setup);
+    if (!same_model(*again.mechanical, *model.mechanical)) return std::nullopt;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  return setup;
+}
+
+mech::Model load_scene(const std::filesystem::path& path) {
+  return parse_scene(read_text(path), path.string());
 }
 
 }  // namespace lcsim::io
