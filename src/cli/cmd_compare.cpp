@@ -61,6 +61,7 @@ void run_compare(const CompareArgs& a) {
   bullet::WorldSettings ws;
   ws.stop_erp = a.stop_erp;
   ws.solver_iterations = a.iterations;
+  const std::string bullet_solver = bullet::solver_description(model, ws);
   const sim::Trajectory bt = bullet::simulate_bullet(model, x0, opt, ws);
   if (bt.status != sim::RunStatus::kCompleted)
     throw NumericalError("compare: the Bullet run failed: " + bt.message);
@@ -86,7 +87,7 @@ void run_compare(const CompareArgs& a) {
     j["unmatched_bullet_switches"] = c.unmatched_other;
     j["energy_drift"] = c.energy_drift;
     j["max_violation"] = c.max_violation;
-    j["bullet_solver"] = bullet::solver_description(ws);
+    j["bullet_solver"] = bullet_solver;
     j["stop_erp"] = ws.stop_erp;
     j["bullet_version"] = bullet::version_string();
     j["steps"] = bt.steps;
@@ -95,8 +96,7 @@ void run_compare(const CompareArgs& a) {
     return;
   }
   std::printf("model %s, t_end %g, h %g: %s, %s, stop ERP %g\n", model.name.c_str(), opt.t_end, a.h,
-              bullet::version_string().c_str(), bullet::solver_description(ws).c_str(),
-              ws.stop_erp);
+              bullet::version_string().c_str(), bullet_solver.c_str(), ws.stop_erp);
   std::printf("deviation max  %.3e (at t = %.6g)\n", c.deviation_max, c.deviation_t);
   std::printf("error final    %.3e\n", c.error_final);
   std::printf("energy drift   %.3e J (Bullet's change minus the exact change)\n", c.energy_drift);
