@@ -12,6 +12,7 @@
 //   bullet_solver  which Bullet constraint solver ran.
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
 
@@ -66,6 +67,9 @@ void run_compare(const CompareArgs& a) {
   if (bt.status != sim::RunStatus::kCompleted)
     throw NumericalError("compare: the Bullet run failed: " + bt.message);
   const bullet::Comparison c = bullet::compare_trajectories(exact, bt, 1e-9 * a.h);
+  // What the Bullet scene does differently (lost restitution, explicit
+  // springs, a scene run as rb6), as `simulate` prints it.
+  for (const auto& w : bt.warning_messages) std::cerr << "lcsim: warning: " << w << "\n";
   const double per_step = bt.steps ? bt.wall_time_s / bt.steps : 0.0;
 
   if (a.json) {
