@@ -3,6 +3,7 @@
 // run of the same scene.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -19,6 +20,7 @@ namespace lcsim::bullet {
 namespace {
 
 namespace fs = std::filesystem;
+using Eigen::MatrixXd;
 
 const std::string kRobots = std::string(LCSIM_SOURCE_DIR) + "/robots/";
 
@@ -240,6 +242,38 @@ TEST(MultibodyScene, TwoActiveLimitsInOneStep) {
     else
       EXPECT_LE(err, 1e-9);
   }
+}
+
+// Explicit spring torques are unstable for omega h > 2: said, with omega^2 the
+// largest eigenvalue of K_s x = omega^2 M x. For the chain, from the URDF by
+// hand: M_ij = a_i.a_j (mass beyond max(i, j)), K_s = diag(20, 10, 8) (the
+// scene's springs; gravity adds no stiffness to sliders): omega = 6.7035 rad/s,
+// so h = 0.3 (omega h = 2.011) warns and h = 0.29 (1.944) does not. Dampers
+// (the arm's servos) are said too.
+TEST(MultibodyScene, ExplicitSpringsAndDampersAreSaid) {
+  Eigen::Matrix3d M;
+  M << 1.75, 0.6 * 0.75, 0.48 * 0.25, 0.6 * 0.75, 0.75, 0.768 * 0.25, 0.48 * 0.25, 0.768 * 0.25,
+      0.25;
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix3d> es(
+      Eigen::Vector3d(20, 10, 8).asDiagonal().toDenseMatrix(), M);
+  const double omega = std::sqrt(es.eigenvalues().maxCoeff());
+  EXPECT_NEAR(omega, 6.7035, 1e-4);
+  const mech::Model m = io::load_model(kRobots + "prismatic_chain_scene.yaml");
+  EXPECT_NEAR((MatrixXd(m.mechanical->M) - M).cwiseAbs().maxCoeff(), 0.0, 1e-12);
+  sim::Options o;
+  o.t_end = 2;
+  const auto said = [](const sim::Trajectory& tr, const std::string& what) {
+    for (const auto& w : tr.warning_messages)
+      if (w.find(what) != std::string::npos) return true;
+    return false;
+  };
+  o.h = 0.3;
+  EXPECT_TRUE(said(simulate_bullet(m, m.initial, o), "omega h > 2"));
+  o.h = 0.29;
+  EXPECT_FALSE(said(simulate_bullet(m, m.initial, o), "omega h > 2"));
+  const mech::Model arm = io::load_model(kRobots + "arm_gripper_scene.yaml");
+  o.h = 1e-3;
+  EXPECT_TRUE(said(simulate_bullet(arm, arm.initial, o), "dampers are explicit joint torques"));
 }
 
 // What Bullet cannot express is refused, 0-based, before anything runs.
