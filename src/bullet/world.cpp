@@ -1,5 +1,6 @@
 // The lcsim mechanical model built in Bullet ("rb6" of ../shared/notes/bullet.md)
-// and run with Bullet's fixed step.
+// and run with Bullet's fixed step. simulate_bullet (at the end) chooses
+// between this scene and the multibody of a URDF scene (multibody_world.cpp).
 //
 // Scene. One btRigidBody per coordinate q_j, mass M_jj, linear factor (1,0,0),
 // angular factor 0, placed at x = q_j; bodies never collide (broadphase mask 0),

@@ -38,7 +38,8 @@ TEST(BulletCli, NonDiagonalMatrixModelExitsTwoEverywhere) {
   }
 }
 
-// Every shipped URDF scene runs beside Bullet: compare exits 0 and names the
+// Every shipped URDF scene runs beside Bullet: compare and sweep exit 0, compare
+// names the
 // scene Bullet built (the multibody, or rb6 for the hook scene) and warns
 // about what it drops.
 TEST(BulletCli, CompareRunsOnEveryShippedScene) {
@@ -58,6 +59,11 @@ TEST(BulletCli, CompareRunsOnEveryShippedScene) {
     if (!multibody) {
       EXPECT_NE(r.err.find("constraint 'hook'"), std::string::npos) << r.err;
     }
+    const auto sw = lcsim("sweep '" + kRobots + scene + ".yaml' --methods bullet --h 1e-2 --json");
+    ASSERT_EQ(sw.exit_code, 0) << scene << ": " << sw.err;
+    const auto row = nlohmann::json::parse(sw.out)["rows"][0];
+    EXPECT_EQ(row["method"], "bullet") << sw.out;
+    EXPECT_EQ(row["status"], "completed") << sw.out;
   }
 }
 
