@@ -270,7 +270,7 @@ Plan plan_of(const mech::Model& model, const WorldSettings& s) {
 
 std::string rb6_description(const WorldSettings& s) {
   return "btSequentialImpulseConstraintSolver (" + std::to_string(s.solver_iterations) +
-         " iterations)";
+         " iterations), btGeneric6DofSpring2Constraint limits (stop ERP " + fmt(s.stop_erp) + ")";
 }
 
 }  // namespace

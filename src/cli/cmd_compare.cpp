@@ -99,8 +99,10 @@ void run_compare(const CompareArgs& a) {
     std::printf("%s\n", j.dump(2).c_str());
     return;
   }
-  std::printf("model %s, t_end %g, h %g: %s, %s, stop ERP %g\n", model.name.c_str(), opt.t_end, a.h,
-              bullet::version_string().c_str(), bullet_solver.c_str(), ws.stop_erp);
+  // The scene's own ERP (rb6's stop ERP, the multibody's limit ERP) is in
+  // bullet_solver.
+  std::printf("model %s, t_end %g, h %g: %s, %s\n", model.name.c_str(), opt.t_end, a.h,
+              bullet::version_string().c_str(), bullet_solver.c_str());
   std::printf("deviation max  %.3e (at t = %.6g)\n", c.deviation_max, c.deviation_t);
   std::printf("error final    %.3e\n", c.error_final);
   std::printf("energy drift   %.3e J (Bullet's change minus the exact change)\n", c.energy_drift);
@@ -123,7 +125,8 @@ void setup(CLI::App& app) {
   cmd->add_option("--x0", a->x0, "Initial state a,b,... (q then v); default: the model's");
   auto* t_end = cmd->add_option("--t-end", a->t_end, "Horizon (s); default: the model's t_end");
   cmd->add_option("--h", a->h, "Bullet's time step (s); default 1e-3");
-  cmd->add_option("--stop-erp", a->stop_erp, "ERP of Bullet's 6DOF2 limits in (0, 1]; default 0.2");
+  cmd->add_option("--stop-erp", a->stop_erp,
+                  "ERP of Bullet's 6DOF2 limits in (0, 1] (rb6 scenes only); default 0.2");
   cmd->add_option("--iterations", a->iterations, "Bullet solver iterations; default 100");
   cmd->add_flag("--json", a->json, "Print the comparison as JSON");
   cmd->callback([a, t_end] {
