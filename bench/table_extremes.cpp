@@ -1,6 +1,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 #include <string>
 #include <unsupported/Eigen/MatrixFunctions>
 
@@ -34,7 +35,17 @@ sim::Trajectory step_run(const std::string& method, const mech::Model& model, co
   o.t_end = T;
   o.h = h;
   o.record_samples = samples;
-  if (method == "bullet") return bullet::simulate_bullet(model, x0, o);
+  if (method == "bullet") {
+    try {
+      return bullet::simulate_bullet(model, x0, o);
+    } catch (const std::invalid_argument& e) {  // a model Bullet cannot express
+      sim::Trajectory tr;
+      tr.status = sim::RunStatus::kFailed;
+      tr.message = e.what();
+      tr.final_state = x0;
+      return tr;
+    }
+  }
   o.theta = method == "mj1" ? 1.0 : 0.5;
   return sim::make_integrator(method == "euler" ? "euler" : "moreau-jean")->run(model, x0, o);
 }

@@ -27,9 +27,14 @@ std::string version_string();
 namespace lcsim::bullet {
 
 // Every Bullet setting that affects accuracy, pinned (Bullet's defaults are
-// stated where they differ). The scene is "rb6" of ../shared/notes/bullet.md:
-// one btRigidBody per coordinate, constraints as btGeneric6DofSpring2Constraint
-// linear limits, springs/dampers/f as forces applied before every step.
+// stated where they differ). Two scenes (docs/bullet-comparison.md):
+// - a model from a URDF scene whose constraints are all joint limits is the
+//   URDF itself: a Featherstone btMultiBody (src/bullet/multibody_world.cpp)
+//   with btMultiBodyJointLimitConstraint limits, the scene's springs and
+//   dampers as joint torques applied before every step;
+// - any other model is "rb6" of ../shared/notes/bullet.md: one btRigidBody per
+//   coordinate, constraints as btGeneric6DofSpring2Constraint linear limits,
+//   springs/dampers/f as forces applied before every step.
 struct WorldSettings {
   // btSequentialImpulseConstraintSolver sweeps per step (Bullet default 10).
   // Two coupled rows (stop and hook on one cart) need more than 3 sweeps to
@@ -45,22 +50,48 @@ struct WorldSettings {
   // The "infinite" side of a one-sided limit (m): a stop x >= a is the range
   // [a, a + limit_range]. Valid while |q| stays well below it.
   double limit_range = 1e6;
+
+  // ---- the multibody scene ----
+  // btContactSolverInfo::m_erp (and m_erp2), the Baumgarte factor of
+  // btMultiBodyJointLimitConstraint (Bullet's default 0.2): a limit row
+  // exists only once the joint is at or past its bound, and asks for the
+  // joint velocity limit_erp * penetration / h. 0: an impact stops the joint
+  // where it is (at most |v| h past the bound) and nothing pushes it back;
+  // see docs/bullet-comparison.md for why not 0.2.
+  double limit_erp = 0.0;
+  // btMultiBodyConstraint::setMaxAppliedImpulse of every limit (Bullet's
+  // default 100 N s, which a heavy arm at its stop exceeds).
+  double limit_max_impulse = 1e30;
+  // btMultiBodyMLCPConstraintSolver with btDantzigSolver instead of the
+  // sequential-impulse btMultiBodyConstraintSolver. Off: with two limit rows
+  // active at once it builds a wrong coupling between them
+  // (../shared/notes/bullet.md, measured in docs/bullet-comparison.md); kept
+  // only to measure that.
+  bool multibody_mlcp = false;
 };
 
-// "btSequentialImpulseConstraintSolver (100 iterations)": what ran.
-std::string solver_description(const WorldSettings& s = {});
+// What runs for `model` with these settings: "btSequentialImpulseConstraintSolver
+// (100 iterations)" for rb6, "btMultiBody from the URDF, ..." for a scene.
+// Throws as check_expressible.
+std::string solver_description(const mech::Model& model, const WorldSettings& s = {});
 
 // Throws std::invalid_argument naming the first part of the model Bullet
-// cannot express with this scene: a general LCS, a non-diagonal M, a row of E
+// cannot express (0-based indices): a general LCS; for a URDF scene, a
+// constraint that is not a joint limit when the scene's matrices are not
+// rb6's either; otherwise a non-diagonal M ("M(1, 0) = 0.1") or a row of E
 // that is neither a stop (c e_j) nor a hook (c (e_a - e_b)).
 void check_expressible(const mech::Model& model);
 
 // The model run in Bullet with fixed step opt.h (the last step shortened to
 // land on opt.t_end), filling the same Trajectory as the time-stepping
-// methods: samples (every step, or on the opt.dt_out grid), u = constraint
-// impulse / h reconstructed from the momentum balance, mode = constraints with
-// a nonzero impulse in the step, events at every mode change, energy,
-// max_violation. Never throws: an inexpressible model gives kFailed.
+// methods: samples (every step, or on the opt.dt_out grid; x = q then v in the
+// model's coordinate order), u = constraint impulse / h (rb6: from the
+// momentum balance; multibody: Bullet's limit impulses), mode = constraints
+// with a nonzero impulse in the step, events at every mode change, energy
+// (of lcsim's model at Bullet's states), max_violation. A model Bullet cannot
+// express throws std::invalid_argument (an input error, as
+// check_expressible) before anything runs; everything else, numerical
+// trouble included, ends the run with kFailed and a message.
 sim::Trajectory simulate_bullet(const mech::Model& model, const Eigen::VectorXd& x0,
                                 const sim::Options& opt, const WorldSettings& s = {});
 
@@ -75,11 +106,11 @@ struct EventShift {
 };
 
 struct Comparison {
-  double deviation_max = 0.0;  // max over common sample times of max-abs state difference
-  double deviation_t = 0.0;    // where it occurs (s)
-  double error_final = 0.0;    // max-abs difference of the final states
+  double deviation_max = 0.0;            // max over common sample times of max-abs state difference
+  double deviation_t = 0.0;              // where it occurs (s)
+  double error_final = 0.0;              // max-abs difference of the final states
   std::vector<EventShift> event_shifts;  // one per switch of the exact run, in time order
-  int unmatched_other = 0;     // switches of the other run that match no exact switch
+  int unmatched_other = 0;               // switches of the other run that match no exact switch
   double energy_drift = 0.0;   // (E_f - E_0) of the other run minus that of the exact run (J)
   double max_violation = 0.0;  // the other run's most negative gap
   long samples_compared = 0;   // samples of `other` with an exact sample at the same time

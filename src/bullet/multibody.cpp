@@ -7,9 +7,11 @@
 #include <urdf_model/model.h>
 
 #include <functional>
+#include <memory>
 #include <stdexcept>
 
 #include "bullet/bullet.hpp"
+#include "bullet/urdf_multibody.hpp"
 
 namespace lcsim::bullet {
 
@@ -44,9 +46,9 @@ struct Body {
 
 }  // namespace
 
-Eigen::MatrixXd multibody_mass_matrix(const urdf::ModelInterface& model,
-                                      const std::vector<std::string>& joints,
-                                      const std::map<std::string, double>& q0) {
+UrdfMultiBody build_urdf_multibody(const urdf::ModelInterface& model,
+                                   const std::vector<std::string>& joints,
+                                   const std::map<std::string, double>& q0) {
   const auto q_of = [&](const std::string& name) {
     const auto it = q0.find(name);
     return it == q0.end() ? 0.0 : it->second;
@@ -83,7 +85,7 @@ Eigen::MatrixXd multibody_mass_matrix(const urdf::ModelInterface& model,
   X[model.getRoot()->name] = btTransform::getIdentity();
   walk(*model.getRoot(), -1);
   if (bodies.size() != joints.size())
-    throw std::invalid_argument("multibody_mass_matrix: a simulated joint is not in the URDF tree");
+    throw std::invalid_argument("bullet: a simulated joint is not in the URDF tree");
 
   // Merge every link into its body: total mass, centre of mass, then the
   // inertia about that centre (parallel-axis theorem), then principal axes.
@@ -122,7 +124,10 @@ Eigen::MatrixXd multibody_mass_matrix(const urdf::ModelInterface& model,
   }
 
   const int n = static_cast<int>(bodies.size());
-  btMultiBody mb(n, 1.0, btVector3(1, 1, 1), /*fixedBase=*/true, /*canSleep=*/false);
+  UrdfMultiBody out;
+  out.body = std::make_unique<btMultiBody>(n, 1.0, btVector3(1, 1, 1), /*fixedBase=*/true,
+                                           /*canSleep=*/false);
+  btMultiBody& mb = *out.body;
   mb.setBaseWorldTransform(btTransform::getIdentity());
   for (int i = 0; i < n; ++i) {
     const Body& b = bodies[static_cast<std::size_t>(i)];
@@ -147,15 +152,31 @@ Eigen::MatrixXd multibody_mass_matrix(const urdf::ModelInterface& model,
                        parent_com_to_pivot, pivot_to_com, true);
   }
   mb.finalizeMultiDof();
-  // Pitfalls (shared/notes/bullet.md): default damping 0.04; no gyroscopic
-  // terms at zero velocity anyway. No gravity: a btMultiBody outside a world
-  // feels only the forces added to it.
+  // Pitfall (shared/notes/bullet.md): default damping 0.04.
   mb.setLinearDamping(0);
   mb.setAngularDamping(0);
-  mb.setUseGyroTerm(false);
-  for (int i = 0; i < n; ++i) mb.setJointPos(i, q_of(bodies[static_cast<std::size_t>(i)].joint));
+  out.coordinate.resize(static_cast<std::size_t>(n));
+  out.link.resize(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const int c = simulated_index(bodies[static_cast<std::size_t>(i)].joint);
+    out.coordinate[static_cast<std::size_t>(i)] = c;
+    out.link[static_cast<std::size_t>(c)] = i;
+    mb.setJointPos(i, q_of(bodies[static_cast<std::size_t>(i)].joint));
+  }
   mb.clearForcesAndTorques();
   mb.clearVelocities();
+  return out;
+}
+
+Eigen::MatrixXd multibody_mass_matrix(const urdf::ModelInterface& model,
+                                      const std::vector<std::string>& joints,
+                                      const std::map<std::string, double>& q0) {
+  UrdfMultiBody built = build_urdf_multibody(model, joints, q0);
+  btMultiBody& mb = *built.body;
+  const int n = mb.getNumLinks();
+  // No gyroscopic terms at zero velocity anyway. No gravity: a btMultiBody
+  // outside a world feels only the forces added to it.
+  mb.setUseGyroTerm(false);
 
   btAlignedObjectArray<btScalar> scratch_r;
   btAlignedObjectArray<btVector3> scratch_v;
@@ -163,9 +184,7 @@ Eigen::MatrixXd multibody_mass_matrix(const urdf::ModelInterface& model,
   mb.computeAccelerationsArticulatedBodyAlgorithmMultiDof(1e-3, scratch_r, scratch_v, scratch_m,
                                                           false, false, false);
   // Bullet link order -> the caller's joint order.
-  std::vector<int> coord(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i)
-    coord[static_cast<std::size_t>(i)] = simulated_index(bodies[static_cast<std::size_t>(i)].joint);
+  const std::vector<int>& coord = built.coordinate;
   Eigen::MatrixXd Minv(n, n);
   std::vector<btScalar> force(static_cast<std::size_t>(6 + n)),
       out(static_cast<std::size_t>(6 + n));

@@ -1,5 +1,6 @@
 // The lcsim mechanical model built in Bullet ("rb6" of ../shared/notes/bullet.md)
-// and run with Bullet's fixed step.
+// and run with Bullet's fixed step. simulate_bullet (at the end) chooses
+// between this scene and the multibody of a URDF scene (multibody_world.cpp).
 //
 // Scene. One btRigidBody per coordinate q_j, mass M_jj, linear factor (1,0,0),
 // angular factor 0, placed at x = q_j; bodies never collide (broadphase mask 0),
@@ -45,10 +46,14 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 
 #include "bullet/bullet.hpp"
+#include "bullet/multibody_scene.hpp"
+#include "bullet/run_recorder.hpp"
+#include "io/io.hpp"
 
 namespace lcsim::bullet {
 
@@ -76,7 +81,7 @@ Limit classify(const mech::MechanicalModel& m, int i, double range) {
       scale = std::max(scale, std::abs(m.E.coeff(i, j)));
     }
   const std::string who =
-      "constraint '" + m.constraints[i] + "' (row " + std::to_string(i + 1) + " of E)";
+      "constraint '" + m.constraints[i] + "' (row " + std::to_string(i) + " of E)";
   Limit L;
   if (nz.size() == 1) {
     const int j = nz[0];
@@ -123,9 +128,11 @@ std::vector<Limit> limits_of(const mech::Model& model, double range) {
   for (int c = 0; c < m.M.outerSize(); ++c)
     for (mech::SparseMatrix::InnerIterator it(m.M, c); it; ++it)
       if (it.row() != c && std::abs(it.value()) > 1e-14 * mscale)
-        throw std::invalid_argument("bullet: M(" + std::to_string(it.row() + 1) + "," +
-                                    std::to_string(c + 1) + ") = " + fmt(it.value()) +
-                                    ": one rigid body per coordinate needs a diagonal M");
+        throw std::invalid_argument(
+            "bullet: M(" + std::to_string(it.row()) + ", " + std::to_string(c) +
+            ") = " + fmt(it.value()) +
+            ": one rigid body per coordinate needs a diagonal M (a non-diagonal M runs in "
+            "Bullet only as a URDF scene, whose multibody Bullet builds from the URDF)");
   std::vector<Limit> out;
   for (int i = 0; i < m.num_constraints(); ++i) out.push_back(classify(m, i, range));
   return out;
@@ -226,20 +233,61 @@ std::unique_ptr<World> build(const mech::MechanicalModel& m, const std::vector<L
   return w;
 }
 
-}  // namespace
+// Which scene runs a model: the multibody for a URDF scene whose rows are
+// all joint limits; else rb6 (a scene's matrices included, with a warning);
+// std::invalid_argument when neither can express it.
+struct Plan {
+  std::optional<io::Scene> scene;  // set: the multibody
+  std::vector<JointLimit> joint_limits;
+  std::vector<Limit> rb6_limits;
+  std::string warning;
+};
 
-std::string solver_description(const WorldSettings& s) {
-  return "btSequentialImpulseConstraintSolver (" + std::to_string(s.solver_iterations) +
-         " iterations)";
+Plan plan_of(const mech::Model& model, const WorldSettings& s) {
+  Plan p;
+  std::optional<io::Scene> setup =
+      model.is_mechanical() ? io::scene_setup(model) : std::nullopt;
+  if (!setup) {
+    p.rb6_limits = limits_of(model, s.limit_range);
+    return p;
+  }
+  try {
+    p.joint_limits = joint_limits_of(*model.mechanical);
+    p.scene = std::move(setup);
+    return p;
+  } catch (const std::invalid_argument& not_limits) {
+    try {
+      p.rb6_limits = limits_of(model, s.limit_range);
+    } catch (const std::invalid_argument&) {
+      throw not_limits;  // the scene's own reason
+    }
+    p.warning = std::string(not_limits.what()) +
+                "; Bullet runs the scene's linearised matrices instead (one rigid body per "
+                "coordinate), not the URDF's dynamics";
+    return p;
+  }
 }
 
-void check_expressible(const mech::Model& model) { (void)limits_of(model, 1e6); }
+std::string rb6_description(const WorldSettings& s) {
+  return "btSequentialImpulseConstraintSolver (" + std::to_string(s.solver_iterations) +
+         " iterations), btGeneric6DofSpring2Constraint limits (stop ERP " + fmt(s.stop_erp) + ")";
+}
 
-sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
-                                const sim::Options& opt, const WorldSettings& s) {
+}  // namespace
+
+std::string solver_description(const mech::Model& model, const WorldSettings& s) {
+  return plan_of(model, s).scene ? multibody_description(s) : rb6_description(s);
+}
+
+void check_expressible(const mech::Model& model) { (void)plan_of(model, WorldSettings{}); }
+
+namespace {
+
+sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>& limits,
+                             const VectorXd& x0, const sim::Options& opt, const WorldSettings& s) {
   const auto wall0 = std::chrono::steady_clock::now();
   sim::Trajectory tr;
-  tr.method = "bullet " + solver_description(s);
+  tr.method = "bullet " + rb6_description(s);
   tr.t_end = opt.t_end;
   tr.final_state = x0;
   auto fail = [&](const std::string& msg) {
@@ -249,12 +297,6 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     return std::move(tr);  // only ever returned from the run: no copy of the samples
   };
-  std::vector<Limit> limits;
-  try {
-    limits = limits_of(model, s.limit_range);
-  } catch (const std::exception& e) {
-    return fail(e.what());
-  }
   const mech::MechanicalModel& m = *model.mechanical;
   const int N = m.dofs(), k = m.num_constraints();
   if (x0.size() != 2 * N)
@@ -265,7 +307,6 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
   if (const std::string bad = sim::infeasible_start(model, x0); !bad.empty())
     return fail("bullet: " + bad);
   VectorXd q = x0.head(N), v = x0.tail(N);
-  tr.energy_initial = mech::total_energy(m, q, v);
   if (m.D.norm() > 0.0)
     tr.add_warning(
         "bullet: dampers are explicit forces -D v (stable only for h small against M/D)");
@@ -318,24 +359,8 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
     if (Et.info() != Eigen::Success) return fail("bullet: cannot factor E' for the multipliers");
   }
 
-  VectorXd y = m.E * q + m.g;
-  if (k > 0) tr.max_violation = std::min(0.0, y.minCoeff());
-  sim::OutputSampler sampler(opt.dt_out);
-  auto record = [&](double t, const VectorXd& u, const sim::IndexSet& mode) {
-    if (!opt.record_samples) return;
-    sim::Sample smp;
-    smp.t = t;
-    smp.x.resize(2 * N);
-    smp.x << q, v;
-    smp.u = u;
-    smp.y = y;
-    smp.mode = mode;
-    tr.samples.push_back(std::move(smp));
-  };
-  sim::IndexSet mode;
-  record(0.0, VectorXd::Zero(k), mode);
-
-  VectorXd F(N), q_next(N), v_next(N), u(k);
+  RunRecorder rec(m, opt, tr, q, v);
+  VectorXd F(N), q_next(N), v_next(N);
   for (long j = 1; j <= grid.n; ++j) {
     const bool last = j == grid.n;
     if (opt.progress && j % sim::Options::kProgressSteps == 0) opt.progress(j * opt.h);
@@ -350,54 +375,29 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
     }
     if (!q_next.allFinite() || !v_next.allFinite())
       return fail("bullet: non-finite state at t = " + fmt(j * opt.h));
-    sim::IndexSet new_mode;
     VectorXd impulse = VectorXd::Zero(k);
-    if (k > 0) {
-      const VectorXd r = m.M * (v_next - v) - h * F;
-      impulse = Et.solve(r);
-      // Round-off in r is ~1e-16 |M v|; impulses of real contacts are O(h).
-      const double tiny =
-          1e-10 * (1.0 + (m.M * v).cwiseAbs().maxCoeff() + h * F.cwiseAbs().maxCoeff());
-      for (int i = 0; i < k; ++i)
-        if (impulse(i) > tiny) new_mode.push_back(i);
-      u = impulse / h;
-    }
-    const double t = last ? opt.t_end : j * opt.h;
-    if (new_mode != mode) {
-      sim::Event e;
-      e.t = t;
-      e.state_before.resize(2 * N);
-      e.state_before << q, v;
-      e.state_after.resize(2 * N);
-      e.state_after << q_next, v_next;
-      e.mode_after = new_mode;
-      e.impulse = impulse;
-      bool gained = false, lost = false, approaching = false;
-      for (int i : new_mode)
-        if (std::find(mode.begin(), mode.end(), i) == mode.end()) {
-          gained = true;
-          if (m.E.row(i).dot(v) < 0.0) approaching = true;
-        }
-      for (int i : mode)
-        if (std::find(new_mode.begin(), new_mode.end(), i) == new_mode.end()) lost = true;
-      e.type = approaching       ? sim::EventType::kImpact
-               : lost && !gained ? sim::EventType::kRelease
-                                 : sim::EventType::kContact;
-      tr.events.push_back(std::move(e));
-      mode = new_mode;
-    }
+    if (k > 0) impulse = Et.solve(VectorXd(m.M * (v_next - v) - h * F));
+    // Round-off in the momentum balance is ~1e-16 |M v|; impulses of real
+    // contacts are O(h).
+    const double tiny =
+        1e-10 * (1.0 + (m.M * v).cwiseAbs().maxCoeff() + h * F.cwiseAbs().maxCoeff());
+    rec.step(last ? opt.t_end : j * opt.h, h, last, q_next, v_next, impulse, tiny);
     q = q_next;
     v = v_next;
-    ++tr.steps;
-    if (k > 0) ++tr.lcp_solves;  // the constraint solver runs every step
-    y = m.E * q + m.g;
-    if (k > 0) tr.max_violation = std::min(tr.max_violation, std::min(0.0, y.minCoeff()));
-    if (sampler.want(t, opt.h, last)) record(t, k > 0 ? u : VectorXd(), mode);
   }
-  tr.final_state.resize(2 * N);
-  tr.final_state << q, v;
-  tr.energy_final = mech::total_energy(m, q, v);
+  rec.finish();
   tr.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return tr;
+}
+
+}  // namespace
+
+sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
+                                const sim::Options& opt, const WorldSettings& s) {
+  const Plan p = plan_of(model, s);  // throws for an inexpressible model
+  sim::Trajectory tr = p.scene ? simulate_multibody(model, *p.scene, p.joint_limits, x0, opt, s)
+                               : simulate_rb6(model, p.rb6_limits, x0, opt, s);
+  if (!p.warning.empty()) tr.add_warning(p.warning);
   return tr;
 }
 

@@ -21,9 +21,4 @@ std::string one_line(const std::string& text, std::size_t max_chars = 1000);
 // file" (or "is a directory", "permission denied or unreadable").
 std::string read_file(const std::filesystem::path& path);
 
-// Why a mimic joint cannot be simulated: "mimics joint 'J' (<mimic>: q =
-// a * q_J + b), so it is not a degree of freedom: ..." with what to do
-// instead (simulate J alone when `leader_simulated`, else J or neither).
-std::string mimic_refusal(const std::string& name, const Mimic& mimic, bool leader_simulated);
-
 }  // namespace lcsim::io

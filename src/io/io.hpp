@@ -115,8 +115,13 @@ struct Mimic {
   double multiplier = 1.0;
   double offset = 0.0;
 };
+// `simulated`: joints a scene simulates. Such a joint is its own coordinate
+// even if it carries a <mimic> (the scene's explicit choice wins: the NAO
+// legs of issue 12 simulate RHipYawPitch, which the URDF ties to
+// LHipYawPitch), so it is not returned, and a chain stops at it.
 std::map<std::string, Mimic> mimic_joints(const urdf::ModelInterface& model,
-                                          const std::string& source);
+                                          const std::string& source,
+                                          const std::vector<std::string>& simulated = {});
 
 // The exact (nonlinear) joint-space dynamics of a scene's URDF as functions
 // of the coordinates q (the simulated joints, in the order of `joints`):
@@ -233,5 +238,10 @@ std::vector<LinearRange> linear_ranges(const Scene& scene, double threshold);
 // [{joint, unit, q0, lower, upper, lower_end, upper_end}, ...].
 nlohmann::json to_json(const LinearisationCheck& check);
 nlohmann::json to_json(const std::vector<LinearRange>& ranges);
+// The scene `model` was loaded from (model.source, read again), for building
+// it again from its URDF (src/bullet); std::nullopt when model.source is not
+// a readable, valid scene file or when `model` is not what that file gives
+// (changed after loading: M, D, K, E, g, f, restitution or the names differ).
+std::optional<Scene> scene_setup(const mech::Model& model);
 
 }  // namespace lcsim::io

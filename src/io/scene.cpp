@@ -164,13 +164,7 @@ Scene read_scene(const std::string& yaml_text, const std::string& source) {
     stops.push_back(st);
     mimic_stops.push_back(mst);
   }
-  const std::map<std::string, Mimic> mimics = mimic_joints(um, us);
-  for (std::size_t i = 0; i < joints.size(); ++i)
-    if (const auto it = mimics.find(joints[i]); it != mimics.end())
-      fail(source, "joints[" + std::to_string(i) + "]",
-           "joint '" + joints[i] + "' " +
-               mimic_refusal(joints[i], it->second,
-                             std::count(joints.begin(), joints.end(), it->second.leader) > 0));
+  const std::map<std::string, Mimic> mimics = mimic_joints(um, us, joints);
   const auto N = static_cast<Eigen::Index>(joints.size());
   const auto coord = [&](const std::string& n) -> Eigen::Index {
     return std::find(joints.begin(), joints.end(), n) - joints.begin();
@@ -382,15 +376,36 @@ std::optional<Scene> load_scene_details(const std::filesystem::path& path) {
   }
 }
 
+namespace {
+
+bool same_matrix(const mech::SparseMatrix& a, const mech::SparseMatrix& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() && MatrixXd(a) == MatrixXd(b);
+}
+
+bool same_vector(const VectorXd& a, const VectorXd& b) { return a.size() == b.size() && a == b; }
+
+bool same_model(const mech::MechanicalModel& a, const mech::MechanicalModel& b) {
+  return same_matrix(a.M, b.M) && same_matrix(a.D, b.D) && same_matrix(a.K, b.K) &&
+         same_matrix(a.E, b.E) && same_vector(a.g, b.g) && same_vector(a.f, b.f) &&
+         same_vector(a.restitution, b.restitution) && a.coordinates == b.coordinates &&
+         a.constraints == b.constraints;
+}
+
+}  // namespace
+
+std::optional<Scene> scene_setup(const mech::Model& model) {
+  if (!model.is_mechanical()) return std::nullopt;
+  try {
+    std::optional<Scene> scene = load_scene_details(model.source);
+    if (!scene || !same_model(*scene->model.mechanical, *model.mechanical)) return std::nullopt;
+    return scene;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
 mech::Model load_scene(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw InputError(path.string() + ": cannot open: no such file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string() + ": cannot open: unreadable");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parse_scene(ss.str(), path.string());
+  return parse_scene(read_file(path), path.string());
 }
 
 }  // namespace lcsim::io

@@ -171,7 +171,7 @@ struct Tree {
 
 Tree make_tree(const urdf::ModelInterface& model, const std::vector<std::string>& joints,
                const std::string& source) {
-  Tree t{model, joints, joints.size(), {}, {}, {}, {}, {}, {}, mimic_joints(model, source)};
+  Tree t{model, joints, joints.size(), {}, {}, {}, {}, {}, {}, mimic_joints(model, source, joints)};
   if (!model.getRoot()) fail(source, "<robot>", "no root link");
   for (std::size_t i = 0; i < joints.size(); ++i) {
     const auto j = model.getJoint(joints[i]);
@@ -183,10 +183,6 @@ Tree make_tree(const urdf::ModelInterface& model, const std::vector<std::string>
     t.index[joints[i]] = static_cast<int>(i);
     t.coord.push_back(static_cast<int>(i));
   }
-  for (std::size_t i = 0; i < joints.size(); ++i)
-    if (const auto it = t.mimics.find(joints[i]); it != t.mimics.end())
-      fail(source, "joint '" + joints[i] + "'",
-           mimic_refusal(joints[i], it->second, t.index.count(it->second.leader) > 0));
   std::vector<std::pair<int, double>> follow;  // (coordinate, multiplier) of each mimic
   for (const auto& [name, mm] : t.mimics) {
     const auto it = t.index.find(mm.leader);
@@ -410,22 +406,19 @@ std::shared_ptr<urdf::ModelInterface> parse_urdf(const std::string& xml,
   return one_line_errors([&] { return parse_urdf_unfolded(xml, source); });
 }
 
-std::string mimic_refusal(const std::string& name, const Mimic& mm, bool leader_simulated) {
-  return "mimics joint '" + mm.leader + "' (<mimic>: q = " + num(mm.multiplier) + " * q_" +
-         mm.leader + " + " + num(mm.offset) + "), so it is not a degree of freedom: " +
-         (leader_simulated ? "simulate '" + mm.leader + "' alone, '" + name + "' follows it"
-                           : "simulate '" + mm.leader + "' and leave '" + name +
-                                 "' out, or leave both out to freeze them");
-}
-
 std::map<std::string, Mimic> mimic_joints(const urdf::ModelInterface& model,
-                                          const std::string& source) {
+                                          const std::string& source,
+                                          const std::vector<std::string>& simulated) {
+  const auto is_simulated = [&](const std::string& n) {
+    return std::find(simulated.begin(), simulated.end(), n) != simulated.end();
+  };
   std::map<std::string, Mimic> out;
   for (const auto& [name, joint] : model.joints_) {
-    if (!joint->mimic || !moves(*joint)) continue;
+    if (!joint->mimic || !moves(*joint) || is_simulated(name)) continue;
     Mimic mm{name, 1.0, 0.0};
     std::vector<std::string> chain{name};
-    for (std::shared_ptr<const urdf::Joint> j = joint; j->mimic;) {
+    for (std::shared_ptr<const urdf::Joint> j = joint;
+         j->mimic && (j == joint || !is_simulated(j->name));) {
       const std::string el =
           "joint '" + j->name + "': <mimic joint='" + j->mimic->joint_name + "'>";
       const auto leader = model.getJoint(j->mimic->joint_name);

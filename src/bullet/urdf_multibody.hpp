@@ -1,0 +1,37 @@
+// Internal to src/bullet: the Featherstone btMultiBody of a URDF
+// (multibody.cpp), shared by the mass-matrix cross-check and the multibody
+// scene (multibody_world.cpp).
+#pragma once
+
+#include <BulletDynamics/Featherstone/btMultiBody.h>
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace urdf {
+class ModelInterface;
+}
+
+namespace lcsim::bullet {
+
+struct UrdfMultiBody {
+  std::unique_ptr<btMultiBody> body;
+  std::vector<int> coordinate;  // Bullet link i -> its joint's index in `joints`
+  std::vector<int> link;        // index in `joints` -> Bullet link
+};
+
+// A fixed-base btMultiBody (base at the URDF root, identity pose) with one
+// link per simulated joint in `joints` (revolute or prismatic), every other
+// joint frozen at q0 (positions by joint name, 0 where not given) and its
+// child merged into the parent body (mass, centre of mass and inertia
+// combined, principal axes by Bullet's Jacobi diagonalisation). Links sit at
+// the COM in principal axes. Joint positions set to q0, velocities 0,
+// damping 0; everything else at Bullet's defaults. std::invalid_argument if a
+// simulated joint is not in the tree.
+UrdfMultiBody build_urdf_multibody(const urdf::ModelInterface& model,
+                                   const std::vector<std::string>& joints,
+                                   const std::map<std::string, double>& q0);
+
+}  // namespace lcsim::bullet

@@ -1,0 +1,70 @@
+// `lcsim simulate --method bullet`, `lcsim compare` and `lcsim sweep --methods
+// bullet` on what Bullet can and cannot express, run as a user would.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "support/run_lcsim.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kRobots = std::string(LCSIM_SOURCE_DIR) + "/robots/";
+
+lcsim::cli_test::CliRun lcsim(const std::string& args) {
+  return lcsim::cli_test::run_lcsim(args,
+                                    lcsim::cli_test::private_temp("lcsim_bullet_stderr", ".txt"));
+}
+
+// A matrix model with M = [[1, 0.1], [0.1, 1]]: no URDF, so no multibody, and
+// not one rigid body per coordinate. Refused the same way by every command:
+// exit 2 (an input error), one line, 0-based "M(1, 0)".
+TEST(BulletCli, NonDiagonalMatrixModelExitsTwoEverywhere) {
+  const fs::path p = fs::path(::testing::TempDir()) / "lcsim_nondiagonal_m.yaml";
+  std::ofstream(p) << "name: nondiagonal\nmechanical:\n  M: [[1, 0.1], [0.1, 1]]\n"
+                      "  K: [[1, 0], [0, 1]]\n  E: [[1, 0]]\n  g: [0]\n"
+                      "initial: [1, 0, 0, 0]\nt_end: 1\n";
+  for (const std::string& cmd :
+       {"simulate '" + p.string() + "' --method bullet", "compare '" + p.string() + "'",
+        "sweep '" + p.string() + "' --methods bullet --h 1e-2"}) {
+    const auto r = lcsim(cmd);
+    EXPECT_EQ(r.exit_code, 2) << cmd << "\n" << r.err;
+    EXPECT_EQ(lcsim::cli_test::count_lines(r.err), 1) << cmd << "\n" << r.err;
+    EXPECT_NE(r.err.find("M(1, 0) = 0.1"), std::string::npos) << cmd << "\n" << r.err;
+  }
+}
+
+// Every shipped URDF scene runs beside Bullet: compare and sweep exit 0, compare
+// names the
+// scene Bullet built (the multibody, or rb6 for the hook scene) and warns
+// about what it drops.
+TEST(BulletCli, CompareRunsOnEveryShippedScene) {
+  for (const char* scene : {"double_pendulum_scene", "arm_gripper_scene", "prismatic_chain_scene",
+                            "two_carts_scene", "two_carts_hook_scene"}) {
+    const auto r = lcsim("compare '" + kRobots + scene + ".yaml' --h 1e-2 --json");
+    ASSERT_EQ(r.exit_code, 0) << scene << ": " << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    const std::string solver = j["bullet_solver"];
+    const bool multibody = std::string(scene) != "two_carts_hook_scene";
+    EXPECT_EQ(solver.rfind(multibody ? "btMultiBody from the URDF" : "btSequentialImpulse", 0), 0u)
+        << scene << ": " << solver;
+    // What Bullet does differently is said on stderr.
+    if (std::string(scene) == "double_pendulum_scene") {
+      EXPECT_NE(r.err.find("restitution is lost"), std::string::npos) << r.err;
+    }
+    if (!multibody) {
+      EXPECT_NE(r.err.find("constraint 'hook'"), std::string::npos) << r.err;
+    }
+    const auto sw = lcsim("sweep '" + kRobots + scene + ".yaml' --methods bullet --h 1e-2 --json");
+    ASSERT_EQ(sw.exit_code, 0) << scene << ": " << sw.err;
+    const auto row = nlohmann::json::parse(sw.out)["rows"][0];
+    EXPECT_EQ(row["method"], "bullet") << sw.out;
+    EXPECT_EQ(row["status"], "completed") << sw.out;
+  }
+}
+
+}  // namespace
