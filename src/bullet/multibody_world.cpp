@@ -239,13 +239,7 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const io::Scene& se
   };
   const mech::MechanicalModel& m = *model.mechanical;
   const int N = m.dofs(), k = m.num_constraints();
-  if (x0.size() != 2 * N)
-    return fail("bullet: initial state has " + std::to_string(x0.size()) +
-                " entries, the model needs " + std::to_string(2 * N));
-  if (const std::string bad = sim::check_step_options(opt, false); !bad.empty())
-    return fail("bullet: " + bad);
-  if (const std::string bad = sim::infeasible_start(model, x0); !bad.empty())
-    return fail("bullet: " + bad);
+  if (const std::string bad = check_run(model, x0, opt); !bad.empty()) return fail(bad);
 
   // The scene's own forces: K and f without the linearised gravity.
   const io::UrdfLinearisation& lin = setup.lin;

@@ -245,8 +245,7 @@ struct Plan {
 
 Plan plan_of(const mech::Model& model, const WorldSettings& s) {
   Plan p;
-  std::optional<io::Scene> setup =
-      model.is_mechanical() ? io::scene_setup(model) : std::nullopt;
+  std::optional<io::Scene> setup = model.is_mechanical() ? io::scene_setup(model) : std::nullopt;
   if (!setup) {
     p.rb6_limits = limits_of(model, s.limit_range);
     return p;
@@ -299,13 +298,7 @@ sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>&
   };
   const mech::MechanicalModel& m = *model.mechanical;
   const int N = m.dofs(), k = m.num_constraints();
-  if (x0.size() != 2 * N)
-    return fail("bullet: initial state has " + std::to_string(x0.size()) +
-                " entries, the model needs " + std::to_string(2 * N));
-  if (const std::string bad = sim::check_step_options(opt, false); !bad.empty())
-    return fail("bullet: " + bad);
-  if (const std::string bad = sim::infeasible_start(model, x0); !bad.empty())
-    return fail("bullet: " + bad);
+  if (const std::string bad = check_run(model, x0, opt); !bad.empty()) return fail(bad);
   VectorXd q = x0.head(N), v = x0.tail(N);
   if (m.D.norm() > 0.0)
     tr.add_warning(

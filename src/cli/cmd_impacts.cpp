@@ -58,14 +58,6 @@ std::string mode_text(const mech::MechanicalModel& m, const impact::IndexSet& mo
   return s;
 }
 
-std::vector<std::string> split(const std::string& text, char sep) {
-  std::vector<std::string> out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, sep)) out.push_back(item);
-  return out;
-}
-
 // The state (q, v) to work on: --x0 or the model's initial state.
 Eigen::VectorXd initial_state(const ImpactsArgs& a, const mech::Model& model) {
   return resolve_initial_state(model, a.model, a.x0, "state");
@@ -88,7 +80,7 @@ Eigen::VectorXd restitution(const ImpactsArgs& a, const mech::MechanicalModel& m
 
 std::vector<std::string> rule_list(const std::string& text) {
   if (text == "all") return impact::impact_law_names();
-  std::vector<std::string> out = split(text, ',');
+  std::vector<std::string> out = io::split(text, ',');
   if (out.empty()) throw io::InputError("--rules: empty list (give all or a,b,...)");
   for (const auto& n : out) (void)impact::make_impact_law(n);  // invalid_argument -> exit 2
   return out;
@@ -167,7 +159,7 @@ std::filesystem::path impact_map_script() {
 void run_map(const ImpactsArgs& a, const mech::Model& model) {
   const mech::MechanicalModel& m = *model.mechanical;
   const int N = m.dofs();
-  const std::vector<std::string> ranges = split(a.map, ',');
+  const std::vector<std::string> ranges = io::split(a.map, ',');
   if (ranges.size() != 2) throw io::InputError("--map: expected v1range,v2range (lo:hi[:n] each)");
   io::ImpactMapSpec spec;
   spec.axis1 = io::parse_map_range(ranges[0], "--map");

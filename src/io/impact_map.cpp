@@ -15,14 +15,6 @@ namespace lcsim::io {
 
 namespace {
 
-std::vector<std::string> split(const std::string& text, char sep) {
-  std::vector<std::string> out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, sep)) out.push_back(item);
-  return out;
-}
-
 std::string vec_text(const Eigen::VectorXd& v) {
   std::string s = "(";
   for (Eigen::Index i = 0; i < v.size(); ++i) s += (i ? ", " : "") + format_number(v(i));

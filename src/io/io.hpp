@@ -68,6 +68,10 @@ void write_file_atomic(const std::filesystem::path& path, const std::string& con
 // otherwise), u1.., y1.., mode (active constraints joined by ';').
 std::string trajectory_csv(const mech::Model& model, const sim::Trajectory& traj);
 
+// `text` cut at every `sep` ("a,,b" gives "a", "", "b"; "" gives none): the
+// comma lists of names and ranges the commands take.
+std::vector<std::string> split(const std::string& text, char sep);
+
 // JSON summary of a run (keys of the simulate command).
 nlohmann::json trajectory_json(const mech::Model& model, const sim::Trajectory& traj);
 
