@@ -182,8 +182,9 @@ void linear_ranges_section(const std::optional<io::Scene>& scene, double thresho
 void run_analyze(const AnalyzeArgs& args) {
   io::check_linearisation_threshold(args.linearisation_threshold);
   if (!args.model_out.empty()) check_writable(args.model_out);
-  const std::optional<io::Scene> scene = io::load_scene_details(args.file);
-  const mech::Model model = scene ? scene->model : io::load_model(args.file);
+  const io::LoadedModel loaded = io::load_model_and_scene(args.file);
+  const std::optional<io::Scene>& scene = loaded.scene;
+  const mech::Model& model = loaded.model;
   const std::vector<std::string> notes = io::model_notes(model);
   const lcs::Lcs sys = model.as_lcs();
   const lcs::WellPosednessReport wp = lcs::analyze_well_posedness(sys);

@@ -54,8 +54,9 @@ std::string fmt_set(const std::vector<int>& s) {
 
 void run_simulate(const SimulateArgs& a) {
   io::check_linearisation_threshold(a.linearisation_threshold);
-  const std::optional<io::Scene> scene = io::load_scene_details(a.model);
-  const mech::Model model = scene ? scene->model : io::load_model(a.model);
+  const io::LoadedModel loaded = io::load_model_and_scene(a.model);
+  const std::optional<io::Scene>& scene = loaded.scene;
+  const mech::Model& model = loaded.model;
   // Names are checked before anything runs, so a typo fails at once.
   auto integrator = sim::make_integrator(a.method);
   (void)impact::make_impact_law(a.impact);

@@ -1,6 +1,8 @@
 // Internal helpers of src/io (not part of the public face, io/io.hpp).
 #pragma once
 
+#include <yaml-cpp/yaml.h>
+
 #include <cstddef>
 #include <filesystem>
 #include <string>
@@ -20,5 +22,11 @@ std::string one_line(const std::string& text, std::size_t max_chars = 1000);
 // The whole text of a model file; InputError "<path>: cannot open: no such
 // file" (or "is a directory", "permission denied or unreadable").
 std::string read_file(const std::filesystem::path& path);
+
+// A model file's YAML root (InputError for an empty file), whether it is a
+// scene (a top-level `urdf:` key), and the model of a root that is not.
+YAML::Node load_model_root(const std::string& yaml_text, const std::string& source);
+bool is_scene(const YAML::Node& root);
+mech::Model parse_model_root(const YAML::Node& root, const std::string& source);
 
 }  // namespace lcsim::io

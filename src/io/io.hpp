@@ -185,6 +185,13 @@ Scene read_scene(const std::string& yaml_text, const std::string& source);
 // The scene in `path`, or nullopt when the file is a model, not a scene (no
 // top-level `urdf:` key). Errors as load_model.
 std::optional<Scene> load_scene_details(const std::filesystem::path& path);
+// The model in `path` (as load_model) and, for a scene, the Scene: the file
+// is read and parsed once (a 10000-cart model's YAML tree is 75 MB).
+struct LoadedModel {
+  mech::Model model;
+  std::optional<Scene> scene;
+};
+LoadedModel load_model_and_scene(const std::filesystem::path& path);
 
 // ---- How far the linear model holds (src/io/linearisation.cpp) ----
 //

@@ -357,18 +357,29 @@ std::string read_file(const std::filesystem::path& path) {
 }
 
 mech::Model parse_model(const std::string& yaml_text, const std::string& source) {
-  const YAML::Node root = load(yaml_text, source);
-  if (root.IsNull() || !root.IsDefined())
-    throw InputError(source +
-                     ": empty file (expected `name` and a `mechanical:` or `lcs:` section)");
+  const YAML::Node root = load_model_root(yaml_text, source);
   // A top-level `urdf:` key makes the file a scene (scene.cpp).
-  if (root.IsMap() && root["urdf"]) {
+  if (is_scene(root)) {
     try {
       return parse_scene(yaml_text, source);
     } catch (const InputError& e) {
       throw InputError(one_line(e.what()));  // URDF names and values may hold newlines
     }
   }
+  return parse_model_root(root, source);
+}
+
+YAML::Node load_model_root(const std::string& yaml_text, const std::string& source) {
+  YAML::Node root = load(yaml_text, source);
+  if (root.IsNull() || !root.IsDefined())
+    throw InputError(source +
+                     ": empty file (expected `name` and a `mechanical:` or `lcs:` section)");
+  return root;
+}
+
+bool is_scene(const YAML::Node& root) { return root.IsMap() && root["urdf"]; }
+
+mech::Model parse_model_root(const YAML::Node& root, const std::string& source) {
   const Keys keys = mapping(root, source, "", {"name", "mechanical", "lcs", "initial", "t_end"});
   mech::Model model;
   model.source = source;

@@ -365,15 +365,21 @@ mech::Model parse_scene(const std::string& yaml_text, const std::string& source)
   return read_scene(yaml_text, source).model;
 }
 
-std::optional<Scene> load_scene_details(const std::filesystem::path& path) {
+LoadedModel load_model_and_scene(const std::filesystem::path& path) {
   const std::string text = read_file(path);
-  const YAML::Node root = load(text, path.string());
-  if (!root.IsMap() || !root["urdf"]) return std::nullopt;
+  const YAML::Node root = load_model_root(text, path.string());
+  if (!is_scene(root)) return {parse_model_root(root, path.string()), std::nullopt};
   try {
-    return read_scene(text, path.string());
+    Scene scene = read_scene(text, path.string());
+    mech::Model model = scene.model;
+    return {std::move(model), std::move(scene)};
   } catch (const InputError& e) {
     throw InputError(one_line(e.what()));  // as load_model: URDF names may hold newlines
   }
+}
+
+std::optional<Scene> load_scene_details(const std::filesystem::path& path) {
+  return load_model_and_scene(path).scene;
 }
 
 namespace {

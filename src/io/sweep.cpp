@@ -244,8 +244,8 @@ ReferenceLaw reference_law(const std::string& method, const std::string& impact,
     r.law = "moreau";
     r.inelastic = e;
     r.reason =
-        "Bullet 3.24 applies no limit bounce at stop ERP 0.2 (docs/bullet-comparison.md): "
-        "nearest exact law is inelastic" +
+        "Bullet 3.24's limits do not bounce (rigid-body limits at stop ERP 0.2, multibody "
+        "joint limits at all; docs/bullet-comparison.md): nearest exact law is inelastic" +
         inelastic_note;
   } else {
     r.law = impact;
