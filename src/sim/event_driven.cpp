@@ -345,8 +345,9 @@ class EventDriven {
   double accumulation_time(int r, double t, double* ratio) const;
   void project_onto(const std::vector<int>& rows, VectorXd& xa, bool positions) const;
   EventResult process_mechanical(double t, const VectorXd& xa);
-  std::string accumulation_note(int r, double t, double ratio, double t_star, const VectorXd& gap,
-                                const VectorXd& gap_scale, VectorXd& xa) const;
+  std::string take_accumulation_limit(int r, double t, double ratio, double t_star,
+                                      const VectorXd& gap, const VectorXd& gap_scale,
+                                      VectorXd& xa) const;
   EventResult process_lcs(const VectorXd& xa);
   void record(Trajectory& tr, double t, const VectorXd& xa, const Phase& ph) const;
   VectorXd multipliers(const Phase& ph, const VectorXd& xa) const {
@@ -506,9 +507,9 @@ void EventDriven::project_onto(const std::vector<int>& rows, VectorXd& xa, bool 
 // projected, in the kinetic metric, onto E_J q + g_J = 0 and E_J v = 0: the
 // nearest limit state, which never gains kinetic energy. Mode selection then
 // decides their forces. Returns how the limit was taken (Event::note).
-std::string EventDriven::accumulation_note(int r, double t, double ratio, double t_star,
-                                           const VectorXd& gap, const VectorXd& gap_scale,
-                                           VectorXd& xa) const {
+std::string EventDriven::take_accumulation_limit(int r, double t, double ratio, double t_star,
+                                                 const VectorXd& gap, const VectorXd& gap_scale,
+                                                 VectorXd& xa) const {
   const double since = impact_times_[r].empty() ? t : impact_times_[r].front();
   std::vector<int> joined;
   std::string names;
@@ -607,7 +608,8 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
       // inelastic impact; the run continues from t_star in the limit mode.
       limit_taken = true;
       out.accumulation = true;
-      out.note = accumulation_note(accumulating, t, acc_ratio, out.t_star, gap, gap_scale, xa);
+      out.note =
+          take_accumulation_limit(accumulating, t, acc_ratio, out.t_star, gap, gap_scale, xa);
       continue;
     }
     if (!approaching) break;
