@@ -18,8 +18,8 @@
 #include <algorithm>
 #include <chrono>
 
-#include "bullet/bullet.hpp"
-#include "sim/sim.hpp"
+#include <lcsim/bullet/bullet.hpp>
+#include <lcsim/sim/sim.hpp>
 
 namespace {
 

@@ -8,7 +8,7 @@
 #include <numbers>
 #include <unsupported/Eigen/MatrixFunctions>
 
-#include "sim/sim.hpp"
+#include <lcsim/sim/sim.hpp>
 
 namespace {
 

@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "lcp/lcp.hpp"
+#include <lcsim/lcp/lcp.hpp>
 
 // bench/CMakeLists.txt adds only <prefix>/siconos/numerics to the include path,
 // but the numerics headers include "SiconosConfig.h" from <prefix>/siconos. Use

@@ -27,8 +27,8 @@
 #include <string>
 #include <vector>
 
-#include "lcp/lcp.hpp"
-#include "sim/sim.hpp"
+#include <lcsim/lcp/lcp.hpp>
+#include <lcsim/sim/sim.hpp>
 
 namespace {
 

@@ -5,8 +5,8 @@
 #include <string>
 #include <unsupported/Eigen/MatrixFunctions>
 
-#include "bullet/bullet.hpp"
-#include "sim/sim.hpp"
+#include <lcsim/bullet/bullet.hpp>
+#include <lcsim/sim/sim.hpp>
 using namespace lcsim;
 // Prints the measured errors of the exact event-driven method and of the
 // time-stepping methods and Bullet at the extremes (docs/extremes.md). The

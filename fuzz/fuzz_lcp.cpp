@@ -22,7 +22,7 @@
 #include <sstream>
 #include <string>
 
-#include "lcp/lcp.hpp"
+#include <lcsim/lcp/lcp.hpp>
 
 namespace {
 

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <string>
 
-#include "io/io.hpp"
+#include <lcsim/io/io.hpp>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

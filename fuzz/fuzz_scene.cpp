@@ -15,7 +15,7 @@
 #include <fstream>
 #include <string>
 
-#include "io/io.hpp"
+#include <lcsim/io/io.hpp>
 
 namespace {
 

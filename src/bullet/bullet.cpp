@@ -1,4 +1,4 @@
-#include "bullet/bullet.hpp"
+#include <lcsim/bullet/bullet.hpp>
 
 #include <LinearMath/btScalar.h>
 

@@ -4,7 +4,7 @@
 #include <limits>
 #include <tuple>
 
-#include "bullet/bullet.hpp"
+#include <lcsim/bullet/bullet.hpp>
 
 namespace lcsim::bullet {
 

@@ -21,7 +21,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "bullet/bullet.hpp"
+#include <lcsim/bullet/bullet.hpp>
 
 namespace lcsim::bullet {
 
@@ -134,7 +134,7 @@ class MlcpBackend final : public lcp::Solver {
 
 void register_mlcp_backends() {
   for (MlcpSolver w : {MlcpSolver::kDantzig, MlcpSolver::kLemke, MlcpSolver::kPgs})
-    lcp::register_solver(name_of(w), [w] { return std::make_unique<MlcpBackend>(w); });
+    lcp::solvers().add(name_of(w), [w] { return std::make_unique<MlcpBackend>(w); });
 }
 
 }  // namespace lcsim::bullet

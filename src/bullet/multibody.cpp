@@ -10,7 +10,7 @@
 #include <memory>
 #include <stdexcept>
 
-#include "bullet/bullet.hpp"
+#include <lcsim/bullet/bullet.hpp>
 #include "bullet/urdf_multibody.hpp"
 
 namespace lcsim::bullet {

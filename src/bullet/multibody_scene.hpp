@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "bullet/bullet.hpp"
-#include "io/io.hpp"
+#include <lcsim/bullet/bullet.hpp>
+#include <lcsim/io/io.hpp>
 
 namespace lcsim::bullet {
 

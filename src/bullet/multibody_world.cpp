@@ -50,7 +50,7 @@
 #include <memory>
 #include <stdexcept>
 
-#include "bullet/bullet.hpp"
+#include <lcsim/bullet/bullet.hpp>
 #include "bullet/multibody_scene.hpp"
 #include "bullet/run_recorder.hpp"
 #include "bullet/urdf_multibody.hpp"

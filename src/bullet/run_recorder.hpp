@@ -6,8 +6,8 @@
 #include <Eigen/Dense>
 #include <string>
 
-#include "mech/mech.hpp"
-#include "sim/sim.hpp"
+#include <lcsim/mech/mech.hpp>
+#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::bullet {
 

@@ -50,10 +50,10 @@
 #include <stdexcept>
 #include <utility>
 
-#include "bullet/bullet.hpp"
+#include <lcsim/bullet/bullet.hpp>
 #include "bullet/multibody_scene.hpp"
 #include "bullet/run_recorder.hpp"
-#include "io/io.hpp"
+#include <lcsim/io/io.hpp>
 
 namespace lcsim::bullet {
 
@@ -410,7 +410,7 @@ class BulletIntegrator : public sim::Integrator {
 void register_mlcp_backends();  // src/bullet/mlcp.cpp
 
 void register_backends() {
-  sim::register_integrator("bullet", [] { return std::make_unique<BulletIntegrator>(); });
+  sim::integrators().add("bullet", [] { return std::make_unique<BulletIntegrator>(); });
   register_mlcp_backends();
 }
 

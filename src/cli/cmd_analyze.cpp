@@ -15,10 +15,10 @@
 
 #include "cli/command.hpp"
 #include "cli/output.hpp"
-#include "io/io.hpp"
-#include "lcp/lcp.hpp"
-#include "lcs/lcs.hpp"
-#include "mech/mech.hpp"
+#include <lcsim/io/io.hpp>
+#include <lcsim/lcp/lcp.hpp>
+#include <lcsim/lcs/lcs.hpp>
+#include <lcsim/mech/mech.hpp>
 
 namespace lcsim::cli {
 namespace {

@@ -18,12 +18,12 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "bullet/bullet.hpp"
+#include <lcsim/bullet/bullet.hpp>
 #include "cli/command.hpp"
 #include "cli/run_inputs.hpp"
-#include "io/io.hpp"
-#include "io/sweep.hpp"
-#include "sim/sim.hpp"
+#include <lcsim/io/io.hpp>
+#include <lcsim/io/sweep.hpp>
+#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::cli {
 namespace {

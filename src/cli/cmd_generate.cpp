@@ -17,7 +17,7 @@
 #include <string>
 
 #include "cli/command.hpp"
-#include "io/io.hpp"
+#include <lcsim/io/io.hpp>
 
 namespace lcsim::cli {
 namespace {

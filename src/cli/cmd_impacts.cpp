@@ -22,9 +22,9 @@
 #include "cli/command.hpp"
 #include "cli/output.hpp"
 #include "cli/run_inputs.hpp"
-#include "impact/impact.hpp"
-#include "io/impact_map.hpp"
-#include "io/io.hpp"
+#include <lcsim/impact/impact.hpp>
+#include <lcsim/io/impact_map.hpp>
+#include <lcsim/io/io.hpp>
 
 namespace lcsim::cli {
 namespace {

@@ -8,8 +8,8 @@
 #include <string>
 
 #include "cli/command.hpp"
-#include "io/io.hpp"
-#include "lcp/lcp.hpp"
+#include <lcsim/io/io.hpp>
+#include <lcsim/lcp/lcp.hpp>
 
 namespace lcsim::cli {
 namespace {

@@ -9,8 +9,8 @@
 #include "cli/command.hpp"
 #include "cli/output.hpp"
 #include "cli/run_inputs.hpp"
-#include "io/io.hpp"
-#include "sim/sim.hpp"
+#include <lcsim/io/io.hpp>
+#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::cli {
 namespace {

@@ -18,9 +18,9 @@
 #include "cli/command.hpp"
 #include "cli/output.hpp"
 #include "cli/run_inputs.hpp"
-#include "io/io.hpp"
-#include "io/sweep.hpp"
-#include "sim/sim.hpp"
+#include <lcsim/io/io.hpp>
+#include <lcsim/io/sweep.hpp>
+#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::cli {
 namespace {

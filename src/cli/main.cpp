@@ -3,9 +3,9 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 
-#include "bullet/bullet.hpp"
+#include <lcsim/bullet/bullet.hpp>
 #include "cli/command.hpp"
-#include "io/io.hpp"
+#include <lcsim/io/io.hpp>
 
 namespace lcsim::cli {
 std::vector<CommandSetup>& command_registry() {
@@ -18,9 +18,6 @@ int main(int argc, char** argv) {
   CLI::App app{"lcsim: linear complementarity systems and unilaterally constrained mechanics"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "lcsim 0.1.0");
-  // Explicit, not a static registrar: an unreferenced object file of the
-  // static library lcsim_bullet would be dropped by the linker.
-  lcsim::bullet::register_backends();
   for (auto& setup : lcsim::cli::command_registry()) setup(app);
   try {
     app.parse(argc, argv);

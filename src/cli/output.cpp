@@ -18,7 +18,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "io/io.hpp"
+#include <lcsim/io/io.hpp>
 
 extern char** environ;
 

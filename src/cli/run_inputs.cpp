@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "io/io.hpp"
+#include <lcsim/io/io.hpp>
 
 namespace lcsim::cli {
 

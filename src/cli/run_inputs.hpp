@@ -5,7 +5,7 @@
 #include <Eigen/Dense>
 #include <string>
 
-#include "mech/mech.hpp"
+#include <lcsim/mech/mech.hpp>
 
 namespace lcsim::cli {
 

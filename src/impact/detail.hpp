@@ -3,7 +3,7 @@
 
 #include <optional>
 
-#include "impact/impact.hpp"
+#include <lcsim/impact/impact.hpp>
 
 namespace lcsim::impact::detail {
 

@@ -1,6 +1,6 @@
 // Impact rules: shared set-up, Moreau's LCP with Newton restitution
 // ("moreau", "newton") and the registry of rules by name.
-#include "impact/impact.hpp"
+#include <lcsim/impact/impact.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -240,7 +240,6 @@ struct Rule {
 // e = 0 is Moreau's inelastic rule): two names, one implementation.
 const Rule kRules[] = {
     {"moreau", &moreau_newton},
-    {"moreau-qp", +[](const ImpactInput& in, const lcp::Solver&) { return moreau_qp(in); }},
     {"newton", &moreau_newton},
     {"moreau-restitution", &moreau_restitution},
     {"sequential", +[](const ImpactInput& in, const lcp::Solver&) { return sequential(in); }},
@@ -261,20 +260,22 @@ class NamedLaw : public ImpactLaw {
 
 }  // namespace
 
-std::vector<std::string> impact_law_names() {
-  std::vector<std::string> names;
-  for (const Rule& r : kRules) names.emplace_back(r.name);
-  return names;
+Registry<ImpactLaw>& laws() {
+  static Registry<ImpactLaw>& r = *[] {
+    auto* reg = new Registry<ImpactLaw>("impact law");  // never destroyed: used at exit
+    for (const Rule& rule : kRules)
+      reg->add(rule.name, [rule] { return std::make_unique<NamedLaw>(rule); });
+    return reg;
+  }();
+  return r;
 }
 
+std::vector<std::string> impact_law_names() { return laws().names(); }
+
 std::unique_ptr<ImpactLaw> make_impact_law(std::string_view name) {
-  for (const Rule& r : kRules)
-    if (name == r.name) return std::make_unique<NamedLaw>(r);
-  std::ostringstream msg;
-  msg << "unknown impact rule '" << name << "' (known:";
-  for (const auto& n : impact_law_names()) msg << " " << n;
-  msg << ")";
-  throw std::invalid_argument(msg.str());
+  if (auto law = laws().make(name)) return law;
+  throw std::invalid_argument(laws().unknown_message(
+      name, name == "moreau-qp" ? "moreau-qp is in the component lcsim::ipopt; link it" : ""));
 }
 
 }  // namespace lcsim::impact

@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "impact/detail.hpp"
-#include "impact/impact.hpp"
+#include <lcsim/impact/impact.hpp>
 
 namespace lcsim::impact {
 

@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <string>
 
-#include "io/io.hpp"
+#include <lcsim/io/io.hpp>
 
 namespace lcsim::io {
 

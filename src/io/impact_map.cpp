@@ -1,6 +1,6 @@
 // The impact map (impact_map.hpp): range and name parsing, the closed set,
 // placing q on the named contacts, the grid of impacts, its CSV.
-#include "io/impact_map.hpp"
+#include <lcsim/io/impact_map.hpp>
 
 #include <Eigen/SparseCholesky>
 #include <algorithm>
@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "io/detail.hpp"
-#include "io/io.hpp"
+#include <lcsim/io/io.hpp>
 
 namespace lcsim::io {
 

@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "io/detail.hpp"
-#include "io/io.hpp"
+#include <lcsim/io/io.hpp>
 
 namespace lcsim::io {
 

@@ -21,7 +21,7 @@
 #include <sstream>
 
 #include "io/detail.hpp"
-#include "io/io.hpp"
+#include <lcsim/io/io.hpp>
 #include "io/yaml_read.hpp"
 
 namespace lcsim::io {

@@ -1,5 +1,5 @@
 // The work-precision sweep: reference laws, reference runs, rows (sweep.hpp).
-#include "io/sweep.hpp"
+#include <lcsim/io/sweep.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -8,9 +8,9 @@
 #include <map>
 #include <memory>
 
-#include "impact/impact.hpp"
+#include <lcsim/impact/impact.hpp>
 #include "io/detail.hpp"
-#include "io/io.hpp"
+#include <lcsim/io/io.hpp>
 
 namespace lcsim::io {
 

@@ -27,7 +27,7 @@
 #include <sstream>
 
 #include "io/detail.hpp"
-#include "io/io.hpp"
+#include <lcsim/io/io.hpp>
 
 namespace lcsim::io {
 

@@ -10,7 +10,7 @@
 #include <stdexcept>
 
 #include "io/detail.hpp"
-#include "io/io.hpp"
+#include <lcsim/io/io.hpp>
 
 namespace lcsim::io {
 

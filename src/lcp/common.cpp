@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "lcp/detail.hpp"
-#include "lcp/lcp.hpp"
+#include <lcsim/lcp/lcp.hpp>
 
 namespace lcsim::lcp {
 
@@ -177,40 +177,21 @@ constexpr Entry kSolvers[] = {
 
 }  // namespace
 
-namespace {
-using Factory = std::function<std::unique_ptr<Solver>()>;
-// Back-ends registered by later layers (register_solver), in order.
-std::vector<std::pair<std::string, Factory>>& extra_solvers() {
-  static std::vector<std::pair<std::string, Factory>> registry;
-  return registry;
-}
-}  // namespace
-
-void register_solver(std::string name, std::function<std::unique_ptr<Solver>()> factory) {
-  for (auto& [n, f] : extra_solvers())
-    if (n == name) {
-      f = std::move(factory);
-      return;
-    }
-  extra_solvers().emplace_back(std::move(name), std::move(factory));
+Registry<Solver>& solvers() {
+  static Registry<Solver>& r = *[] {
+    auto* reg = new Registry<Solver>("LCP solver");  // never destroyed: used at exit
+    for (const auto& e : kSolvers)
+      reg->add(e.name, [e] { return std::make_unique<FnSolver>(e.name, e.fn); });
+    return reg;
+  }();
+  return r;
 }
 
-std::vector<std::string> solver_names() {
-  std::vector<std::string> names;
-  for (const auto& e : kSolvers) names.emplace_back(e.name);
-  for (const auto& [n, f] : extra_solvers()) names.push_back(n);
-  return names;
-}
+std::vector<std::string> solver_names() { return solvers().names(); }
 
 std::unique_ptr<Solver> make_solver(std::string_view name) {
-  for (const auto& e : kSolvers)
-    if (name == e.name) return std::make_unique<FnSolver>(e.name, e.fn);
-  for (const auto& [n, f] : extra_solvers())
-    if (name == n) return f();
-  std::string known;
-  for (const auto& n : solver_names()) known += std::string(known.empty() ? "" : ", ") + n;
-  throw std::invalid_argument("unknown LCP solver '" + std::string(name) +
-                              "'; known solvers: " + known);
+  if (auto s = solvers().make(name)) return s;
+  throw std::invalid_argument(solvers().unknown_message(name));
 }
 
 }  // namespace lcsim::lcp

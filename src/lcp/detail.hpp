@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "lcp/lcp.hpp"
+#include <lcsim/lcp/lcp.hpp>
 
 namespace lcsim::lcp::detail {
 

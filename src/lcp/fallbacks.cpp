@@ -1,6 +1,6 @@
 #include <cmath>
 
-#include "lcp/lcp.hpp"
+#include <lcsim/lcp/lcp.hpp>
 
 namespace lcsim::lcp {
 

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "lcp/detail.hpp"
-#include "lcp/lcp.hpp"
+#include <lcsim/lcp/lcp.hpp>
 
 namespace lcsim::lcp {
 namespace {

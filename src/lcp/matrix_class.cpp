@@ -4,7 +4,7 @@
 #include <cmath>
 #include <vector>
 
-#include "lcp/lcp.hpp"
+#include <lcsim/lcp/lcp.hpp>
 
 namespace lcsim::lcp {
 namespace {

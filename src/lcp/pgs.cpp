@@ -10,7 +10,7 @@
 #include <string>
 
 #include "lcp/detail.hpp"
-#include "lcp/lcp.hpp"
+#include <lcsim/lcp/lcp.hpp>
 
 namespace lcsim::lcp {
 namespace {

@@ -1,6 +1,6 @@
 // Markov parameters (3.32) and leading row/column indices and coefficient
 // matrices (3.39).
-#include "lcs/lcs.hpp"
+#include <lcsim/lcs/lcs.hpp>
 
 #include <Eigen/SVD>
 #include <algorithm>

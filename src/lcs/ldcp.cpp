@@ -18,7 +18,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "lcs/lcs.hpp"
+#include <lcsim/lcs/lcs.hpp>
 
 namespace lcsim::lcs {
 

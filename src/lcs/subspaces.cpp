@@ -17,7 +17,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "lcs/lcs.hpp"
+#include <lcsim/lcs/lcs.hpp>
 
 namespace lcsim::lcs {
 

@@ -10,7 +10,7 @@
 #include <complex>
 #include <sstream>
 
-#include "lcs/lcs.hpp"
+#include <lcsim/lcs/lcs.hpp>
 
 namespace lcsim::lcs {
 

@@ -1,7 +1,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "mech/mech.hpp"
+#include <lcsim/mech/mech.hpp>
 
 namespace lcsim::mech {
 

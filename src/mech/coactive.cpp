@@ -5,8 +5,8 @@
 #include <map>
 #include <set>
 
-#include "lcp/lcp.hpp"
-#include "mech/mech.hpp"
+#include <lcsim/lcp/lcp.hpp>
+#include <lcsim/mech/mech.hpp>
 
 namespace lcsim::mech {
 

@@ -1,4 +1,4 @@
-#include "mech/mech.hpp"
+#include <lcsim/mech/mech.hpp>
 
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>

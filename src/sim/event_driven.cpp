@@ -21,7 +21,7 @@
 #include <sstream>
 #include <unsupported/Eigen/MatrixFunctions>
 
-#include "sim/sim.hpp"
+#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::sim {
 

@@ -1,6 +1,6 @@
 #include <sstream>
 
-#include "sim/sim.hpp"
+#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::sim {
 

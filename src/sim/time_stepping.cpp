@@ -22,7 +22,7 @@
 #include <utility>
 #include <vector>
 
-#include "sim/sim.hpp"
+#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::sim {
 

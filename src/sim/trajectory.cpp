@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "sim/sim.hpp"
+#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::sim {
 
@@ -89,41 +89,23 @@ class EventDrivenIntegrator : public Integrator {
 std::unique_ptr<Integrator> make_euler_integrator();
 std::unique_ptr<Integrator> make_moreau_jean_integrator();
 
-namespace {
-using Factory = std::function<std::unique_ptr<Integrator>()>;
-// Integrators registered by later layers (register_integrator), in order.
-std::vector<std::pair<std::string, Factory>>& extra_integrators() {
-  static std::vector<std::pair<std::string, Factory>> registry;
-  return registry;
-}
-}  // namespace
-
-void register_integrator(std::string name, std::function<std::unique_ptr<Integrator>()> factory) {
-  for (auto& [n, f] : extra_integrators())
-    if (n == name) {
-      f = std::move(factory);
-      return;
-    }
-  extra_integrators().emplace_back(std::move(name), std::move(factory));
+Registry<Integrator>& integrators() {
+  static Registry<Integrator>& r = *[] {
+    auto* reg = new Registry<Integrator>("method");  // never destroyed: used at exit
+    reg->add("event", [] { return std::make_unique<EventDrivenIntegrator>(); });
+    reg->add("euler", [] { return make_euler_integrator(); });
+    reg->add("moreau-jean", [] { return make_moreau_jean_integrator(); });
+    return reg;
+  }();
+  return r;
 }
 
-std::vector<std::string> integrator_names() {
-  std::vector<std::string> names = {"event", "euler", "moreau-jean"};
-  for (const auto& [n, f] : extra_integrators()) names.push_back(n);
-  return names;
-}
+std::vector<std::string> integrator_names() { return integrators().names(); }
 
 std::unique_ptr<Integrator> make_integrator(std::string_view name) {
-  if (name == "event") return std::make_unique<EventDrivenIntegrator>();
-  if (name == "euler") return make_euler_integrator();
-  if (name == "moreau-jean") return make_moreau_jean_integrator();
-  for (const auto& [n, f] : extra_integrators())
-    if (name == n) return f();
-  std::ostringstream msg;
-  msg << "unknown method '" << name << "' (known:";
-  for (const auto& n : integrator_names()) msg << " " << n;
-  msg << ")";
-  throw std::invalid_argument(msg.str());
+  if (auto m = integrators().make(name)) return m;
+  throw std::invalid_argument(integrators().unknown_message(
+      name, name == "bullet" ? "bullet is in the component lcsim::bullet; link it" : ""));
 }
 
 }  // namespace lcsim::sim

@@ -4,7 +4,7 @@
 
 #include <random>
 
-#include "bullet/bullet.hpp"
+#include <lcsim/bullet/bullet.hpp>
 
 namespace lcsim::bullet {
 namespace {

@@ -14,8 +14,8 @@
 
 #include <cstdio>
 
-#include "bullet/bullet.hpp"
-#include "io/io.hpp"
+#include <lcsim/bullet/bullet.hpp>
+#include <lcsim/io/io.hpp>
 
 namespace lcsim {
 namespace {

@@ -11,10 +11,10 @@
 #include <stdexcept>
 #include <string>
 
-#include "bullet/bullet.hpp"
-#include "io/io.hpp"
-#include "lcp/lcp.hpp"
-#include "sim/sim.hpp"
+#include <lcsim/bullet/bullet.hpp>
+#include <lcsim/io/io.hpp>
+#include <lcsim/lcp/lcp.hpp>
+#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::bullet {
 namespace {

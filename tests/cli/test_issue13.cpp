@@ -9,8 +9,8 @@
 #include <sstream>
 #include <string>
 
-#include "io/impact_map.hpp"
-#include "io/io.hpp"
+#include <lcsim/io/impact_map.hpp>
+#include <lcsim/io/io.hpp>
 #include "support/run_lcsim.hpp"
 
 namespace {

@@ -10,7 +10,7 @@
 #include <string>
 #include <unsupported/Eigen/MatrixFunctions>
 
-#include "sim/sim.hpp"
+#include <lcsim/sim/sim.hpp>
 
 namespace lcsim {
 namespace {

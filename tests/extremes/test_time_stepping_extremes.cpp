@@ -22,8 +22,8 @@
 #include <string>
 #include <unsupported/Eigen/MatrixFunctions>
 
-#include "io/io.hpp"
-#include "sim/sim.hpp"
+#include <lcsim/io/io.hpp>
+#include <lcsim/sim/sim.hpp>
 #include "support/run_lcsim.hpp"
 
 namespace lcsim {

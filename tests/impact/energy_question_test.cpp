@@ -20,7 +20,7 @@
 #include <cstdio>
 #include <random>
 
-#include "impact/impact.hpp"
+#include <lcsim/impact/impact.hpp>
 #include "impact_test_util.hpp"
 
 namespace lcsim::impact {

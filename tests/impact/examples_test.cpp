@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <tuple>
 
-#include "impact/impact.hpp"
+#include <lcsim/impact/impact.hpp>
 #include "impact_test_util.hpp"
 
 namespace lcsim::impact {

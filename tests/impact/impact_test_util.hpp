@@ -4,8 +4,8 @@
 #include <Eigen/Dense>
 #include <random>
 
-#include "impact/impact.hpp"
-#include "mech/mech.hpp"
+#include <lcsim/impact/impact.hpp>
+#include <lcsim/mech/mech.hpp>
 
 namespace lcsim::impact::testing {
 

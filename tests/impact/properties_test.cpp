@@ -19,7 +19,8 @@
 #include <cstdio>
 #include <random>
 
-#include "impact/impact.hpp"
+#include <lcsim/impact/impact.hpp>
+#include <lcsim/ipopt/moreau_qp.hpp>
 #include "impact_test_util.hpp"
 
 namespace lcsim::impact {

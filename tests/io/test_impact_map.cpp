@@ -5,9 +5,9 @@
 
 #include <string>
 
-#include "impact/impact.hpp"
-#include "io/impact_map.hpp"
-#include "io/io.hpp"
+#include <lcsim/impact/impact.hpp>
+#include <lcsim/io/impact_map.hpp>
+#include <lcsim/io/io.hpp>
 
 namespace lcsim::io {
 namespace {

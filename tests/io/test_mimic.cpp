@@ -8,7 +8,7 @@
 #include <fstream>
 #include <random>
 
-#include "io/io.hpp"
+#include <lcsim/io/io.hpp>
 #include "support/same_model.hpp"
 
 namespace lcsim {

@@ -8,7 +8,7 @@
 #include <string>
 #include <unsupported/Eigen/MatrixFunctions>
 
-#include "io/io.hpp"
+#include <lcsim/io/io.hpp>
 #include "support/same_model.hpp"
 
 namespace lcsim::io {

@@ -8,8 +8,8 @@
 #include <fstream>
 #include <random>
 
-#include "io/io.hpp"
-#include "sim/sim.hpp"
+#include <lcsim/io/io.hpp>
+#include <lcsim/sim/sim.hpp>
 #include "support/same_model.hpp"
 
 namespace lcsim {

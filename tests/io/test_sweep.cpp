@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "io/io.hpp"
-#include "io/sweep.hpp"
-#include "sim/sim.hpp"
+#include <lcsim/io/io.hpp>
+#include <lcsim/io/sweep.hpp>
+#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::io {
 namespace {

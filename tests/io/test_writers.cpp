@@ -7,7 +7,7 @@
 #include <sstream>
 #include <string>
 
-#include "io/io.hpp"
+#include <lcsim/io/io.hpp>
 
 namespace lcsim::io {
 namespace {

@@ -5,7 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "lcp/lcp.hpp"
+#include <lcsim/lcp/lcp.hpp>
 
 namespace lcsim::lcp {
 namespace {

@@ -5,7 +5,7 @@
 #include <random>
 #include <vector>
 
-#include "lcp/lcp.hpp"
+#include <lcsim/lcp/lcp.hpp>
 #include "lcp_test_util.hpp"
 
 namespace lcsim::lcp {

@@ -7,7 +7,7 @@
 // by O(1).
 #include <gtest/gtest.h>
 
-#include "lcs/lcs.hpp"
+#include <lcsim/lcs/lcs.hpp>
 
 namespace lcsim::lcs {
 namespace {

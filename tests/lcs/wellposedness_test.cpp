@@ -9,7 +9,7 @@
 
 #include <Eigen/Dense>
 
-#include "lcs/lcs.hpp"
+#include <lcsim/lcs/lcs.hpp>
 
 namespace lcsim::lcs {
 namespace {

@@ -2,7 +2,7 @@
 // (src/mech/coactive.cpp). Every expected set is found by hand from the rows.
 #include <gtest/gtest.h>
 
-#include "mech/mech.hpp"
+#include <lcsim/mech/mech.hpp>
 
 namespace lcsim::mech {
 namespace {

@@ -4,8 +4,8 @@
 
 #include <random>
 
-#include "lcs/lcs.hpp"
-#include "mech/mech.hpp"
+#include <lcsim/lcs/lcs.hpp>
+#include <lcsim/mech/mech.hpp>
 
 namespace lcsim::lcs {
 namespace {

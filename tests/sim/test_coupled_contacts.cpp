@@ -10,8 +10,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "io/io.hpp"
-#include "sim/sim.hpp"
+#include <lcsim/io/io.hpp>
+#include <lcsim/sim/sim.hpp>
 
 namespace lcsim {
 namespace {

@@ -7,8 +7,8 @@
 
 #include <vector>
 
-#include "mech/mech.hpp"
-#include "sim/sim.hpp"
+#include <lcsim/mech/mech.hpp>
+#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::sim {
 namespace {

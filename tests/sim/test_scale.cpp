@@ -11,7 +11,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "sim/sim.hpp"
+#include <lcsim/sim/sim.hpp>
 
 namespace lcsim {
 namespace {

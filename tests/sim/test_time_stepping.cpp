@@ -15,8 +15,8 @@
 #include <random>
 #include <unsupported/Eigen/MatrixFunctions>
 
-#include "io/io.hpp"
-#include "sim/sim.hpp"
+#include <lcsim/io/io.hpp>
+#include <lcsim/sim/sim.hpp>
 
 namespace lcsim {
 namespace {

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "mech/mech.hpp"
+#include <lcsim/mech/mech.hpp>
 
 namespace lcsim::test_support {
 

@@ -10,6 +10,8 @@
 #include <string_view>
 #include <vector>
 
+#include <lcsim/core/registry.hpp>
+
 namespace lcsim::lcp {
 
 using Eigen::MatrixXd;
@@ -101,6 +103,9 @@ class Solver {
   virtual std::string name() const = 0;
   virtual Result solve(const MatrixXd& M, const VectorXd& q, const Options& opt) const = 0;
 };
+// The solvers by name: the built-in ones, then the back-ends of components a
+// program links (lcsim::bullet adds bullet-dantzig, bullet-lemke, bullet-pgs).
+Registry<Solver>& solvers();
 // Throws std::invalid_argument naming the unknown solver and the known names.
 std::unique_ptr<Solver> make_solver(std::string_view name);
 std::vector<std::string> solver_names();
@@ -129,11 +134,3 @@ Result solve_scaled(const Solver& first, const MatrixXd& M, const VectorXd& q, c
 
 }  // namespace lcsim::lcp
 
-// Registration hook for LCP back-ends that live in later layers (the Bullet
-// layer registers bullet-dantzig, bullet-lemke, bullet-pgs). make_solver and
-// solver_names consult it after the built-in solvers; registering a name again
-// replaces the earlier factory. Not thread-safe: register at start-up.
-#include <functional>
-namespace lcsim::lcp {
-void register_solver(std::string name, std::function<std::unique_ptr<Solver>()> factory);
-}  // namespace lcsim::lcp

@@ -10,8 +10,9 @@
 #include <string_view>
 #include <vector>
 
-#include "lcp/lcp.hpp"
-#include "mech/mech.hpp"
+#include <lcsim/core/registry.hpp>
+#include <lcsim/lcp/lcp.hpp>
+#include <lcsim/mech/mech.hpp>
 
 namespace lcsim::impact {
 
@@ -55,6 +56,9 @@ class ImpactLaw {
   virtual std::string name() const = 0;
   virtual ImpactResult apply(const ImpactInput& in, const lcp::Solver& solver) const = 0;
 };
+// The laws by name: those below, and "moreau-qp" in programs that link the
+// component lcsim::ipopt (include/lcsim/ipopt/moreau_qp.hpp).
+Registry<ImpactLaw>& laws();
 // Throws std::invalid_argument naming the unknown law and the known ones.
 std::unique_ptr<ImpactLaw> make_impact_law(std::string_view name);
 std::vector<std::string> impact_law_names();
@@ -68,11 +72,6 @@ std::vector<std::string> impact_law_names();
 // per-contact Newton restitution applied to the inelastic impulse (§8.2.2):
 // v+ = v + sum_i (1 + e_i) M^{-1} E_i' lambda_i. e = 0 is Moreau's rule.
 ImpactResult moreau_newton(const ImpactInput& in, const lcp::Solver& solver);
-// "moreau-qp": the same rule with lambda from the minimisation 3.8.1,
-// min ½(w - v)'M(w - v) s.t. E_J w >= 0, solved by Ipopt (TNLP); lambda are
-// Ipopt's constraint multipliers with the sign flipped (Ipopt's Lagrangian is
-// f + lambda' g, so a lower-bounded active constraint has lambda <= 0).
-ImpactResult moreau_qp(const ImpactInput& in);
 // "moreau-restitution": the Moreau–Jean law, restitution inside the LCP:
 // 0 <= E_J v+ + e∘E_J v ⟂ lambda >= 0, v+ = v + M^{-1} E_J' lambda.
 ImpactResult moreau_restitution(const ImpactInput& in, const lcp::Solver& solver);

@@ -12,8 +12,8 @@
 #include <string_view>
 #include <vector>
 
-#include "impact/impact.hpp"
-#include "mech/mech.hpp"
+#include <lcsim/impact/impact.hpp>
+#include <lcsim/mech/mech.hpp>
 
 namespace lcsim::sim {
 
@@ -133,6 +133,9 @@ class Integrator {
   virtual Trajectory run(const mech::Model& model, const VectorXd& x0,
                          const Options& opt) const = 0;
 };
+// The integrators by name: "event", "euler", "moreau-jean", and "bullet" in
+// programs that link the component lcsim::bullet.
+Registry<Integrator>& integrators();
 // Throws std::invalid_argument naming the unknown method and the known ones.
 std::unique_ptr<Integrator> make_integrator(std::string_view name);
 std::vector<std::string> integrator_names();
@@ -179,12 +182,3 @@ Trajectory simulate_event_driven(const mech::Model& model, const VectorXd& x0, c
 
 }  // namespace lcsim::sim
 
-// Registration hook for integrators that live in later layers (the Bullet
-// layer registers "bullet"; layering forbids sim from naming them). A
-// registered name is found by make_integrator and listed by integrator_names;
-// registering a name again replaces the earlier factory. Not thread-safe:
-// register at start-up (lcsim's main calls bullet::register_backends()).
-#include <functional>
-namespace lcsim::sim {
-void register_integrator(std::string name, std::function<std::unique_ptr<Integrator>()> factory);
-}  // namespace lcsim::sim

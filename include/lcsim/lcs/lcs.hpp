@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "lcp/lcp.hpp"
+#include <lcsim/lcp/lcp.hpp>
 
 namespace lcsim::lcs {
 

@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "impact/impact.hpp"
-#include "mech/mech.hpp"
+#include <lcsim/impact/impact.hpp>
+#include <lcsim/mech/mech.hpp>
 
 namespace lcsim::io {
 

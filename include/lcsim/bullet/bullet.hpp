@@ -20,9 +20,9 @@ std::string version_string();
 #include <Eigen/Dense>
 #include <vector>
 
-#include "lcp/lcp.hpp"
-#include "mech/mech.hpp"
-#include "sim/sim.hpp"
+#include <lcsim/lcp/lcp.hpp>
+#include <lcsim/mech/mech.hpp>
+#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::bullet {
 
@@ -134,11 +134,10 @@ enum class MlcpSolver { kDantzig, kLemke, kPgs };
 lcp::Result solve_bullet_mlcp(MlcpSolver which, const Eigen::MatrixXd& M, const Eigen::VectorXd& q,
                               const lcp::Options& opt = {});
 
-// Registers the "bullet" integrator (sim::register_integrator) and the LCP
-// back-ends bullet-dantzig, bullet-lemke, bullet-pgs (lcp::register_solver).
-// Called explicitly from lcsim's main: a static registrar in a static library
-// is dropped by the linker when nothing references its object file.
-// Idempotent.
+// Adds the "bullet" integrator to sim::integrators() and the LCP back-ends
+// bullet-dantzig, bullet-lemke, bullet-pgs to lcp::solvers(). Called by the
+// registration source that CMake compiles into every program linking
+// lcsim::bullet (src/bullet/autoregister/); calling it again is harmless.
 void register_backends();
 
 }  // namespace lcsim::bullet

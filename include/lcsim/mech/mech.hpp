@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "lcs/lcs.hpp"
+#include <lcsim/lcs/lcs.hpp>
 
 namespace lcsim::mech {
 

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "impact/detail.hpp"
-#include "impact/impact.hpp"
+#include <lcsim/ipopt/moreau_qp.hpp>
 
 namespace lcsim::impact {
 
@@ -221,6 +221,20 @@ ImpactResult moreau_qp(const ImpactInput& in) {
                           " iterations"
                     : "";
   return out;
+}
+
+namespace {
+class MoreauQpLaw final : public ImpactLaw {
+ public:
+  std::string name() const override { return "moreau-qp"; }
+  ImpactResult apply(const ImpactInput& in, const lcp::Solver&) const override {
+    return moreau_qp(in);
+  }
+};
+}  // namespace
+
+void register_moreau_qp() {
+  laws().add("moreau-qp", [] { return std::make_unique<MoreauQpLaw>(); });
 }
 
 }  // namespace lcsim::impact

@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "mech/mech.hpp"
-#include "sim/sim.hpp"
+#include <lcsim/mech/mech.hpp>
+#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::io {
 

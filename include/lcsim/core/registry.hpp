@@ -1,0 +1,94 @@
+// The one registry of named methods: LCP solvers, impact laws and
+// integrators are each chosen by name from a Registry<Interface>.
+//
+// A layer's registry holds its own methods from the start (the layer fills it
+// when it is first used); an optional component (lcsim::bullet,
+// lcsim::ipopt) adds its methods with a namespace-scope Registrar in a source
+// file that CMake links into every program that links the component, so no
+// caller ever makes a registration call. Thread-safe.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace lcsim {
+
+template <class Interface>
+class Registry {
+ public:
+  using Factory = std::function<std::unique_ptr<Interface>()>;
+
+  // `kind` names the methods in messages ("LCP solver", "impact law", "method").
+  explicit Registry(std::string kind) : kind_(std::move(kind)) {}
+
+  // Adds `name`, or replaces the factory of a name already present (the
+  // position in names() is kept).
+  void add(std::string name, Factory factory) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (auto& [n, f] : entries_)
+      if (n == name) {
+        f = std::move(factory);
+        return;
+      }
+    entries_.emplace_back(std::move(name), std::move(factory));
+  }
+
+  bool contains(std::string_view name) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& e : entries_)
+      if (e.first == name) return true;
+    return false;
+  }
+
+  // A new instance of `name`; nullptr when unknown (unknown_message says why).
+  std::unique_ptr<Interface> make(std::string_view name) const {
+    Factory f;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (const auto& e : entries_)
+        if (e.first == name) f = e.second;
+    }
+    return f ? f() : nullptr;
+  }
+
+  // The names, in registration order.
+  std::vector<std::string> names() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<std::string> out;
+    for (const auto& e : entries_) out.push_back(e.first);
+    return out;
+  }
+
+  // "unknown <kind> 'x' (known: a, b, c)", plus `hint` when given.
+  std::string unknown_message(std::string_view name, std::string_view hint = {}) const {
+    std::string known;
+    for (const auto& n : names()) known += (known.empty() ? "" : ", ") + n;
+    std::string msg = "unknown " + kind_ + " '" + std::string(name) + "' (known: " + known + ")";
+    if (!hint.empty()) msg += "; " + std::string(hint);
+    return msg;
+  }
+
+  const std::string& kind() const { return kind_; }
+
+ private:
+  std::string kind_;
+  mutable std::mutex mutex_;
+  std::vector<std::pair<std::string, Factory>> entries_;
+};
+
+// Adds a method to `registry` when the program starts: a namespace-scope
+// object in a component's source file.
+template <class Interface>
+struct Registrar {
+  Registrar(Registry<Interface>& registry, std::string name,
+            typename Registry<Interface>::Factory factory) {
+    registry.add(std::move(name), std::move(factory));
+  }
+};
+
+}  // namespace lcsim
