@@ -17,7 +17,6 @@
 
 #include <algorithm>
 #include <chrono>
-
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/sim/sim.hpp>
 

@@ -5,10 +5,9 @@
 // event-driven simulation of the same run (bench/peer_siconos_two_carts).
 #include <benchmark/benchmark.h>
 
+#include <lcsim/sim/sim.hpp>
 #include <numbers>
 #include <unsupported/Eigen/MatrixFunctions>
-
-#include <lcsim/sim/sim.hpp>
 
 namespace {
 

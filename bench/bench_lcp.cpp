@@ -17,12 +17,11 @@
 #include <benchmark/benchmark.h>
 
 #include <functional>
+#include <lcsim/lcp/lcp.hpp>
 #include <map>
 #include <random>
 #include <string>
 #include <vector>
-
-#include <lcsim/lcp/lcp.hpp>
 
 // bench/CMakeLists.txt adds only <prefix>/siconos/numerics to the include path,
 // but the numerics headers include "SiconosConfig.h" from <prefix>/siconos. Use

@@ -24,11 +24,10 @@
 
 #include <chrono>
 #include <cmath>
-#include <string>
-#include <vector>
-
 #include <lcsim/lcp/lcp.hpp>
 #include <lcsim/sim/sim.hpp>
+#include <string>
+#include <vector>
 
 namespace {
 

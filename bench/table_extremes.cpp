@@ -1,12 +1,11 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <cstdio>
+#include <lcsim/bullet/bullet.hpp>
+#include <lcsim/sim/sim.hpp>
 #include <stdexcept>
 #include <string>
 #include <unsupported/Eigen/MatrixFunctions>
-
-#include <lcsim/bullet/bullet.hpp>
-#include <lcsim/sim/sim.hpp>
 using namespace lcsim;
 // Prints the measured errors of the exact event-driven method and of the
 // time-stepping methods and Bullet at the extremes (docs/extremes.md). The
@@ -40,7 +39,7 @@ sim::Trajectory step_run(const std::string& method, const mech::Model& model, co
       return bullet::simulate_bullet(model, x0, o);
     } catch (const std::invalid_argument& e) {  // a model Bullet cannot express
       sim::Trajectory tr;
-      tr.status = sim::RunStatus::kFailed;
+      tr.status = sim::RunStatus::kNumericalFailure;
       tr.message = e.what();
       tr.final_state = x0;
       return tr;

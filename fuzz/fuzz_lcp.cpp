@@ -19,10 +19,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <lcsim/lcp/lcp.hpp>
 #include <sstream>
 #include <string>
-
-#include <lcsim/lcp/lcp.hpp>
 
 namespace {
 
@@ -45,7 +44,7 @@ struct Reader {
 [[noreturn]] void fail(const std::string& solver, const char* what, const lcsim::lcp::Result& r,
                        const MatrixXd& M, const VectorXd& q) {
   std::fprintf(stderr, "fuzz_lcp: %s: %s (status %s, residual %g, min z %g, min w %g: %s)\n",
-               solver.c_str(), what, std::string(lcsim::lcp::to_string(r.status)).c_str(),
+               solver.c_str(), what, std::string(lcsim::lcp::to_string(r.status, "solved")).c_str(),
                r.residual, r.min_z, r.min_w, r.message.c_str());
   Eigen::IOFormat fmt(Eigen::FullPrecision, 0, ", ", "\n", "[", "]");
   std::fprintf(

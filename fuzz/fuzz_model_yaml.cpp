@@ -5,9 +5,8 @@
 // as_lcs, which the commands call next.
 #include <cstddef>
 #include <cstdint>
-#include <string>
-
 #include <lcsim/io/io.hpp>
+#include <string>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

@@ -13,9 +13,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <string>
-
 #include <lcsim/io/io.hpp>
+#include <string>
 
 namespace {
 

@@ -1,6 +1,6 @@
-#include <lcsim/bullet/bullet.hpp>
-
 #include <LinearMath/btScalar.h>
+
+#include <lcsim/bullet/bullet.hpp>
 
 namespace lcsim::bullet {
 

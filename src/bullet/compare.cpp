@@ -1,10 +1,9 @@
 // Comparison of a run with the exact event-driven run: state deviation over
 // time, final error, event-time shifts, energy drift, violation.
 #include <cmath>
+#include <lcsim/bullet/bullet.hpp>
 #include <limits>
 #include <tuple>
-
-#include <lcsim/bullet/bullet.hpp>
 
 namespace lcsim::bullet {
 

@@ -19,9 +19,8 @@
 #include <BulletDynamics/MLCPSolvers/btSolveProjectedGaussSeidel.h>
 
 #include <cmath>
-#include <sstream>
-
 #include <lcsim/bullet/bullet.hpp>
+#include <sstream>
 
 namespace lcsim::bullet {
 

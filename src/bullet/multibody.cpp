@@ -7,10 +7,10 @@
 #include <urdf_model/model.h>
 
 #include <functional>
+#include <lcsim/bullet/bullet.hpp>
 #include <memory>
 #include <stdexcept>
 
-#include <lcsim/bullet/bullet.hpp>
 #include "bullet/urdf_multibody.hpp"
 
 namespace lcsim::bullet {

@@ -3,11 +3,10 @@
 #pragma once
 
 #include <Eigen/Dense>
-#include <string>
-#include <vector>
-
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
+#include <string>
+#include <vector>
 
 namespace lcsim::bullet {
 

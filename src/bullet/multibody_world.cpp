@@ -47,10 +47,10 @@
 #include <Eigen/Eigenvalues>
 #include <chrono>
 #include <cmath>
+#include <lcsim/bullet/bullet.hpp>
 #include <memory>
 #include <stdexcept>
 
-#include <lcsim/bullet/bullet.hpp>
 #include "bullet/multibody_scene.hpp"
 #include "bullet/run_recorder.hpp"
 #include "bullet/urdf_multibody.hpp"
@@ -228,10 +228,10 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const io::Scene& se
   const auto wall0 = std::chrono::steady_clock::now();
   sim::Trajectory tr;
   tr.method = "bullet " + multibody_description(s);
-  tr.t_end = opt.t_end;
+  tr.t_end = *opt.t_end;
   tr.final_state = x0;
   auto fail = [&](const std::string& msg) {
-    tr.status = sim::RunStatus::kFailed;
+    tr.status = sim::RunStatus::kNumericalFailure;
     tr.message = msg;
     tr.wall_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
@@ -262,7 +262,7 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const io::Scene& se
   }
   btMultiBody& b = *w->mb.body;
   RunRecorder rec(m, opt, tr, q, v);
-  const sim::StepGrid grid = sim::StepGrid::of(opt.t_end, opt.h);
+  const sim::StepGrid grid = sim::StepGrid::of(*opt.t_end, opt.h);
   VectorXd tau(N), q_next(N), v_next(N), impulse(k);
   for (long j = 1; j <= grid.n; ++j) {
     const bool last = j == grid.n;
@@ -292,7 +292,7 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const io::Scene& se
     // Round-off in an impulse is ~1e-16 of the momentum; real ones are O(h).
     const double tiny =
         1e-10 * (1.0 + (m.M * v).cwiseAbs().maxCoeff() + h * tau.cwiseAbs().maxCoeff());
-    rec.step(last ? opt.t_end : j * opt.h, h, last, q_next, v_next, impulse, tiny);
+    rec.step(last ? *opt.t_end : j * opt.h, h, last, q_next, v_next, impulse, tiny);
     q = q_next;
     v = v_next;
   }

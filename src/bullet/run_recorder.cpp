@@ -38,7 +38,7 @@ void RunRecorder::record(double t, const VectorXd& u) {
   smp.u = u;
   smp.y = y_;
   smp.mode = mode_;
-  tr_.samples.push_back(std::move(smp));
+  tr_.record_sample(std::move(smp), opt_);
 }
 
 void RunRecorder::step(double t, double h, bool last, const VectorXd& q, const VectorXd& v,

@@ -4,10 +4,9 @@
 #pragma once
 
 #include <Eigen/Dense>
-#include <string>
-
 #include <lcsim/mech/mech.hpp>
 #include <lcsim/sim/sim.hpp>
+#include <string>
 
 namespace lcsim::bullet {
 

@@ -45,15 +45,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <lcsim/bullet/bullet.hpp>
+#include <lcsim/io/io.hpp>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <utility>
 
-#include <lcsim/bullet/bullet.hpp>
 #include "bullet/multibody_scene.hpp"
 #include "bullet/run_recorder.hpp"
-#include <lcsim/io/io.hpp>
 
 namespace lcsim::bullet {
 
@@ -287,10 +287,10 @@ sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>&
   const auto wall0 = std::chrono::steady_clock::now();
   sim::Trajectory tr;
   tr.method = "bullet " + rb6_description(s);
-  tr.t_end = opt.t_end;
+  tr.t_end = *opt.t_end;
   tr.final_state = x0;
   auto fail = [&](const std::string& msg) {
-    tr.status = sim::RunStatus::kFailed;
+    tr.status = sim::RunStatus::kNumericalFailure;
     tr.message = msg;
     tr.wall_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
@@ -334,7 +334,7 @@ sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>&
     }
 
   // The grid of the time-stepping methods: n steps of h, the last shortened.
-  const sim::StepGrid grid = sim::StepGrid::of(opt.t_end, opt.h);
+  const sim::StepGrid grid = sim::StepGrid::of(*opt.t_end, opt.h);
 
   std::unique_ptr<World> w = build(m, limits, q, v, s);
   // Multipliers from the momentum balance M (v+ - v) = h F + E' (h u):
@@ -374,7 +374,7 @@ sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>&
     // contacts are O(h).
     const double tiny =
         1e-10 * (1.0 + (m.M * v).cwiseAbs().maxCoeff() + h * F.cwiseAbs().maxCoeff());
-    rec.step(last ? opt.t_end : j * opt.h, h, last, q_next, v_next, impulse, tiny);
+    rec.step(last ? *opt.t_end : j * opt.h, h, last, q_next, v_next, impulse, tiny);
     q = q_next;
     v = v_next;
   }
@@ -399,8 +399,8 @@ namespace {
 class BulletIntegrator : public sim::Integrator {
  public:
   std::string name() const override { return "bullet"; }
-  sim::Trajectory run(const mech::Model& model, const VectorXd& x0,
-                      const sim::Options& opt) const override {
+  sim::Trajectory integrate(const mech::Model& model, const VectorXd& x0,
+                            const sim::Options& opt) const override {
     return simulate_bullet(model, x0, opt);
   }
 };

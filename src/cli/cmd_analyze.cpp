@@ -8,6 +8,10 @@
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
+#include <lcsim/io/io.hpp>
+#include <lcsim/lcp/lcp.hpp>
+#include <lcsim/lcs/lcs.hpp>
+#include <lcsim/mech/mech.hpp>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -15,10 +19,6 @@
 
 #include "cli/command.hpp"
 #include "cli/output.hpp"
-#include <lcsim/io/io.hpp>
-#include <lcsim/lcp/lcp.hpp>
-#include <lcsim/lcs/lcs.hpp>
-#include <lcsim/mech/mech.hpp>
 
 namespace lcsim::cli {
 namespace {

@@ -15,15 +15,15 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
-#include <memory>
-#include <nlohmann/json.hpp>
-
 #include <lcsim/bullet/bullet.hpp>
-#include "cli/command.hpp"
-#include "cli/run_inputs.hpp"
 #include <lcsim/io/io.hpp>
 #include <lcsim/io/sweep.hpp>
 #include <lcsim/sim/sim.hpp>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "cli/command.hpp"
+#include "cli/run_inputs.hpp"
 
 namespace lcsim::cli {
 namespace {
@@ -49,12 +49,12 @@ void run_compare(const CompareArgs& a) {
   const Eigen::VectorXd x0 = resolve_initial_state(model, a.model, a.x0);
   sim::Options opt;
   opt.t_end = resolve_horizon(model, a.model, a.t_end_given, a.t_end);
-  if (!(a.h > 0.0) || !std::isfinite(a.h) || a.h > opt.t_end)
+  if (!(a.h > 0.0) || !std::isfinite(a.h) || a.h > *opt.t_end)
     throw io::InputError("--h: must be a finite number > 0 and <= the horizon (got " +
                          std::to_string(a.h) + ")");
   opt.h = a.h;
   // Comparison grid: a multiple of h, at most ~2000 points (as lcsim sweep).
-  opt.dt_out = std::max(1.0, std::round(opt.t_end / (2000.0 * a.h))) * a.h;
+  opt.dt_out = std::max(1.0, std::round(*opt.t_end / (2000.0 * a.h))) * a.h;
 
   // Like with like (issue 13): Bullet loses restitution at the scene's stop
   // ERP, so its exact counterpart is the nearest exact law (io::reference_law).
@@ -82,7 +82,7 @@ void run_compare(const CompareArgs& a) {
     nlohmann::json j;
     j["model"] = model.name;
     j["h"] = a.h;
-    j["t_end"] = opt.t_end;
+    j["t_end"] = *opt.t_end;
     j["deviation_max"] = num(c.deviation_max);
     j["deviation_t"] = c.deviation_t;
     j["error_final"] = num(c.error_final);
@@ -109,7 +109,7 @@ void run_compare(const CompareArgs& a) {
   }
   // The scene's own ERP (rb6's stop ERP, the multibody's limit ERP) is in
   // bullet_solver.
-  std::printf("model %s, t_end %g, h %g: %s, %s\n", model.name.c_str(), opt.t_end, a.h,
+  std::printf("model %s, t_end %g, h %g: %s, %s\n", model.name.c_str(), *opt.t_end, a.h,
               bullet::version_string().c_str(), bullet_solver.c_str());
   std::printf("reference      exact run, %s (%s)\n", law.label().c_str(), law.reason.c_str());
   std::printf("deviation max  %.3e (at t = %.6g)\n", c.deviation_max, c.deviation_t);

@@ -14,10 +14,10 @@
 // their non-zeros, so the file grows as N (N = 10000: about 0.5 MB).
 #include <cstdio>
 #include <iostream>
+#include <lcsim/io/io.hpp>
 #include <string>
 
 #include "cli/command.hpp"
-#include <lcsim/io/io.hpp>
 
 namespace lcsim::cli {
 namespace {

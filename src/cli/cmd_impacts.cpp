@@ -16,15 +16,15 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <lcsim/impact/impact.hpp>
+#include <lcsim/io/impact_map.hpp>
+#include <lcsim/io/io.hpp>
 #include <memory>
 #include <sstream>
 
 #include "cli/command.hpp"
 #include "cli/output.hpp"
 #include "cli/run_inputs.hpp"
-#include <lcsim/impact/impact.hpp>
-#include <lcsim/io/impact_map.hpp>
-#include <lcsim/io/io.hpp>
 
 namespace lcsim::cli {
 namespace {

@@ -4,12 +4,12 @@
 // 2 on bad input.
 #include <cstdio>
 #include <iostream>
+#include <lcsim/io/io.hpp>
+#include <lcsim/lcp/lcp.hpp>
 #include <memory>
 #include <string>
 
 #include "cli/command.hpp"
-#include <lcsim/io/io.hpp>
-#include <lcsim/lcp/lcp.hpp>
 
 namespace lcsim::cli {
 namespace {
@@ -43,7 +43,7 @@ void run_lcp(const LcpArgs& args) {
   if (args.json) {
     nlohmann::json j;
     j["solver"] = solver->name();
-    j["status"] = std::string(lcp::to_string(r.status));
+    j["status"] = std::string(lcp::to_string(r.status, "solved"));
     j["z"] = io::to_json(r.z);
     j["w"] = io::to_json(r.w);
     j["residual"] = r.residual;
@@ -57,7 +57,7 @@ void run_lcp(const LcpArgs& args) {
     char res[32];
     std::snprintf(res, sizeof res, "%.3g", r.residual);
     std::cout << "solver:   " << solver->name() << "\n"
-              << "status:   " << lcp::to_string(r.status) << "\n"
+              << "status:   " << lcp::to_string(r.status, "solved") << "\n"
               << "z =       " << vector_text(r.z) << "\n"
               << "w =       " << vector_text(r.w) << "\n"
               << "residual: " << res << "  (||min(z, w)||_inf)\n"
@@ -69,7 +69,7 @@ void run_lcp(const LcpArgs& args) {
   std::cout.flush();
   if (!r.ok())
     throw NumericalError(args.file + ": LCP not solved by " + solver->name() + ": " +
-                         std::string(lcp::to_string(r.status)) +
+                         std::string(lcp::to_string(r.status, "solved")) +
                          (r.message.empty() ? "" : " (" + r.message + ")"));
 }
 

@@ -2,6 +2,8 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <lcsim/io/io.hpp>
+#include <lcsim/sim/sim.hpp>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -9,8 +11,6 @@
 #include "cli/command.hpp"
 #include "cli/output.hpp"
 #include "cli/run_inputs.hpp"
-#include <lcsim/io/io.hpp>
-#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::cli {
 namespace {
@@ -84,8 +84,8 @@ void run_simulate(const SimulateArgs& a) {
     const double h = a.h_given ? a.h : opt.h;
     if (!(h > 0.0) || !std::isfinite(h))
       throw io::InputError("--h: must be a finite number > 0 (got " + std::to_string(h) + ")");
-    if (h > opt.t_end)
-      throw io::InputError("--h: must not exceed the horizon " + std::to_string(opt.t_end) +
+    if (h > *opt.t_end)
+      throw io::InputError("--h: must not exceed the horizon " + std::to_string(*opt.t_end) +
                            " (got " + std::to_string(h) + ")");
     opt.h = h;
   }
@@ -105,14 +105,14 @@ void run_simulate(const SimulateArgs& a) {
   if (scene) {
     opt.record_samples = true;
     if (opt.dt_out == 0.0 && a.out.empty())
-      opt.dt_out = opt.t_end / static_cast<double>(io::kLinearisationStates);
+      opt.dt_out = *opt.t_end / static_cast<double>(io::kLinearisationStates);
   }
   // An unwritable --out fails now, not after the run.
   if (!a.out.empty()) check_writable(a.out);
 
-  ProgressLine progress(opt.t_end, a.no_progress ? ProgressLine::Mode::kNever
-                                   : a.progress  ? ProgressLine::Mode::kAlways
-                                                 : ProgressLine::Mode::kAuto);
+  ProgressLine progress(*opt.t_end, a.no_progress ? ProgressLine::Mode::kNever
+                                    : a.progress  ? ProgressLine::Mode::kAlways
+                                                  : ProgressLine::Mode::kAuto);
   opt.progress = [&progress](double t) { progress.update(t); };
   const sim::Trajectory tr = integrator->run(model, x0, opt);
   if (tr.status == sim::RunStatus::kCompleted) progress.done();

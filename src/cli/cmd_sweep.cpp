@@ -11,6 +11,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <lcsim/io/io.hpp>
+#include <lcsim/io/sweep.hpp>
+#include <lcsim/sim/sim.hpp>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -18,9 +21,6 @@
 #include "cli/command.hpp"
 #include "cli/output.hpp"
 #include "cli/run_inputs.hpp"
-#include <lcsim/io/io.hpp>
-#include <lcsim/io/sweep.hpp>
-#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::cli {
 namespace {

@@ -2,10 +2,10 @@
 // printed as one clear line with a non-zero exit (DESIGN.md, Conventions).
 #include <CLI/CLI.hpp>
 #include <iostream>
-
 #include <lcsim/bullet/bullet.hpp>
-#include "cli/command.hpp"
 #include <lcsim/io/io.hpp>
+
+#include "cli/command.hpp"
 
 namespace lcsim::cli {
 std::vector<CommandSetup>& command_registry() {

@@ -14,11 +14,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <lcsim/io/io.hpp>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
-
-#include <lcsim/io/io.hpp>
 
 extern char** environ;
 

@@ -1,7 +1,6 @@
 #include "cli/run_inputs.hpp"
 
 #include <cmath>
-
 #include <lcsim/io/io.hpp>
 
 namespace lcsim::cli {

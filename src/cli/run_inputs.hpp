@@ -3,9 +3,8 @@
 #pragma once
 
 #include <Eigen/Dense>
-#include <string>
-
 #include <lcsim/mech/mech.hpp>
+#include <string>
 
 namespace lcsim::cli {
 

@@ -1,9 +1,8 @@
 // Internal helpers shared by the impact rules (not part of the public face).
 #pragma once
 
-#include <optional>
-
 #include <lcsim/impact/impact.hpp>
+#include <optional>
 
 namespace lcsim::impact::detail {
 

@@ -1,9 +1,8 @@
 // Impact rules: shared set-up, Moreau's LCP with Newton restitution
 // ("moreau", "newton") and the registry of rules by name.
-#include <lcsim/impact/impact.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <lcsim/impact/impact.hpp>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -188,7 +187,7 @@ std::optional<VectorXd> solve_impact_lcp(const MatrixXd& W, const VectorXd& q,
   }
   out.lcp_status = res.status;
   if (!res.ok()) {
-    out.message = "impact LCP failed (" + tried + "): " + std::string(lcp::to_string(res.status)) +
+    out.message = "impact LCP failed (" + tried + "): " + std::string(lcp::to_string(res.status, "solved")) +
                   (res.message.empty() ? "" : " (" + res.message + ")");
     return std::nullopt;
   }

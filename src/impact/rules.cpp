@@ -2,10 +2,10 @@
 // the LCP, sequential pairwise impacts (Example 1.4.1) and the mode rule of
 // ref. [177] that Example 3.8.3 refutes ("flip").
 #include <cmath>
+#include <lcsim/impact/impact.hpp>
 #include <sstream>
 
 #include "impact/detail.hpp"
-#include <lcsim/impact/impact.hpp>
 
 namespace lcsim::impact {
 

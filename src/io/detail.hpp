@@ -5,9 +5,8 @@
 
 #include <cstddef>
 #include <filesystem>
-#include <string>
-
 #include <lcsim/io/io.hpp>
+#include <string>
 
 namespace lcsim::io {
 

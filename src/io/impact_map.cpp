@@ -1,15 +1,14 @@
 // The impact map (impact_map.hpp): range and name parsing, the closed set,
 // placing q on the named contacts, the grid of impacts, its CSV.
-#include <lcsim/io/impact_map.hpp>
-
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
+#include <lcsim/io/impact_map.hpp>
+#include <lcsim/io/io.hpp>
 #include <optional>
 #include <sstream>
 
 #include "io/detail.hpp"
-#include <lcsim/io/io.hpp>
 
 namespace lcsim::io {
 

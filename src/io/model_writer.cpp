@@ -2,11 +2,11 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <lcsim/io/io.hpp>
 #include <sstream>
 #include <stdexcept>
 
 #include "io/detail.hpp"
-#include <lcsim/io/io.hpp>
 
 namespace lcsim::io {
 

@@ -12,12 +12,12 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <lcsim/io/io.hpp>
 #include <map>
 #include <set>
 #include <sstream>
 
 #include "io/detail.hpp"
-#include <lcsim/io/io.hpp>
 #include "io/yaml_read.hpp"
 
 namespace lcsim::io {

@@ -16,12 +16,12 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <lcsim/io/io.hpp>
 #include <limits>
 #include <set>
 #include <sstream>
 
 #include "io/detail.hpp"
-#include <lcsim/io/io.hpp>
 #include "io/yaml_read.hpp"
 
 namespace lcsim::io {

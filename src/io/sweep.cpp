@@ -1,16 +1,15 @@
 // The work-precision sweep: reference laws, reference runs, rows (sweep.hpp).
-#include <lcsim/io/sweep.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <lcsim/impact/impact.hpp>
+#include <lcsim/io/io.hpp>
+#include <lcsim/io/sweep.hpp>
 #include <limits>
 #include <map>
 #include <memory>
 
-#include <lcsim/impact/impact.hpp>
 #include "io/detail.hpp"
-#include <lcsim/io/io.hpp>
 
 namespace lcsim::io {
 
@@ -67,7 +66,7 @@ void check_options(const SweepOptions& o) {
   }
   if (o.hs.empty()) throw InputError("--h: empty list");
   for (double h : o.hs)
-    if (!(h > 0.0) || !std::isfinite(h) || h > o.base.t_end)
+    if (!(h > 0.0) || !std::isfinite(h) || h > o.base.t_end.value_or(0.0))
       throw InputError("--h: every step must be finite, > 0 and <= the horizon (got " +
                        format_number(h) + ")");
   if (o.repeat < 1)
@@ -177,7 +176,7 @@ SweepRow stepping_row(const std::string& method, const sim::Integrator& integ, d
   sim::Options opt = o.base;
   opt.h = h;
   // Comparison grid: a multiple of h, at most ~2000 points.
-  opt.dt_out = std::max(1.0, std::round(o.base.t_end / (2000.0 * h))) * h;
+  opt.dt_out = std::max(1.0, std::round(o.base.t_end.value_or(model.t_end) / (2000.0 * h))) * h;
   const sim::Trajectory tr = integ.run(model, x0, opt);
   r.status = status_of(tr);
   r.warnings = tr.warnings;
@@ -272,7 +271,7 @@ SweepResult run_sweep(const mech::Model& model, const Eigen::VectorXd& x0, const
   check_options(o);
   SweepResult out;
   out.model = model.name;
-  out.t_end = o.base.t_end;
+  out.t_end = o.base.t_end.value_or(model.t_end);
   out.impact = o.base.impact;
   References refs(model, x0, o.base);
   const size_t total = o.methods.size() * o.hs.size();

@@ -23,11 +23,11 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <lcsim/io/io.hpp>
 #include <set>
 #include <sstream>
 
 #include "io/detail.hpp"
-#include <lcsim/io/io.hpp>
 
 namespace lcsim::io {
 

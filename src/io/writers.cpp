@@ -7,10 +7,10 @@
 #include <charconv>
 #include <cstdio>
 #include <cstring>
+#include <lcsim/io/io.hpp>
 #include <stdexcept>
 
 #include "io/detail.hpp"
-#include <lcsim/io/io.hpp>
 
 namespace lcsim::io {
 
@@ -67,15 +67,7 @@ std::string prefixed(std::string_view prefix, const std::string& text) {
   return s;
 }
 
-std::string_view run_status_name(sim::RunStatus s) {
-  switch (s) {
-    case sim::RunStatus::kCompleted:
-      return "completed";
-    case sim::RunStatus::kFailed:
-      return "failed";
-  }
-  return "unknown";
-}
+std::string_view run_status_name(sim::RunStatus s) { return to_string(s, "completed"); }
 
 nlohmann::json index_set_json(const std::vector<int>& s) {
   nlohmann::json a = nlohmann::json::array();

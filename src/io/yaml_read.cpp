@@ -4,9 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <lcsim/io/io.hpp>
 
 #include "io/detail.hpp"
-#include <lcsim/io/io.hpp>
 
 namespace lcsim::io::yaml {
 

@@ -7,10 +7,10 @@
 #include <IpTNLP.hpp>
 #include <algorithm>
 #include <cmath>
+#include <lcsim/ipopt/moreau_qp.hpp>
 #include <string>
 
 #include "impact/detail.hpp"
-#include <lcsim/ipopt/moreau_qp.hpp>
 
 namespace lcsim::impact {
 

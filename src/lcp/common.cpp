@@ -2,31 +2,15 @@
 #include <cmath>
 #include <exception>
 #include <functional>
+#include <lcsim/lcp/lcp.hpp>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
 
 #include "lcp/detail.hpp"
-#include <lcsim/lcp/lcp.hpp>
 
 namespace lcsim::lcp {
-
-std::string_view to_string(Status s) {
-  switch (s) {
-    case Status::kSolved:
-      return "solved";
-    case Status::kRayTermination:
-      return "ray termination";
-    case Status::kIterationLimit:
-      return "iteration limit";
-    case Status::kNumericalFailure:
-      return "numerical failure";
-    case Status::kInvalidInput:
-      return "invalid input";
-  }
-  return "unknown";
-}
 
 namespace {
 // A message from its parts, formatted as by an ostringstream; built only on

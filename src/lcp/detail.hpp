@@ -1,9 +1,8 @@
 // Internal helpers shared by the LCP solvers (not part of the public face).
 #pragma once
 
-#include <string>
-
 #include <lcsim/lcp/lcp.hpp>
+#include <string>
 
 namespace lcsim::lcp::detail {
 

@@ -5,11 +5,11 @@
 // singular the solution set may be a polyhedron whose vertices these are.
 #include <algorithm>
 #include <exception>
+#include <lcsim/lcp/lcp.hpp>
 #include <string>
 #include <vector>
 
 #include "lcp/detail.hpp"
-#include <lcsim/lcp/lcp.hpp>
 
 namespace lcsim::lcp {
 namespace {

@@ -1,5 +1,4 @@
 #include <cmath>
-
 #include <lcsim/lcp/lcp.hpp>
 
 namespace lcsim::lcp {

@@ -11,11 +11,11 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <lcsim/lcp/lcp.hpp>
 #include <string>
 #include <vector>
 
 #include "lcp/detail.hpp"
-#include <lcsim/lcp/lcp.hpp>
 
 namespace lcsim::lcp {
 namespace {

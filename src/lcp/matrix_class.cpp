@@ -2,9 +2,8 @@
 // §4.5): P-matrices (unique solution for every q), positive (semi)definite.
 #include <algorithm>
 #include <cmath>
-#include <vector>
-
 #include <lcsim/lcp/lcp.hpp>
+#include <vector>
 
 namespace lcsim::lcp {
 namespace {

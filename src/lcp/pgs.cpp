@@ -7,10 +7,10 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <lcsim/lcp/lcp.hpp>
 #include <string>
 
 #include "lcp/detail.hpp"
-#include <lcsim/lcp/lcp.hpp>
 
 namespace lcsim::lcp {
 namespace {

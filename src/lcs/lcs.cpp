@@ -1,10 +1,9 @@
 // Markov parameters (3.32) and leading row/column indices and coefficient
 // matrices (3.39).
-#include <lcsim/lcs/lcs.hpp>
-
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <lcsim/lcs/lcs.hpp>
 #include <limits>
 
 namespace lcsim::lcs {

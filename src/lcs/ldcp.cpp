@@ -16,9 +16,8 @@
 // x0 + sum_j A^j B u^{-j} (eq. (3.10)).
 #include <algorithm>
 #include <cmath>
-#include <sstream>
-
 #include <lcsim/lcs/lcs.hpp>
+#include <sstream>
 
 namespace lcsim::lcs {
 
@@ -218,7 +217,7 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
       out.lcp_solves += attempts;
       if (!res.ok()) {
         out.message = "LCP at LDCP level " + std::to_string(p) +
-                      " failed: " + std::string(lcp::to_string(res.status)) +
+                      " failed: " + std::string(lcp::to_string(res.status, "solved")) +
                       (res.message.empty() ? "" : " (" + res.message + ")");
         return out;
       }

@@ -14,10 +14,9 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <lcsim/lcs/lcs.hpp>
 #include <sstream>
 #include <stdexcept>
-
-#include <lcsim/lcs/lcs.hpp>
 
 namespace lcsim::lcs {
 

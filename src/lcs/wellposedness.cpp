@@ -8,9 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
-#include <sstream>
-
 #include <lcsim/lcs/lcs.hpp>
+#include <sstream>
 
 namespace lcsim::lcs {
 

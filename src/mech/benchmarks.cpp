@@ -1,7 +1,6 @@
+#include <lcsim/mech/mech.hpp>
 #include <stdexcept>
 #include <vector>
-
-#include <lcsim/mech/mech.hpp>
 
 namespace lcsim::mech {
 

@@ -2,11 +2,10 @@
 // those index sets only (declarations and the reasoning in mech.hpp).
 #include <Eigen/SVD>
 #include <algorithm>
-#include <map>
-#include <set>
-
 #include <lcsim/lcp/lcp.hpp>
 #include <lcsim/mech/mech.hpp>
+#include <map>
+#include <set>
 
 namespace lcsim::mech {
 

@@ -1,9 +1,8 @@
-#include <lcsim/mech/mech.hpp>
-
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseQR>
 #include <algorithm>
+#include <lcsim/mech/mech.hpp>
 #include <stdexcept>
 
 namespace lcsim::mech {
@@ -96,7 +95,7 @@ VectorXd project_feasible(const MechanicalModel& m, const VectorXd& q) {
     if (!r.ok())
       throw std::invalid_argument(
           "cannot project the initial state onto E q + g >= 0: the constraints " +
-          std::string("admit no configuration (LCP ") + std::string(lcp::to_string(r.status)) +
+          std::string("admit no configuration (LCP ") + std::string(lcp::to_string(r.status, "solved")) +
           ")");
     p = q + MinvEt * r.z;
   }

@@ -15,13 +15,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <lcsim/sim/sim.hpp>
 #include <limits>
 #include <map>
 #include <set>
 #include <sstream>
 #include <unsupported/Eigen/MatrixFunctions>
-
-#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::sim {
 
@@ -305,7 +304,7 @@ class LivelockGuard {
 
 class EventDriven {
  public:
-  // `model` fits the dense LCS (simulate_event_driven checks).
+  // `model` fits the dense LCS (Integrator::run checks).
   EventDriven(const mech::Model& model, const Options& opt)
       : model_(model), opt_(opt), sys_(model.as_lcs()) {
     n_ = sys_.n();
@@ -702,17 +701,17 @@ void EventDriven::record(Trajectory& tr, double t, const VectorXd& xa, const Pha
   s.u = multipliers(ph, xa);
   s.y = sys_.C * xa + sys_.D * s.u;
   s.mode = ph.mode;
-  tr.samples.push_back(std::move(s));
+  tr.record_sample(std::move(s), opt_);
 }
 
 Trajectory EventDriven::run(const VectorXd& x0_user) {
   const auto wall0 = std::chrono::steady_clock::now();
   Trajectory tr;
   tr.method = "event";
-  tr.t_end = opt_.t_end;
+  tr.t_end = *opt_.t_end;
   if (model_.is_mechanical()) tr.impact_law = impact_->name();
   auto fail = [&](const std::string& msg) {
-    tr.status = RunStatus::kFailed;
+    tr.status = RunStatus::kNumericalFailure;
     tr.message = msg;
   };
   VectorXd xa = augment(x0_user);
@@ -731,7 +730,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     phase = make_phase(ev.mode, ldcp_undetermined_, ev.x_plus, err);
     if (!err.empty()) fail(err);
   }
-  if (tr.status == RunStatus::kFailed) {
+  if (tr.status == RunStatus::kNumericalFailure) {
     tr.final_state = x0_user;
     tr.energy_final = tr.energy_initial;
     return tr;
@@ -753,7 +752,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
   xa = ev.x_plus;
   record(tr, t, xa, phase);
 
-  const double t_end = opt_.t_end;
+  const double t_end = *opt_.t_end;
   LivelockGuard livelock(
       opt_.livelock_events, rho_A_,
       model_.is_mechanical() ? model_.mechanical->constraints : std::vector<std::string>{});
@@ -1068,12 +1067,14 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
 
 }  // namespace
 
-Trajectory simulate_event_driven(const mech::Model& model, const VectorXd& x0, const Options& opt) {
+// The method on input that Integrator::run has checked (trajectory.cpp).
+Trajectory integrate_event_driven(const mech::Model& model, const VectorXd& x0,
+                                  const Options& opt) {
   const auto refuse = [&](const std::string& why) {
     Trajectory tr;
     tr.method = "event";
-    tr.t_end = opt.t_end;
-    tr.status = RunStatus::kFailed;
+    tr.t_end = *opt.t_end;
+    tr.status = RunStatus::kNumericalFailure;
     tr.message = why;
     tr.final_state = x0;
     return tr;

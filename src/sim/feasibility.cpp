@@ -1,6 +1,5 @@
-#include <sstream>
-
 #include <lcsim/sim/sim.hpp>
+#include <sstream>
 
 namespace lcsim::sim {
 

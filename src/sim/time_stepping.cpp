@@ -18,11 +18,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <lcsim/sim/sim.hpp>
 #include <stdexcept>
 #include <utility>
 #include <vector>
-
-#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::sim {
 
@@ -36,7 +35,8 @@ std::string fmt(double x) { return short_number(x); }
 // The message of a step whose LCP failed, for both schemes.
 std::string lcp_failure(const char* method, double t, const lcp::Result& r) {
   return std::string(method) + ": LCP failed at t = " + fmt(t) + " (" +
-         std::string(lcp::to_string(r.status)) + ")" + (r.message.empty() ? "" : ": " + r.message);
+         std::string(lcp::to_string(r.status, "solved")) + ")" +
+         (r.message.empty() ? "" : ": " + r.message);
 }
 
 // ---------------------------------------------------------------------------
@@ -74,7 +74,7 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
   const auto wall0 = std::chrono::steady_clock::now();
   Trajectory tr;
   tr.method = "euler";
-  tr.t_end = opt.t_end;
+  tr.t_end = *opt.t_end;
   // Backward Euler's step LCP acts on positions: every impact is inelastic.
   if (model.is_mechanical()) tr.impact_law = "moreau (e = 0: restitution ignored)";
   const bool mech = model.is_mechanical();
@@ -91,7 +91,7 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
     return std::move(tr);  // only ever returned from the run: no copy of the samples
   };
   auto fail = [&](const std::string& msg, const VectorXd& xa) {
-    tr.status = RunStatus::kFailed;
+    tr.status = RunStatus::kNumericalFailure;
     tr.message = msg;
     return finish(xa);
   };
@@ -102,7 +102,7 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
     sys = model.as_lcs();
     solver = lcp::make_solver(opt.lcp_solver);
   } catch (const std::exception& e) {
-    tr.status = RunStatus::kFailed;
+    tr.status = RunStatus::kNumericalFailure;
     tr.message = std::string("euler: ") + e.what();
     tr.final_state = x0_user;
     return tr;
@@ -110,14 +110,14 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
   const int n = sys.n(), k = sys.k();
   VectorXd x(n);
   if (x0_user.size() != model.state_size()) {
-    tr.status = RunStatus::kFailed;
+    tr.status = RunStatus::kNumericalFailure;
     tr.message = "euler: initial state has " + std::to_string(x0_user.size()) +
                  " entries, the model needs " + std::to_string(model.state_size());
     tr.final_state = x0_user;
     return tr;
   }
   if (const std::string bad = infeasible_start(model, x0_user); !bad.empty()) {
-    tr.status = RunStatus::kFailed;
+    tr.status = RunStatus::kNumericalFailure;
     tr.message = "euler: " + bad;
     tr.final_state = x0_user;
     return tr;
@@ -153,7 +153,7 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
       model.mechanical->restitution.maxCoeff() > 0.0)
     tr.add_warning("backward Euler ignores restitution: every impact is inelastic");
 
-  const StepGrid grid = StepGrid::of(opt.t_end, opt.h);
+  const StepGrid grid = StepGrid::of(*opt.t_end, opt.h);
   EulerFactors F = euler_factors(sys, grid.h);
   if (!F.ok) return fail("euler: " + F.message, x);
   EulerFactors F_last;
@@ -175,7 +175,7 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
     s.y = y;
     for (int i = 0; i < k; ++i)
       if (uu(i) > 0.0) s.mode.push_back(i);
-    tr.samples.push_back(std::move(s));
+    tr.record_sample(std::move(s), opt);
   };
   record(0.0, x, u);
 
@@ -202,7 +202,7 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
     if (!x_next.allFinite()) return fail("euler: non-finite state at t = " + fmt(j * grid.h), x);
     x = x_next;
     ++tr.steps;
-    const double t = last ? opt.t_end : j * grid.h;
+    const double t = last ? *opt.t_end : j * grid.h;
     if (sampler.want(t, grid.h, last)) {
       record(t, x, u);  // also updates max_violation
     } else if (k > 0) {
@@ -589,10 +589,10 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
   const auto wall0 = std::chrono::steady_clock::now();
   Trajectory tr;
   tr.method = "moreau-jean";
-  tr.t_end = opt.t_end;
+  tr.t_end = *opt.t_end;
   tr.impact_law = "moreau-restitution";  // the law inside the velocity LCP
   if (!model.is_mechanical()) {
-    tr.status = RunStatus::kFailed;
+    tr.status = RunStatus::kNumericalFailure;
     tr.message = "moreau-jean: needs a mechanical model ('" + model.name +
                  "' is a general LCS; use euler or event)";
     tr.final_state = x0;
@@ -601,7 +601,7 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
   const mech::MechanicalModel& m = *model.mechanical;
   const int N = m.dofs(), k = m.num_constraints();
   if (x0.size() != 2 * N) {
-    tr.status = RunStatus::kFailed;
+    tr.status = RunStatus::kNumericalFailure;
     tr.message = "moreau-jean: initial state has " + std::to_string(x0.size()) +
                  " entries, the model needs " + std::to_string(2 * N);
     tr.final_state = x0;
@@ -619,7 +619,7 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     return std::move(tr);  // only ever returned from the run: no copy of the samples
   };
   auto fail = [&](const std::string& msg) {
-    tr.status = RunStatus::kFailed;
+    tr.status = RunStatus::kNumericalFailure;
     tr.message = msg;
     return finish();
   };
@@ -634,7 +634,7 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     return fail(std::string("moreau-jean: ") + e.what());
   }
   const double theta = opt.theta;
-  const StepGrid grid = StepGrid::of(opt.t_end, opt.h);
+  const StepGrid grid = StepGrid::of(*opt.t_end, opt.h);
   MjIteration F, F_last;
   if (!F.factor(ops, grid.h, theta)) return fail("moreau-jean: " + F.message());
   if (grid.h_last != grid.h && !F_last.factor(ops, grid.h_last, theta))
@@ -651,7 +651,7 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     s.u = uu;
     s.y = y;
     s.mode = mode;
-    tr.samples.push_back(std::move(s));
+    tr.record_sample(std::move(s), opt);
   };
   VectorXd y(k);
   ops.E_times(q, y);
@@ -794,7 +794,7 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
       y += m.g;
       tr.max_violation = std::min(tr.max_violation, std::min(0.0, y.minCoeff()));
     }
-    const double t = last ? opt.t_end : j * grid.h;
+    const double t = last ? *opt.t_end : j * grid.h;
     if (sampler.want(t, grid.h, last)) record(t, y, u, mode);
   }
   return finish();
@@ -803,7 +803,8 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
 class EulerIntegrator : public Integrator {
  public:
   std::string name() const override { return "euler"; }
-  Trajectory run(const mech::Model& model, const VectorXd& x0, const Options& opt) const override {
+  Trajectory integrate(const mech::Model& model, const VectorXd& x0,
+                       const Options& opt) const override {
     return run_euler(model, x0, opt);
   }
 };
@@ -811,7 +812,8 @@ class EulerIntegrator : public Integrator {
 class MoreauJeanIntegrator : public Integrator {
  public:
   std::string name() const override { return "moreau-jean"; }
-  Trajectory run(const mech::Model& model, const VectorXd& x0, const Options& opt) const override {
+  Trajectory integrate(const mech::Model& model, const VectorXd& x0,
+                       const Options& opt) const override {
     return run_moreau_jean(model, x0, opt);
   }
 };

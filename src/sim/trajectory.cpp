@@ -1,10 +1,9 @@
 #include <cmath>
 #include <functional>
+#include <lcsim/sim/sim.hpp>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
-
-#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::sim {
 
@@ -22,6 +21,17 @@ std::string_view to_string(EventType t) {
       return "start";
   }
   return "unknown";
+}
+
+Trajectory Integrator::run(const mech::Model& model, const VectorXd& x0, const Options& opt) const {
+  return integrate(model, x0, opt);
+}
+
+void Trajectory::record_sample(Sample s, const Options& opt) {
+  if (opt.sample_sink)
+    opt.sample_sink(s);
+  else
+    samples.push_back(std::move(s));
 }
 
 void Trajectory::add_warning(std::string w) {
@@ -61,24 +71,30 @@ std::string short_number(double x) {
 
 std::string check_step_options(const Options& opt, bool theta_used) {
   const auto fmt = short_number;
-  if (!(opt.t_end > 0.0) || !std::isfinite(opt.t_end))
-    return "t_end must be a finite number > 0 (got " + fmt(opt.t_end) + ")";
+  if (!(*opt.t_end > 0.0) || !std::isfinite(*opt.t_end))
+    return "t_end must be a finite number > 0 (got " + fmt(*opt.t_end) + ")";
   if (!(opt.h > 0.0) || !std::isfinite(opt.h))
     return "step h must be a finite number > 0 (got " + fmt(opt.h) + ")";
-  if (opt.t_end / opt.h > 1e9)
-    return "t_end / h = " + fmt(opt.t_end / opt.h) + " steps is more than 1e9";
+  if (*opt.t_end / opt.h > 1e9)
+    return "t_end / h = " + fmt(*opt.t_end / opt.h) + " steps is more than 1e9";
   if (theta_used && !(opt.theta >= 0.0 && opt.theta <= 1.0))
     return "theta must lie in [0, 1] (got " + fmt(opt.theta) + ")";
   return "";
 }
+
+namespace {}  // namespace
+
+// The methods themselves, on checked input (event_driven.cpp, time_stepping.cpp).
+Trajectory integrate_event_driven(const mech::Model& model, const VectorXd& x0, const Options& opt);
 
 namespace {
 
 class EventDrivenIntegrator : public Integrator {
  public:
   std::string name() const override { return "event"; }
-  Trajectory run(const mech::Model& model, const VectorXd& x0, const Options& opt) const override {
-    return simulate_event_driven(model, x0, opt);
+  Trajectory integrate(const mech::Model& model, const VectorXd& x0,
+                       const Options& opt) const override {
+    return integrate_event_driven(model, x0, opt);
   }
 };
 
@@ -98,6 +114,10 @@ Registry<Integrator>& integrators() {
     return reg;
   }();
   return r;
+}
+
+Trajectory simulate_event_driven(const mech::Model& model, const VectorXd& x0, const Options& opt) {
+  return EventDrivenIntegrator().run(model, x0, opt);
 }
 
 std::vector<std::string> integrator_names() { return integrators().names(); }

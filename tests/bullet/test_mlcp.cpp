@@ -2,9 +2,8 @@
 // against lcsim's principal pivoting on problems with a unique solution.
 #include <gtest/gtest.h>
 
-#include <random>
-
 #include <lcsim/bullet/bullet.hpp>
+#include <random>
 
 namespace lcsim::bullet {
 namespace {

@@ -13,7 +13,6 @@
 #include <urdf_model/model.h>
 
 #include <cstdio>
-
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
 

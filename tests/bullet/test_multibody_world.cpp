@@ -8,13 +8,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <stdexcept>
-#include <string>
-
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
 #include <lcsim/lcp/lcp.hpp>
 #include <lcsim/sim/sim.hpp>
+#include <stdexcept>
+#include <string>
 
 namespace lcsim::bullet {
 namespace {

@@ -3,13 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <stdexcept>
-#include <string>
-#include <vector>
-
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
 #include <lcsim/sim/sim.hpp>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace lcsim::bullet {
 namespace {
@@ -159,7 +158,7 @@ TEST(BulletWorld, InexpressibleModelsAreRefusedNamingTheConstraint) {
 TEST(BulletWorld, InfeasibleStartAndUnreproducibleSettingsAreReported) {
   mech::Model ball = load("ball.yaml");  // e = 0.5
   sim::Trajectory tr = bullet_run(ball, Eigen::Vector2d(-0.1, 0.0), 1e-3, 0.0);
-  EXPECT_EQ(tr.status, sim::RunStatus::kFailed);
+  EXPECT_EQ(tr.status, sim::RunStatus::kNumericalFailure);
   EXPECT_NE(tr.message.find("constraint 'ground' is violated at t = 0 (gap = -0.1)"),
             std::string::npos)
       << tr.message;

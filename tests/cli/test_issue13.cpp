@@ -5,12 +5,12 @@
 
 #include <filesystem>
 #include <fstream>
+#include <lcsim/io/impact_map.hpp>
+#include <lcsim/io/io.hpp>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
-#include <lcsim/io/impact_map.hpp>
-#include <lcsim/io/io.hpp>
 #include "support/run_lcsim.hpp"
 
 namespace {

@@ -6,11 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <lcsim/sim/sim.hpp>
 #include <numbers>
 #include <string>
 #include <unsupported/Eigen/MatrixFunctions>
-
-#include <lcsim/sim/sim.hpp>
 
 namespace lcsim {
 namespace {
@@ -168,7 +167,7 @@ TEST(Extremes, LargeModelsRefusedClearlyByDenseMethods) {
   for (int N : {1000, 10000}) {
     const mech::Model model = mech::chain_model({N, true, false, true});
     const auto tr = run(model, model.initial, 1.0);
-    EXPECT_EQ(tr.status, sim::RunStatus::kFailed);
+    EXPECT_EQ(tr.status, sim::RunStatus::kNumericalFailure);
     EXPECT_NE(tr.message.find("size " + std::to_string(2 * N + 1) + " > 1001"), std::string::npos)
         << tr.message;
     EXPECT_NE(tr.message.find("--method moreau-jean"), std::string::npos) << tr.message;
@@ -176,7 +175,7 @@ TEST(Extremes, LargeModelsRefusedClearlyByDenseMethods) {
     o.t_end = 1.0;
     o.h = 0.1;
     const auto be = sim::make_integrator("euler")->run(model, model.initial, o);
-    EXPECT_EQ(be.status, sim::RunStatus::kFailed);
+    EXPECT_EQ(be.status, sim::RunStatus::kNumericalFailure);
     EXPECT_NE(be.message.find("more than the 1001"), std::string::npos) << be.message;
   }
 }
@@ -279,7 +278,7 @@ TEST(Extremes, InfeasibleStartIsRefused) {
   m.E = MatrixXd::Identity(1, 1).sparseView();
   m.constraints = {"floor"};
   const auto tr = run(mechanical(m, "ball"), Eigen::Vector2d(-0.1, 0), 1.0);
-  EXPECT_EQ(tr.status, sim::RunStatus::kFailed);
+  EXPECT_EQ(tr.status, sim::RunStatus::kNumericalFailure);
   EXPECT_NE(tr.message.find("floor"), std::string::npos) << tr.message;
   EXPECT_NE(tr.message.find("-0.1"), std::string::npos) << tr.message;
   EXPECT_NE(tr.message.find("--project"), std::string::npos) << tr.message;

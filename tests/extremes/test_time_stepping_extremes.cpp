@@ -15,6 +15,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <lcsim/io/io.hpp>
+#include <lcsim/sim/sim.hpp>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <numbers>
@@ -22,8 +24,6 @@
 #include <string>
 #include <unsupported/Eigen/MatrixFunctions>
 
-#include <lcsim/io/io.hpp>
-#include <lcsim/sim/sim.hpp>
 #include "support/run_lcsim.hpp"
 
 namespace lcsim {
@@ -313,7 +313,7 @@ TEST_P(SimultaneousImpactsStepping, ChainStopsAtOnce) {
        {std::pair{kMj05, 1.01 * h / 2}, {kMj1, 1.01 * h}, {kEuler, 1e-9}}) {
     const auto tr = step(s, model, x0, 2.0, h);
     if (s.method[0] == 'e' && N == 1000) {
-      EXPECT_EQ(tr.status, sim::RunStatus::kFailed);
+      EXPECT_EQ(tr.status, sim::RunStatus::kNumericalFailure);
       EXPECT_NE(tr.message.find("more than the 1001"), std::string::npos) << tr.message;
       continue;
     }
@@ -481,7 +481,7 @@ TEST(SteppingExtremes, InfeasibleStartIsRefused) {
   b.constraints = {"floor"};
   for (const Scheme& s : {kMj05, kMj1, kEuler}) {
     const auto tr = step(s, wrap(b), Eigen::Vector2d(-0.1, 0), 1.0, 1e-3);
-    EXPECT_EQ(tr.status, sim::RunStatus::kFailed) << label(s);
+    EXPECT_EQ(tr.status, sim::RunStatus::kNumericalFailure) << label(s);
     EXPECT_NE(tr.message.find("floor"), std::string::npos) << label(s) << ": " << tr.message;
   }
 }

@@ -18,9 +18,9 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <lcsim/impact/impact.hpp>
 #include <random>
 
-#include <lcsim/impact/impact.hpp>
 #include "impact_test_util.hpp"
 
 namespace lcsim::impact {

@@ -9,10 +9,10 @@
 // velocities are checked to 1e-8 (the barrier leaves O(sqrt(mu)) errors).
 #include <gtest/gtest.h>
 
+#include <lcsim/impact/impact.hpp>
 #include <stdexcept>
 #include <tuple>
 
-#include <lcsim/impact/impact.hpp>
 #include "impact_test_util.hpp"
 
 namespace lcsim::impact {

@@ -2,10 +2,9 @@
 #pragma once
 
 #include <Eigen/Dense>
-#include <random>
-
 #include <lcsim/impact/impact.hpp>
 #include <lcsim/mech/mech.hpp>
+#include <random>
 
 namespace lcsim::impact::testing {
 

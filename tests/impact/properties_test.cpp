@@ -17,10 +17,10 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
-#include <random>
-
 #include <lcsim/impact/impact.hpp>
 #include <lcsim/ipopt/moreau_qp.hpp>
+#include <random>
+
 #include "impact_test_util.hpp"
 
 namespace lcsim::impact {

@@ -3,11 +3,10 @@
 // with the law, and every refused input named in its message.
 #include <gtest/gtest.h>
 
-#include <string>
-
 #include <lcsim/impact/impact.hpp>
 #include <lcsim/io/impact_map.hpp>
 #include <lcsim/io/io.hpp>
+#include <string>
 
 namespace lcsim::io {
 namespace {

@@ -6,10 +6,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <random>
-
 #include <lcsim/io/io.hpp>
 #include <lcsim/sim/sim.hpp>
+#include <random>
+
 #include "support/same_model.hpp"
 
 namespace lcsim {

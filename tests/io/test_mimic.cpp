@@ -6,9 +6,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <lcsim/io/io.hpp>
 #include <random>
 
-#include <lcsim/io/io.hpp>
 #include "support/same_model.hpp"
 
 namespace lcsim {

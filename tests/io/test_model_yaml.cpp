@@ -5,10 +5,10 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <lcsim/io/io.hpp>
 #include <string>
 #include <unsupported/Eigen/MatrixFunctions>
 
-#include <lcsim/io/io.hpp>
 #include "support/same_model.hpp"
 
 namespace lcsim::io {

@@ -4,12 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <string>
-#include <vector>
-
 #include <lcsim/io/io.hpp>
 #include <lcsim/io/sweep.hpp>
 #include <lcsim/sim/sim.hpp>
+#include <string>
+#include <vector>
 
 namespace lcsim::io {
 namespace {

@@ -4,10 +4,9 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <lcsim/io/io.hpp>
 #include <sstream>
 #include <string>
-
-#include <lcsim/io/io.hpp>
 
 namespace lcsim::io {
 namespace {
@@ -212,10 +211,10 @@ TEST(TrajectoryJson, RoundTrip) {
 TEST(TrajectoryJson, FailedRunAndLcsEnergies) {
   const mech::Model model = parse_model("lcs:\n  A: [[0]]\n  B: [[1]]\n  C: [[1]]\n", "lcs.yaml");
   sim::Trajectory tr;
-  tr.status = sim::RunStatus::kFailed;
+  tr.status = sim::RunStatus::kNumericalFailure;
   tr.message = "LCP ray termination at t = 0.5";
   const nlohmann::json j = trajectory_json(model, tr);
-  EXPECT_EQ(j["status"], "failed");
+  EXPECT_EQ(j["status"], "numerical failure");
   EXPECT_EQ(j["message"], "LCP ray termination at t = 0.5");
   EXPECT_TRUE(j["energy_initial"].is_null());  // no energy for a general LCS
   EXPECT_TRUE(j["events"].is_array());

@@ -2,10 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <lcsim/lcp/lcp.hpp>
 #include <limits>
 #include <stdexcept>
-
-#include <lcsim/lcp/lcp.hpp>
 
 namespace lcsim::lcp {
 namespace {

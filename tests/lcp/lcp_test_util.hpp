@@ -1,9 +1,8 @@
 // Random LCP generators for the LCP tests (fixed seeds, reproducible).
 #pragma once
 
-#include <random>
-
 #include <lcsim/lcp/lcp.hpp>
+#include <random>
 
 namespace lcsim::lcp::test {
 

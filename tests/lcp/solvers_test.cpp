@@ -2,10 +2,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <lcsim/lcp/lcp.hpp>
 #include <random>
 #include <vector>
 
-#include <lcsim/lcp/lcp.hpp>
 #include "lcp_test_util.hpp"
 
 namespace lcsim::lcp {

@@ -12,9 +12,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <stdexcept>
-
 #include <lcsim/lcs/lcs.hpp>
+#include <stdexcept>
 
 namespace lcsim::lcs {
 namespace {

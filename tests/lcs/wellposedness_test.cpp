@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
-
 #include <lcsim/lcs/lcs.hpp>
 
 namespace lcsim::lcs {

@@ -2,10 +2,9 @@
 // LDCP re-initialisation is Moreau's rule; §3.4.2 says it is P_I x0.
 #include <gtest/gtest.h>
 
-#include <random>
-
 #include <lcsim/lcs/lcs.hpp>
 #include <lcsim/mech/mech.hpp>
+#include <random>
 
 namespace lcsim::lcs {
 namespace {

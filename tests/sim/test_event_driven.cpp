@@ -9,12 +9,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <lcsim/io/io.hpp>
+#include <lcsim/sim/sim.hpp>
 #include <numbers>
 #include <random>
 #include <unsupported/Eigen/MatrixFunctions>
-
-#include <lcsim/io/io.hpp>
-#include <lcsim/sim/sim.hpp>
 
 namespace lcsim {
 namespace {

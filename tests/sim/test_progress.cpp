@@ -5,10 +5,9 @@
 // to T = 3: impact, constrained phase, release at pi/2, free motion.
 #include <gtest/gtest.h>
 
-#include <vector>
-
 #include <lcsim/mech/mech.hpp>
 #include <lcsim/sim/sim.hpp>
+#include <vector>
 
 namespace lcsim::sim {
 namespace {

@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <lcsim/sim/sim.hpp>
 
 namespace lcsim {

@@ -11,12 +11,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <lcsim/io/io.hpp>
+#include <lcsim/sim/sim.hpp>
 #include <numbers>
 #include <random>
 #include <unsupported/Eigen/MatrixFunctions>
-
-#include <lcsim/io/io.hpp>
-#include <lcsim/sim/sim.hpp>
 
 namespace lcsim {
 namespace {
@@ -212,7 +211,7 @@ TEST(TimeStepping, TripleIntegratorGuardAndBlowUp) {
   opt.h = 1e-2;
   const auto euler = sim::make_integrator("euler");
   const auto refused = euler->run(model, model.initial, opt);
-  EXPECT_EQ(refused.status, sim::RunStatus::kFailed);
+  EXPECT_EQ(refused.status, sim::RunStatus::kNumericalFailure);
   EXPECT_NE(refused.message.find("rho"), std::string::npos) << refused.message;
   EXPECT_NE(refused.message.find("7.3.3"), std::string::npos) << refused.message;
   EXPECT_TRUE(refused.final_state.allFinite());
@@ -239,14 +238,14 @@ TEST(TimeStepping, TripleIntegratorGuardAndBlowUp) {
 TEST(TimeStepping, FailuresAreReportedNotThrown) {
   const mech::Model lcs_model = load("triple_integrator.yaml");
   const auto tr = run("moreau-jean", lcs_model, lcs_model.initial, 1.0, 1e-2);
-  EXPECT_EQ(tr.status, sim::RunStatus::kFailed);
+  EXPECT_EQ(tr.status, sim::RunStatus::kNumericalFailure);
   EXPECT_NE(tr.message.find("mechanical"), std::string::npos);
   const mech::Model carts = load("two_carts.yaml");
   const auto bad_h = run("euler", carts, carts.initial, 1.0, -1.0);
-  EXPECT_EQ(bad_h.status, sim::RunStatus::kFailed);
+  EXPECT_EQ(bad_h.status, sim::RunStatus::kNumericalFailure);
   EXPECT_TRUE(bad_h.final_state.allFinite());
   const auto bad_theta = run("moreau-jean", carts, carts.initial, 1.0, 1e-2, 1.5);
-  EXPECT_EQ(bad_theta.status, sim::RunStatus::kFailed);
+  EXPECT_EQ(bad_theta.status, sim::RunStatus::kNumericalFailure);
 }
 
 // Output grid: with dt_out a multiple of h the samples fall on it exactly, and

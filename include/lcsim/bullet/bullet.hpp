@@ -18,11 +18,10 @@ std::string version_string();
 // Side-by-side runs (src/bullet/world.cpp), comparison (compare.cpp), MLCP
 // back-ends (mlcp.cpp). See docs/bullet-comparison.md for what was measured.
 #include <Eigen/Dense>
-#include <vector>
-
 #include <lcsim/lcp/lcp.hpp>
 #include <lcsim/mech/mech.hpp>
 #include <lcsim/sim/sim.hpp>
+#include <vector>
 
 namespace lcsim::bullet {
 

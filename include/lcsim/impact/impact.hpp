@@ -5,14 +5,13 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <lcsim/core/registry.hpp>
+#include <lcsim/lcp/lcp.hpp>
+#include <lcsim/mech/mech.hpp>
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <lcsim/core/registry.hpp>
-#include <lcsim/lcp/lcp.hpp>
-#include <lcsim/mech/mech.hpp>
 
 namespace lcsim::impact {
 

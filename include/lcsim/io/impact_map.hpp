@@ -17,11 +17,10 @@
 #pragma once
 
 #include <Eigen/Dense>
-#include <string>
-#include <vector>
-
 #include <lcsim/impact/impact.hpp>
 #include <lcsim/mech/mech.hpp>
+#include <string>
+#include <vector>
 
 namespace lcsim::io {
 

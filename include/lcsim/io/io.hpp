@@ -7,6 +7,8 @@
 
 #include <Eigen/Dense>
 #include <filesystem>
+#include <lcsim/mech/mech.hpp>
+#include <lcsim/sim/sim.hpp>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -14,9 +16,6 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <lcsim/mech/mech.hpp>
-#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::io {
 

@@ -8,12 +8,11 @@
 
 #include <Eigen/Dense>
 #include <functional>
+#include <lcsim/mech/mech.hpp>
+#include <lcsim/sim/sim.hpp>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <lcsim/mech/mech.hpp>
-#include <lcsim/sim/sim.hpp>
 
 namespace lcsim::io {
 

@@ -5,26 +5,24 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <lcsim/core/registry.hpp>
+#include <lcsim/core/status.hpp>
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <lcsim/core/registry.hpp>
 
 namespace lcsim::lcp {
 
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-enum class Status {
-  kSolved,            // a complementary solution within tolerance
-  kRayTermination,    // Lemke: secondary ray, no solution found (e.g. infeasible LCP)
-  kIterationLimit,    // iterative solver or pivot cap hit before convergence
-  kNumericalFailure,  // singular pivot, non-finite values, or residual check failed
-  kInvalidInput,      // dimensions disagree, empty or non-finite data
-};
-std::string_view to_string(Status s);
+// The one status vocabulary (include/lcsim/core/status.hpp); an LCP solve
+// uses kSolved, kRayTermination, kIterationLimit, kNumericalFailure (a
+// singular pivot, non-finite values, a failed residual test) and
+// kInvalidInput (dimensions disagree, empty or non-finite data).
+using lcsim::Status;
+using lcsim::to_string;
 
 struct Result {
   Status status = Status::kInvalidInput;
@@ -133,4 +131,3 @@ Result solve_scaled(const Solver& first, const MatrixXd& M, const VectorXd& q, c
                     int* attempts = nullptr, std::string* tried = nullptr);
 
 }  // namespace lcsim::lcp
-

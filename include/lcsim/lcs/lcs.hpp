@@ -11,10 +11,9 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <lcsim/lcp/lcp.hpp>
 #include <string>
 #include <vector>
-
-#include <lcsim/lcp/lcp.hpp>
 
 namespace lcsim::lcs {
 

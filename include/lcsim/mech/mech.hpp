@@ -7,12 +7,11 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
+#include <lcsim/lcs/lcs.hpp>
 #include <limits>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <lcsim/lcs/lcs.hpp>
 
 namespace lcsim::mech {
 

@@ -7,13 +7,14 @@
 
 #include <Eigen/Dense>
 #include <functional>
+#include <lcsim/core/status.hpp>
+#include <lcsim/impact/impact.hpp>
+#include <lcsim/mech/mech.hpp>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <lcsim/impact/impact.hpp>
-#include <lcsim/mech/mech.hpp>
 
 namespace lcsim::sim {
 
@@ -43,7 +44,12 @@ struct Event {
   std::string note;
 };
 
-enum class RunStatus { kCompleted, kFailed };
+struct Options;
+
+// A run ends kCompleted, kInvalidInput (nothing was integrated),
+// kNumericalFailure, kEventLimit or kInterrupted, with Trajectory::message
+// saying why and Trajectory::t_end the time reached.
+using RunStatus = lcsim::Status;
 
 struct Trajectory {
   std::string method;
@@ -65,13 +71,18 @@ struct Trajectory {
   int warnings = 0;
   std::vector<std::string> warning_messages;  // first few, for the report
   double wall_time_s = 0.0;
+  // Hands a recorded sample to opt.sample_sink when set (it is then not
+  // kept), else appends it to samples.
+  void record_sample(Sample s, const Options& opt);
   // Counts a warning; keeps the text of the first kMaxWarningMessages.
   void add_warning(std::string w);
   static constexpr std::size_t kMaxWarningMessages = 10;
 };
 
 struct Options {
-  double t_end = 1.0;   // horizon (s)
+  // Horizon (s). Unset: the model's t_end (its scenario); a run with
+  // neither is invalid input.
+  std::optional<double> t_end;
   double dt_out = 0.0;  // output grid (s); 0 = events only (plus start and end)
   double h = 1e-3;      // time step of time-stepping methods (s)
   double theta = 0.5;   // Moreau–Jean theta
@@ -104,6 +115,11 @@ struct Options {
   double accumulation_dt = 1e-10;
   double accumulation_tail = 1e-6;
   bool record_samples = true;
+  // When set, every recorded sample is passed here instead of being kept in
+  // Trajectory::samples, in time order (a writer streams them to disk, so a
+  // long run's output never has to fit in memory). Called on the thread that
+  // runs the integrator; it must not throw.
+  std::function<void(const Sample&)> sample_sink;
   // Progress of a long run: when set, called with the time reached, every
   // kProgressSteps steps of a time-stepping method and once per sampling step
   // of the event-driven method's event search (at least once per phase;
@@ -130,8 +146,15 @@ class Integrator {
  public:
   virtual ~Integrator() = default;
   virtual std::string name() const = 0;
-  virtual Trajectory run(const mech::Model& model, const VectorXd& x0,
-                         const Options& opt) const = 0;
+  // Checks the model, x0 and opt, then integrates. Invalid input never
+  // reaches the method: it gives a trajectory with status kInvalidInput and
+  // a message naming the field and the value.
+  Trajectory run(const mech::Model& model, const VectorXd& x0, const Options& opt) const;
+
+ protected:
+  // The method itself, on input that run() has checked.
+  virtual Trajectory integrate(const mech::Model& model, const VectorXd& x0,
+                               const Options& opt) const = 0;
 };
 // The integrators by name: "event", "euler", "moreau-jean", and "bullet" in
 // programs that link the component lcsim::bullet.
@@ -181,4 +204,3 @@ std::string short_number(double x);
 Trajectory simulate_event_driven(const mech::Model& model, const VectorXd& x0, const Options& opt);
 
 }  // namespace lcsim::sim
-
