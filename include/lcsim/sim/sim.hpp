@@ -115,6 +115,11 @@ struct Options {
   double accumulation_dt = 1e-10;
   double accumulation_tail = 1e-6;
   bool record_samples = true;
+  // A run whose recorded samples would take more than this many bytes (an
+  // estimate from the horizon, dt_out or h, and the state and constraint
+  // sizes) is refused before it starts (kInvalidInput), naming dt_out or h;
+  // a sample_sink that streams to disk counts too.
+  double max_output_bytes = 1e9;
   // When set, every recorded sample is passed here instead of being kept in
   // Trajectory::samples, in time order (a writer streams them to disk, so a
   // long run's output never has to fit in memory). Called on the thread that
