@@ -399,6 +399,11 @@ namespace {
 class BulletIntegrator : public sim::Integrator {
  public:
   std::string name() const override { return "bullet"; }
+  sim::OptionsUsed options_used() const override {
+    sim::OptionsUsed u;  // Bullet's own contact solver and restitution
+    u.h = true;
+    return u;
+  }
   sim::Trajectory integrate(const mech::Model& model, const VectorXd& x0,
                             const sim::Options& opt) const override {
     return simulate_bullet(model, x0, opt);

@@ -182,60 +182,6 @@ std::vector<std::string> names(const YAML::Node& n, Eigen::Index size, const std
   return out;
 }
 
-// Up to this many coordinates M is checked densely, with its eigenvalues in
-// the message; above it by a sparse LDL' factorisation (O(nnz) for banded M).
-constexpr Eigen::Index kDenseMassCheckMax = 1000;
-
-// M symmetric (relative tolerance 1e-12 of its largest entry) and positive
-// definite. Dense: Cholesky succeeds and the smallest eigenvalue is not
-// negligible against the largest (N * eps relative), so a numerically
-// singular M whose Cholesky squeaks through on rounding is refused as well.
-// Sparse: the pivots of LDL' are all positive and the smallest is not
-// negligible against the largest (the same N * eps).
-void check_mass_matrix(const mech::SparseMatrix& M, const std::string& source) {
-  double scale = 0.0;
-  for (Eigen::Index j = 0; j < M.outerSize(); ++j)
-    for (mech::SparseMatrix::InnerIterator it(M, j); it; ++it)
-      scale = std::max(scale, std::abs(it.value()));
-  for (Eigen::Index j = 0; j < M.outerSize(); ++j)
-    for (mech::SparseMatrix::InnerIterator it(M, j); it; ++it) {
-      const Eigen::Index i = it.row();
-      if (std::abs(it.value() - M.coeff(j, i)) > 1e-12 * scale) {
-        const Eigen::Index a = std::min(i, j), b = std::max(i, j);
-        fail(source, "mechanical.M",
-             "not symmetric (M[" + std::to_string(a) + "][" + std::to_string(b) +
-                 "] = " + format_number(M.coeff(a, b)) + " but M[" + std::to_string(b) + "][" +
-                 std::to_string(a) + "] = " + format_number(M.coeff(b, a)) + ")");
-      }
-    }
-  const double eps = std::numeric_limits<double>::epsilon();
-  const double rel = static_cast<double>(M.rows()) * eps;
-  // Computed values, not input: 6 digits read better than 17.
-  char buf[128];
-  if (M.rows() <= kDenseMassCheckMax) {
-    const MatrixXd Md = M.toDense();
-    const MatrixXd S = 0.5 * (Md + Md.transpose());
-    const Eigen::LLT<MatrixXd> llt(S);
-    const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<MatrixXd>(S).eigenvalues();
-    if (llt.info() != Eigen::Success || ev.minCoeff() <= rel * std::abs(ev.maxCoeff())) {
-      std::snprintf(buf, sizeof buf, "smallest eigenvalue %.6g, largest %.6g", ev.minCoeff(),
-                    ev.maxCoeff());
-      fail(source, "mechanical.M", "not positive definite (" + std::string(buf) + ")");
-    }
-    return;
-  }
-  const Eigen::SimplicialLDLT<mech::SparseMatrix> ldlt(M);
-  const VectorXd d = ldlt.info() == Eigen::Success ? ldlt.vectorD() : VectorXd();
-  if (d.size() == 0 || !d.allFinite() || d.minCoeff() <= rel * d.cwiseAbs().maxCoeff()) {
-    if (d.size() == 0)
-      std::snprintf(buf, sizeof buf, "its LDL' factorisation failed");
-    else
-      std::snprintf(buf, sizeof buf, "smallest LDL' pivot %.6g, largest %.6g", d.minCoeff(),
-                    d.maxCoeff());
-    fail(source, "mechanical.M", "not positive definite (" + std::string(buf) + ")");
-  }
-}
-
 mech::MechanicalModel parse_mechanical(const YAML::Node& node, const std::string& source) {
   const Keys keys =
       mapping(node, source, "mechanical",
@@ -249,7 +195,6 @@ mech::MechanicalModel parse_mechanical(const YAML::Node& node, const std::string
   if (m.M.rows() != m.M.cols())
     fail(source, "mechanical.M", "expected a square matrix (got " + dims(m.M) + ")");
   const Eigen::Index N = m.M.rows();
-  check_mass_matrix(m.M, source);
   const std::string nn = "(N = " + std::to_string(N) + " coordinates, from M)";
   if (has("D")) {
     m.D = sparse_matrix(keys.at("D"), source, "mechanical.D", N);
@@ -279,10 +224,6 @@ mech::MechanicalModel parse_mechanical(const YAML::Node& node, const std::string
   if (has("restitution")) {
     m.restitution = vector(keys.at("restitution"), source, "mechanical.restitution");
     expect_size(m.restitution, k, source, "mechanical.restitution", kk);
-    for (Eigen::Index i = 0; i < k; ++i)
-      if (m.restitution(i) < 0.0 || m.restitution(i) > 1.0)
-        fail(source, "mechanical.restitution[" + std::to_string(i) + "]",
-             "outside [0, 1] (got " + format_number(m.restitution(i)) + ")");
   }
   if (has("coordinates"))
     m.coordinates = names(keys.at("coordinates"), N, source, "mechanical.coordinates", nn);
@@ -291,17 +232,9 @@ mech::MechanicalModel parse_mechanical(const YAML::Node& node, const std::string
   // fill_defaults leaves the zero-row E alone and sizes g and restitution to
   // k, so a model without constraints (E omitted or []) is complete as well.
   mech::fill_defaults(m);
-  // A zero row of E is the constraint 0 q + g >= 0: it never acts (g >= 0) or
-  // is never satisfiable (g < 0), and its multiplier has no leading index
-  // (no derivative of E_i q depends on u). Refused here rather than at t = 0.
-  if (k > 0) {
-    const Eigen::VectorXd row_norms = (m.E.cwiseAbs() * Eigen::VectorXd::Ones(N)).eval();
-    for (int i = 0; i < k; ++i)
-      if (!(row_norms(i) > 0.0))
-        fail(source, "mechanical.E[" + std::to_string(i) + "]",
-             "constraint '" + m.constraints[i] +
-                 "' has an all-zero row (it constrains no coordinate)");
-  }
+  // What the file's structure did not already refuse: M symmetric positive
+  // definite, restitution in [0, 1], finite entries, no all-zero row of E.
+  if (auto p = mech::check_mechanical(m)) fail(source, p->field, p->what);
   return m;
 }
 

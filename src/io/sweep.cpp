@@ -135,6 +135,7 @@ double timed(const sim::Integrator& integ, const mech::Model& model, const Eigen
   opt.record_samples = false;
   opt.dt_out = 0.0;
   std::vector<double> times;
+  opt = sim::keep_used(opt, integ.options_used());
   for (int r = 0; r < repeat; ++r) times.push_back(integ.run(model, x0, opt).wall_time_s);
   return median(times);
 }
@@ -177,7 +178,7 @@ SweepRow stepping_row(const std::string& method, const sim::Integrator& integ, d
   opt.h = h;
   // Comparison grid: a multiple of h, at most ~2000 points.
   opt.dt_out = std::max(1.0, std::round(o.base.t_end.value_or(model.t_end) / (2000.0 * h))) * h;
-  const sim::Trajectory tr = integ.run(model, x0, opt);
+  const sim::Trajectory tr = integ.run(model, x0, sim::keep_used(opt, integ.options_used()));
   r.status = status_of(tr);
   r.warnings = tr.warnings;
   r.first_warning = first_of(tr);
@@ -255,11 +256,13 @@ ReferenceLaw reference_law(const std::string& method, const std::string& impact,
 
 sim::Trajectory run_reference(const mech::Model& model, const Eigen::VectorXd& x0,
                               const ReferenceLaw& law, sim::Options opt) {
+  const auto event = sim::make_integrator("event");
+  opt = sim::keep_used(opt, event->options_used());
   opt.impact = law.law;
-  if (!law.inelastic) return sim::make_integrator("event")->run(model, x0, opt);
+  if (!law.inelastic) return event->run(model, x0, opt);
   mech::Model m = model;
   m.mechanical->restitution.setZero();
-  return sim::make_integrator("event")->run(m, x0, opt);
+  return event->run(m, x0, opt);
 }
 
 bool SweepResult::reference_failed() const {

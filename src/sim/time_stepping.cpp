@@ -803,6 +803,11 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
 class EulerIntegrator : public Integrator {
  public:
   std::string name() const override { return "euler"; }
+  OptionsUsed options_used() const override {
+    OptionsUsed u;  // every impact inelastic: Options::impact is not read
+    u.h = u.lcp_solver = u.force = true;
+    return u;
+  }
   Trajectory integrate(const mech::Model& model, const VectorXd& x0,
                        const Options& opt) const override {
     return run_euler(model, x0, opt);
@@ -812,6 +817,11 @@ class EulerIntegrator : public Integrator {
 class MoreauJeanIntegrator : public Integrator {
  public:
   std::string name() const override { return "moreau-jean"; }
+  OptionsUsed options_used() const override {
+    OptionsUsed u;  // its impact law is restitution inside the step LCP
+    u.h = u.theta = u.lcp_solver = u.linear_algebra = true;
+    return u;
+  }
   Trajectory integrate(const mech::Model& model, const VectorXd& x0,
                        const Options& opt) const override {
     return run_moreau_jean(model, x0, opt);

@@ -23,10 +23,6 @@ std::string_view to_string(EventType t) {
   return "unknown";
 }
 
-Trajectory Integrator::run(const mech::Model& model, const VectorXd& x0, const Options& opt) const {
-  return integrate(model, x0, opt);
-}
-
 void Trajectory::record_sample(Sample s, const Options& opt) {
   if (opt.sample_sink)
     opt.sample_sink(s);
@@ -92,6 +88,11 @@ namespace {
 class EventDrivenIntegrator : public Integrator {
  public:
   std::string name() const override { return "event"; }
+  OptionsUsed options_used() const override {
+    OptionsUsed u;
+    u.impact = u.lcp_solver = u.event_search = true;
+    return u;
+  }
   Trajectory integrate(const mech::Model& model, const VectorXd& x0,
                        const Options& opt) const override {
     return integrate_event_driven(model, x0, opt);

@@ -100,6 +100,23 @@ struct Model {
   lcs::Lcs as_lcs() const;
 };
 
+// What is wrong with a model: the field as the model file names it
+// ("mechanical.M", "mechanical.E[1]", "lcs.B", "initial[2]") and what.
+struct ModelProblem {
+  std::string field;
+  std::string what;
+};
+// The one check of a model, whether built in code or read from a file (the
+// loaders put the file name in front): sizes that agree, finite entries, M
+// symmetric (1e-12 relative) and positive definite (its smallest eigenvalue,
+// or LDL' pivot above 64 coordinates, above N eps of the largest),
+// restitution in [0, 1], no all-zero row of E, an initial state of the right
+// size and a finite t_end > 0 when set. nullopt when usable.
+std::optional<ModelProblem> check_model(const Model& model);
+std::optional<ModelProblem> check_mechanical(const MechanicalModel& m);
+std::optional<ModelProblem> check_lcs(const lcs::Lcs& s);
+std::optional<ModelProblem> check_mass_matrix(const SparseMatrix& M);
+
 }  // namespace lcsim::mech
 
 namespace lcsim::mech {

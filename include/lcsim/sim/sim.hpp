@@ -54,8 +54,8 @@ using RunStatus = lcsim::Status;
 struct Trajectory {
   std::string method;
   RunStatus status = RunStatus::kCompleted;
-  std::string message;  // why it failed, or "" when completed
-  double t_end = 0.0;
+  std::string message;           // why it failed, or "" when completed
+  double t_end = 0.0;            // the time reached (the horizon when completed)
   std::vector<Sample> samples;   // at a jump two samples share t (before, after)
   std::vector<Event> events;     // the first Options::max_recorded_events of them
   long events_not_recorded = 0;  // events past that cap: counted, not kept
@@ -147,13 +147,30 @@ struct Options {
   int pivot_max_active = 32;
 };
 
+// What a method reads from Options besides what every method reads (t_end,
+// dt_out, record_samples, sample_sink, progress, max_output_bytes). An
+// option a method does not read must stay at its default: Integrator::run
+// refuses a changed one rather than ignore it silently.
+struct OptionsUsed {
+  bool h = false;               // the time step
+  bool theta = false;           // Moreau–Jean's theta
+  bool impact = false;          // the impact law
+  bool lcp_solver = false;      // the LCP solver
+  bool event_search = false;    // event_time_tol, max_events*, livelock_events, accumulation_*
+  bool force = false;           // backward Euler's consistency override
+  bool linear_algebra = false;  // sparse_dofs_threshold, pivot_max_active
+};
+
 class Integrator {
  public:
   virtual ~Integrator() = default;
   virtual std::string name() const = 0;
-  // Checks the model, x0 and opt, then integrates. Invalid input never
-  // reaches the method: it gives a trajectory with status kInvalidInput and
-  // a message naming the field and the value.
+  // The options this method reads (see OptionsUsed).
+  virtual OptionsUsed options_used() const = 0;
+  // Checks the model, x0 and opt (check_run), then integrates. Invalid input
+  // never reaches the method: it gives a trajectory with status kInvalidInput
+  // and a message naming the field and the value. An unset opt.t_end is the
+  // model's.
   Trajectory run(const mech::Model& model, const VectorXd& x0, const Options& opt) const;
 
  protected:
@@ -167,6 +184,30 @@ Registry<Integrator>& integrators();
 // Throws std::invalid_argument naming the unknown method and the known ones.
 std::unique_ptr<Integrator> make_integrator(std::string_view name);
 std::vector<std::string> integrator_names();
+
+// The one check of a run's input, used by Integrator::run (and so by the
+// CLI and the Python module): the model (mech::check_model), x0 (size,
+// finite), opt.t_end (finite > 0; run() fills it from the model), dt_out,
+// the options `used` reads (h > 0 and at most 1e9 steps, theta in (0, 1],
+// known impact law and LCP solver, event-search limits) and those it does
+// not (each at its default), an admissible start (infeasible_start) and the
+// output limit (max_output_bytes, from an estimate of the samples recorded).
+// "" when usable, else one line naming the field and the value.
+std::string check_run(const mech::Model& model, const VectorXd& x0, const Options& opt,
+                      std::string_view method, const OptionsUsed& used);
+
+// `opt` with the options that `used` does not read reset to their defaults:
+// one set of options applied to several methods (a sweep, a study) keeps for
+// each what it reads.
+Options keep_used(const Options& opt, const OptionsUsed& used);
+
+// The run of `method` ("event" by default) from x0, or from the model's
+// initial state when x0 is empty; unknown names and a missing initial state
+// give status kInvalidInput like any other bad input.
+Trajectory simulate(const mech::Model& model, const VectorXd& x0, const Options& opt = {},
+                    std::string_view method = "event");
+Trajectory simulate(const mech::Model& model, const Options& opt = {},
+                    std::string_view method = "event");
 
 // Empty if the initial state x0 (q then v) satisfies E q0 + g >= 0 up to
 // rounding (a gap below -(1e-9 (|E| |q0| + |g|) + 1e-13) counts, the zero test

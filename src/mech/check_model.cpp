@@ -1,0 +1,201 @@
+// The one check of a model built in code or read from a file: sizes that
+// agree, finite entries, M symmetric positive definite, restitution in
+// [0, 1], no all-zero constraint row. The loaders (src/io) report a problem
+// with the file's name in front; a run (sim::check_run) with the model's.
+#include <Eigen/SparseCholesky>
+#include <cmath>
+#include <cstdio>
+#include <lcsim/mech/mech.hpp>
+#include <limits>
+#include <string>
+
+namespace lcsim::mech {
+
+namespace {
+
+std::string num(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
+}
+
+std::string dims(Eigen::Index r, Eigen::Index c) {
+  return std::to_string(r) + " x " + std::to_string(c);
+}
+
+// The first non-finite entry of a sparse or dense matrix, as "[i][j] = v".
+template <class Mat>
+std::optional<std::string> non_finite(const Mat& A) {
+  if constexpr (std::is_same_v<Mat, SparseMatrix>) {
+    for (Eigen::Index j = 0; j < A.outerSize(); ++j)
+      for (SparseMatrix::InnerIterator it(A, j); it; ++it)
+        if (!std::isfinite(it.value()))
+          return "[" + std::to_string(it.row()) + "][" + std::to_string(it.col()) +
+                 "] = " + num(it.value());
+  } else {
+    for (Eigen::Index i = 0; i < A.rows(); ++i)
+      for (Eigen::Index j = 0; j < A.cols(); ++j)
+        if (!std::isfinite(A(i, j)))
+          return "[" + std::to_string(i) + "][" + std::to_string(j) + "] = " + num(A(i, j));
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> non_finite_vector(const VectorXd& v) {
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (!std::isfinite(v(i))) return "[" + std::to_string(i) + "] = " + num(v(i));
+  return std::nullopt;
+}
+
+// Up to this many coordinates M is checked densely, with its eigenvalues in
+// the message; above it by a sparse LDL' factorisation (O(nnz) for banded M),
+// cheap enough for every run to repeat (Integrator::run checks the model).
+constexpr Eigen::Index kDenseMassCheckMax = 64;
+
+}  // namespace
+
+std::optional<ModelProblem> check_mass_matrix(const SparseMatrix& M) {
+  double scale = 0.0;
+  for (Eigen::Index j = 0; j < M.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(M, j); it; ++it)
+      scale = std::max(scale, std::abs(it.value()));
+  for (Eigen::Index j = 0; j < M.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(M, j); it; ++it) {
+      const Eigen::Index i = it.row();
+      if (std::abs(it.value() - M.coeff(j, i)) > 1e-12 * scale) {
+        const Eigen::Index a = std::min(i, j), b = std::max(i, j);
+        return ModelProblem{"mechanical.M",
+                            "not symmetric (M[" + std::to_string(a) + "][" + std::to_string(b) +
+                                "] = " + num(M.coeff(a, b)) + " but M[" + std::to_string(b) + "][" +
+                                std::to_string(a) + "] = " + num(M.coeff(b, a)) + ")"};
+      }
+    }
+  const double rel = static_cast<double>(M.rows()) * std::numeric_limits<double>::epsilon();
+  if (M.rows() <= kDenseMassCheckMax) {
+    const MatrixXd Md = M.toDense();
+    const MatrixXd S = 0.5 * (Md + Md.transpose());
+    const Eigen::LLT<MatrixXd> llt(S);
+    const VectorXd ev = Eigen::SelfAdjointEigenSolver<MatrixXd>(S).eigenvalues();
+    if (llt.info() != Eigen::Success || ev.minCoeff() <= rel * std::abs(ev.maxCoeff()))
+      return ModelProblem{"mechanical.M", "not positive definite (smallest eigenvalue " +
+                                              num(ev.minCoeff()) + ", largest " +
+                                              num(ev.maxCoeff()) + ")"};
+    return std::nullopt;
+  }
+  const Eigen::SimplicialLDLT<SparseMatrix> ldlt(M);
+  const VectorXd d = ldlt.info() == Eigen::Success ? ldlt.vectorD() : VectorXd();
+  if (d.size() == 0 || !d.allFinite() || d.minCoeff() <= rel * d.cwiseAbs().maxCoeff())
+    return ModelProblem{"mechanical.M",
+                        d.size() == 0
+                            ? "not positive definite (its LDL' factorisation failed)"
+                            : "not positive definite (smallest LDL' pivot " + num(d.minCoeff()) +
+                                  ", largest " + num(d.maxCoeff()) + ")"};
+  return std::nullopt;
+}
+
+std::optional<ModelProblem> check_mechanical(const MechanicalModel& m) {
+  const Eigen::Index N = m.M.rows(), k = m.E.rows();
+  if (N == 0) return ModelProblem{"mechanical.M", "empty (a model needs at least one coordinate)"};
+  if (m.M.cols() != N)
+    return ModelProblem{"mechanical.M",
+                        "expected a square matrix (got " + dims(N, m.M.cols()) + ")"};
+  const std::string nn = " (N = " + std::to_string(N) + " coordinates, from M)";
+  const std::string kk = " (k = " + std::to_string(k) + " constraints, from the rows of E)";
+  auto square = [&](const SparseMatrix& A, const char* field) -> std::optional<ModelProblem> {
+    if (A.rows() != N || A.cols() != N)
+      return ModelProblem{
+          field, "expected " + dims(N, N) + nn + " (got " + dims(A.rows(), A.cols()) + ")"};
+    return std::nullopt;
+  };
+  if (auto p = square(m.D, "mechanical.D")) return p;
+  if (auto p = square(m.K, "mechanical.K")) return p;
+  if (m.E.cols() != N)
+    return ModelProblem{"mechanical.E", "expected " + std::to_string(N) + " columns" + nn +
+                                            " (got " + dims(k, m.E.cols()) + ")"};
+  auto sized = [&](const VectorXd& v, Eigen::Index n, const char* field,
+                   const std::string& why) -> std::optional<ModelProblem> {
+    if (v.size() != n)
+      return ModelProblem{field, "expected " + std::to_string(n) + " entries" + why + " (got " +
+                                     std::to_string(v.size()) + ")"};
+    return std::nullopt;
+  };
+  if (auto p = sized(m.g, k, "mechanical.g", kk)) return p;
+  if (auto p = sized(m.f, N, "mechanical.f", nn)) return p;
+  if (auto p = sized(m.restitution, k, "mechanical.restitution", kk)) return p;
+  if (static_cast<Eigen::Index>(m.coordinates.size()) != N)
+    return ModelProblem{"mechanical.coordinates", "expected " + std::to_string(N) + " names" + nn +
+                                                      " (got " +
+                                                      std::to_string(m.coordinates.size()) + ")"};
+  if (static_cast<Eigen::Index>(m.constraints.size()) != k)
+    return ModelProblem{"mechanical.constraints", "expected " + std::to_string(k) + " names" + kk +
+                                                      " (got " +
+                                                      std::to_string(m.constraints.size()) + ")"};
+  const std::pair<const SparseMatrix*, const char*> mats[] = {{&m.M, "mechanical.M"},
+                                                              {&m.D, "mechanical.D"},
+                                                              {&m.K, "mechanical.K"},
+                                                              {&m.E, "mechanical.E"}};
+  for (const auto& [A, field] : mats)
+    if (auto at = non_finite(*A)) return ModelProblem{field + *at, "not finite"};
+  const std::pair<const VectorXd*, const char*> vecs[] = {
+      {&m.g, "mechanical.g"}, {&m.f, "mechanical.f"}, {&m.restitution, "mechanical.restitution"}};
+  for (const auto& [v, field] : vecs)
+    if (auto at = non_finite_vector(*v)) return ModelProblem{field + *at, "not finite"};
+  if (auto p = check_mass_matrix(m.M)) return p;
+  for (Eigen::Index i = 0; i < k; ++i)
+    if (m.restitution(i) < 0.0 || m.restitution(i) > 1.0)
+      return ModelProblem{"mechanical.restitution[" + std::to_string(i) + "]",
+                          "outside [0, 1] (got " + num(m.restitution(i)) + ")"};
+  // A zero row of E is the constraint 0 q + g >= 0: it never acts (g >= 0) or
+  // is never satisfiable (g < 0), and its multiplier has no leading index.
+  if (k > 0) {
+    const VectorXd row_norms = m.E.cwiseAbs() * VectorXd::Ones(N);
+    for (Eigen::Index i = 0; i < k; ++i)
+      if (!(row_norms(i) > 0.0))
+        return ModelProblem{"mechanical.E[" + std::to_string(i) + "]",
+                            "constraint '" + m.constraints[i] +
+                                "' has an all-zero row (it constrains no coordinate)"};
+  }
+  return std::nullopt;
+}
+
+std::optional<ModelProblem> check_lcs(const lcs::Lcs& s) {
+  const Eigen::Index n = s.A.rows(), k = s.B.cols();
+  if (n == 0) return ModelProblem{"lcs.A", "empty (an LCS needs at least one state)"};
+  if (s.A.cols() != n)
+    return ModelProblem{"lcs.A", "expected a square matrix (got " + dims(n, s.A.cols()) + ")"};
+  if (s.B.rows() != n)
+    return ModelProblem{
+        "lcs.B", "expected " + std::to_string(n) + " rows (got " + dims(s.B.rows(), k) + ")"};
+  if (s.C.rows() != k || s.C.cols() != n)
+    return ModelProblem{"lcs.C",
+                        "expected " + dims(k, n) + " (got " + dims(s.C.rows(), s.C.cols()) + ")"};
+  if (s.D.rows() != k || s.D.cols() != k)
+    return ModelProblem{"lcs.D",
+                        "expected " + dims(k, k) + " (got " + dims(s.D.rows(), s.D.cols()) + ")"};
+  const std::pair<const MatrixXd*, const char*> mats[] = {
+      {&s.A, "lcs.A"}, {&s.B, "lcs.B"}, {&s.C, "lcs.C"}, {&s.D, "lcs.D"}};
+  for (const auto& [A, field] : mats)
+    if (auto at = non_finite(*A)) return ModelProblem{field + *at, "not finite"};
+  return std::nullopt;
+}
+
+std::optional<ModelProblem> check_model(const Model& model) {
+  if (model.mechanical.has_value() == model.lcs.has_value())
+    return ModelProblem{"model", model.mechanical ? "holds both a mechanical model and an LCS"
+                                                  : "holds neither a mechanical model nor an LCS"};
+  auto p = model.mechanical ? check_mechanical(*model.mechanical) : check_lcs(*model.lcs);
+  if (p) return p;
+  if (model.initial.size() > 0) {
+    if (model.initial.size() != model.state_size())
+      return ModelProblem{"initial", "expected " + std::to_string(model.state_size()) +
+                                         " entries (got " + std::to_string(model.initial.size()) +
+                                         ")"};
+    if (auto at = non_finite_vector(model.initial))
+      return ModelProblem{"initial" + *at, "not finite"};
+  }
+  if (!std::isnan(model.t_end) && !(model.t_end > 0.0 && std::isfinite(model.t_end)))
+    return ModelProblem{"t_end", "must be a finite number > 0 (got " + num(model.t_end) + ")"};
+  return std::nullopt;
+}
+
+}  // namespace lcsim::mech

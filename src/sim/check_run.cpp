@@ -1,0 +1,149 @@
+// The one check of a run's input (sim::check_run): whatever calls an
+// integrator — the CLI, the Python module, a study, a user's program — goes
+// through Integrator::run and so through this.
+#include <cmath>
+#include <lcsim/impact/impact.hpp>
+#include <lcsim/lcp/lcp.hpp>
+#include <lcsim/sim/sim.hpp>
+#include <string>
+
+namespace lcsim::sim {
+
+namespace {
+
+const std::string& fmt_s(const std::string& s) { return s; }
+std::string fmt_s(double x) { return short_number(x); }
+std::string fmt_s(long x) { return std::to_string(x); }
+std::string fmt_s(int x) { return std::to_string(x); }
+std::string fmt_s(bool x) { return x ? "true" : "false"; }
+
+// Calls f(used, &Options::member, "member") for every option that some
+// method does not read (the groups of OptionsUsed).
+template <class F>
+void visit_method_options(const OptionsUsed& u, F&& f) {
+  f(u.h, &Options::h, "h");
+  f(u.theta, &Options::theta, "theta");
+  f(u.impact, &Options::impact, "impact");
+  f(u.lcp_solver, &Options::lcp_solver, "lcp_solver");
+  f(u.event_search, &Options::event_time_tol, "event_time_tol");
+  f(u.event_search, &Options::max_events_per_unit_time, "max_events_per_unit_time");
+  f(u.event_search, &Options::max_events, "max_events");
+  f(u.event_search, &Options::livelock_events, "livelock_events");
+  f(u.event_search, &Options::accumulation_dt, "accumulation_dt");
+  f(u.event_search, &Options::accumulation_tail, "accumulation_tail");
+  f(u.force, &Options::force, "force");
+  f(u.linear_algebra, &Options::sparse_dofs_threshold, "sparse_dofs_threshold");
+  f(u.linear_algebra, &Options::pivot_max_active, "pivot_max_active");
+}
+
+// "" when every option the method does not read is at its default.
+std::string ignored_options(const Options& opt, std::string_view method, const OptionsUsed& u) {
+  const Options defaults{};
+  std::string message;
+  visit_method_options(u, [&](bool used, auto member, const char* name) {
+    if (used || !message.empty() || opt.*member == defaults.*member) return;
+    message = "method '" + std::string(method) + "' does not use Options::" + name + " (got " +
+              fmt_s(opt.*member) + "); leave it at its default (" + fmt_s(defaults.*member) + ")";
+  });
+  return message;
+}
+
+bool finite_positive(double x) { return std::isfinite(x) && x > 0.0; }
+
+std::string check_values(const Options& opt, const OptionsUsed& u) {
+  const auto f = short_number;
+  const double T = *opt.t_end;
+  if (!finite_positive(T)) return "t_end must be a finite number > 0 (got " + f(T) + ")";
+  if (!(std::isfinite(opt.dt_out) && opt.dt_out >= 0.0))
+    return "dt_out must be a finite number >= 0 (got " + f(opt.dt_out) + ")";
+  if (!(opt.max_output_bytes > 0.0))
+    return "max_output_bytes must be > 0 (got " + f(opt.max_output_bytes) + ")";
+  if (u.h) {
+    if (!finite_positive(opt.h)) return "step h must be a finite number > 0 (got " + f(opt.h) + ")";
+    if (T / opt.h > 1e9) return "t_end / h = " + f(T / opt.h) + " steps is more than 1e9 (raise h)";
+  }
+  if (u.theta && !(opt.theta > 0.0 && opt.theta <= 1.0))
+    return "theta must lie in (0, 1] (got " + f(opt.theta) + ")";
+  if (u.impact && !impact::laws().contains(opt.impact))
+    return impact::laws().unknown_message(opt.impact);
+  if (u.lcp_solver && !lcp::solvers().contains(opt.lcp_solver))
+    return lcp::solvers().unknown_message(opt.lcp_solver);
+  if (u.event_search) {
+    if (!(std::isfinite(opt.event_time_tol) && opt.event_time_tol >= 0.0))
+      return "event_time_tol must be a finite number >= 0 (got " + f(opt.event_time_tol) + ")";
+    if (!(opt.max_events_per_unit_time > 0.0))
+      return "max_events_per_unit_time must be > 0 (got " + f(opt.max_events_per_unit_time) + ")";
+    if (opt.max_events < 1) return "max_events must be >= 1 (got " + f(opt.max_events) + ")";
+    if (opt.max_recorded_events < 0)
+      return "max_recorded_events must be >= 0 (got " + f(opt.max_recorded_events) + ")";
+    if (opt.livelock_events < 2)
+      return "livelock_events must be >= 2 (got " + std::to_string(opt.livelock_events) + ")";
+    if (!(std::isfinite(opt.accumulation_dt) && opt.accumulation_dt >= 0.0))
+      return "accumulation_dt must be a finite number >= 0 (got " + f(opt.accumulation_dt) + ")";
+    if (!(std::isfinite(opt.accumulation_tail) && opt.accumulation_tail >= 0.0))
+      return "accumulation_tail must be a finite number >= 0 (got " + f(opt.accumulation_tail) +
+             ")";
+  }
+  if (u.linear_algebra && (opt.sparse_dofs_threshold < 0 || opt.pivot_max_active < 0))
+    return "sparse_dofs_threshold and pivot_max_active must be >= 0 (got " +
+           std::to_string(opt.sparse_dofs_threshold) + ", " + std::to_string(opt.pivot_max_active) +
+           ")";
+  return "";
+}
+
+// Samples a run records: on the dt_out grid, else every step of h; the
+// event-driven method without a grid records events only, bounded by
+// max_recorded_events. Each is costed as its CSV row, about 25 bytes per
+// number (17 significant digits, sign, exponent, separator), which is more
+// than the 8 bytes per number it takes in memory.
+std::string check_output_size(const mech::Model& model, const Options& opt, const OptionsUsed& u) {
+  if (!opt.record_samples && !opt.sample_sink) return "";
+  double samples = 0.0;
+  const char* knob = "dt_out";
+  if (opt.dt_out > 0.0)
+    samples = *opt.t_end / opt.dt_out + 2.0;
+  else if (u.h) {
+    samples = *opt.t_end / opt.h + 1.0;
+    knob = "dt_out (or h)";
+  } else
+    return "";
+  const double numbers = 1.0 + model.state_size() + 2.0 * model.num_constraints();
+  const double bytes = samples * numbers * 25.0;
+  if (bytes <= opt.max_output_bytes) return "";
+  return "the recorded output would be about " + short_number(bytes) + " bytes (" +
+         short_number(samples) + " samples of " + short_number(numbers) +
+         " numbers), more than max_output_bytes = " + short_number(opt.max_output_bytes) +
+         ": raise " + knob + ", or max_output_bytes";
+}
+
+}  // namespace
+
+Options keep_used(const Options& opt, const OptionsUsed& used) {
+  Options out = opt;
+  const Options defaults{};
+  visit_method_options(used, [&](bool u, auto member, const char*) {
+    if (!u) out.*member = defaults.*member;
+  });
+  return out;
+}
+
+std::string check_run(const mech::Model& model, const VectorXd& x0, const Options& opt,
+                      std::string_view method, const OptionsUsed& used) {
+  if (auto p = mech::check_model(model))
+    return "model '" + model.name + "': " + p->field + ": " + p->what;
+  const long n = model.state_size();
+  if (x0.size() != n)
+    return "initial state: expected " + std::to_string(n) + " entries (the model's state size) " +
+           "(got " + std::to_string(x0.size()) + ")";
+  for (Eigen::Index i = 0; i < x0.size(); ++i)
+    if (!std::isfinite(x0(i)))
+      return "initial state[" + std::to_string(i) + "]: not finite (got " + short_number(x0(i)) +
+             ")";
+  if (!opt.t_end) return "no horizon: set Options::t_end, or t_end in the model";
+  if (std::string m = check_values(opt, used); !m.empty()) return m;
+  if (std::string m = ignored_options(opt, method, used); !m.empty()) return m;
+  if (std::string m = infeasible_start(model, x0); !m.empty()) return m;
+  return check_output_size(model, opt, used);
+}
+
+}  // namespace lcsim::sim
