@@ -60,7 +60,10 @@ sim::Trajectory step(const Scheme& s, const mech::Model& model, const VectorXd& 
   o.h = h;
   o.theta = s.theta;
   o.record_samples = samples;
-  return sim::make_integrator(s.method)->run(model, x0, o);
+  // One option set for every scheme: each keeps what it reads (Euler has no
+  // theta, and the library refuses an option a method would ignore).
+  const auto integ = sim::make_integrator(s.method);
+  return integ->run(model, x0, sim::keep_used(o, integ->options_used()));
 }
 
 double maxabs(const VectorXd& x) { return x.cwiseAbs().maxCoeff(); }
