@@ -9,6 +9,11 @@ namespace lcsim::lcp::detail {
 // Scaled acceptance threshold tolerance * (1 + ||q||_inf) (see Options::tolerance).
 double acceptance(const VectorXd& q, const Options& opt);
 
+// Principal pivoting treats z_i or w_i as zero (not infeasible) down to
+// -kPivotZero * acceptance; the warm-started pivot (warm_pivot.cpp) measures
+// its margin in the same unit.
+constexpr double kPivotZero = 0.25;
+
 // Validates (M, q) and the options; "" when fine.
 std::string validate_all(const MatrixXd& M, const VectorXd& q, const Options& opt);
 

@@ -36,7 +36,7 @@ Result principal_pivoting(const MatrixXd& M, const VectorXd& q, const Options& o
   using Idx = Eigen::Matrix<int, Eigen::Dynamic, 1, Eigen::ColMajor, MaxK, 1>;
   const int k = static_cast<int>(q.size());
   const int cap = opt.max_pivots > 0 ? opt.max_pivots : (k <= 20 ? (1 << k) + 10 : 50 * k + 1000);
-  const double eps = 0.25 * detail::acceptance(q, opt);
+  const double eps = detail::kPivotZero * detail::acceptance(q, opt);
   const bool symmetric = is_symmetric(M);
 
   Idx in = Idx::Zero(k);  // in(i): z_i basic (w_i = 0)

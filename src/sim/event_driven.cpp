@@ -12,685 +12,24 @@
 // or an active multiplier u_i (i in I) turns negative: a root of a Bohl
 // function, bracketed on a sampling grid fine enough for its frequencies and
 // refined by Brent's method; grazing minima between samples are checked.
+//
+// This file holds the main loop (EventDriven::run: phases, sampling, root
+// finding, events) and the entry point; event_driven_detail.hpp lists the
+// other parts.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <lcsim/sim/sim.hpp>
 #include <limits>
-#include <map>
-#include <set>
 #include <sstream>
 #include <unsupported/Eigen/MatrixFunctions>
 
+#include "sim/brent.hpp"
+#include "sim/event_driven_detail.hpp"
+
 namespace lcsim::sim {
 
-namespace {
-
-using Eigen::MatrixXd;
-using Eigen::RowVectorXd;
-
-constexpr double kEps = std::numeric_limits<double>::epsilon();
-
-// Brent's method (Dekker–Brent zeroin) for a root of f in [a, b] with
-// f(a) f(b) <= 0. Returns the bracket end at which |f| is smallest once the
-// bracket is shorter than tol.
-template <class F>
-double brent_root(F&& f, double a, double b, double fa, double fb, double tol) {
-  if (fa == 0.0) return a;
-  if (fb == 0.0) return b;
-  double c = a, fc = fa, d = b - a, e = d;
-  for (int iter = 0; iter < 200; ++iter) {
-    if ((fb > 0) == (fc > 0)) {
-      c = a;
-      fc = fa;
-      d = e = b - a;
-    }
-    if (std::abs(fc) < std::abs(fb)) {
-      a = b;
-      b = c;
-      c = a;
-      fa = fb;
-      fb = fc;
-      fc = fa;
-    }
-    const double tol1 = 2.0 * kEps * std::abs(b) + 0.5 * tol;
-    const double xm = 0.5 * (c - b);
-    if (std::abs(xm) <= tol1 || fb == 0.0) return b;
-    if (std::abs(e) >= tol1 && std::abs(fa) > std::abs(fb)) {
-      double p, q, r;
-      const double s = fb / fa;
-      if (a == c) {
-        p = 2.0 * xm * s;
-        q = 1.0 - s;
-      } else {
-        q = fa / fc;
-        r = fb / fc;
-        p = s * (2.0 * xm * q * (q - r) - (b - a) * (r - 1.0));
-        q = (q - 1.0) * (r - 1.0) * (s - 1.0);
-      }
-      if (p > 0) q = -q;
-      p = std::abs(p);
-      if (2.0 * p < std::min(3.0 * xm * q - std::abs(tol1 * q), std::abs(e * q))) {
-        e = d;
-        d = p / q;
-      } else {
-        d = xm;
-        e = d;
-      }
-    } else {
-      d = xm;
-      e = d;
-    }
-    a = b;
-    fa = fb;
-    b += std::abs(d) > tol1 ? d : (xm > 0 ? tol1 : -tol1);
-    fb = f(b);
-  }
-  return b;
-}
-
-// The return to zero of phi on (a, b] when phi leaves zero upwards at a and
-// phi(b) = fb < 0: a positive point is searched for by halving towards a,
-// then the root is bracketed between it and b. If none is found down to
-// 2^-60 of the interval the opening is below resolution and a is returned.
-template <class F>
-double return_after_opening(F&& phi, double a, double b, double fb, double tol) {
-  for (int k = 1; k <= 60; ++k) {
-    const double tp = a + std::ldexp(b - a, -k);
-    if (!(tp > a)) break;
-    const double fp = phi(tp);
-    if (fp > 0.0) return brent_root(phi, tp, b, fp, fb, tol);
-  }
-  return a;
-}
-
-// An upper bound on the spectral radius, ||B^16||^(1/16) ||A|| with
-// B = A/||A|| (Gelfand's formula; 4 squarings, no eigen-decomposition).
-double spectral_radius_bound(const MatrixXd& A) {
-  const double a = A.cwiseAbs().rowwise().sum().maxCoeff();
-  if (a == 0.0) return 0.0;
-  MatrixXd B = A / a;
-  for (int i = 0; i < 4; ++i) B = (B * B).eval();
-  return std::pow(B.cwiseAbs().rowwise().sum().maxCoeff(), 1.0 / 16.0) * a;
-}
-
-struct Monitor {
-  RowVectorXd w;            // phi(t) = w x(t)
-  RowVectorXd wA;           // phi'(t) = w Acl x(t)
-  double scale = 0.0;       // |w| |x| scale for tolerances
-  int constraint = -1;      // which constraint
-  bool multiplier = false;  // true: u_i of an active constraint; false: free output y_i
-};
-
-struct Phase {
-  lcs::IndexSet mode;
-  MatrixXd Acl;  // closed-loop matrix
-  MatrixXd F;    // u_I = F x (|I| x n)
-  // Balanced coordinates z = x ./ D with Ab = D^{-1} Acl D (powers of 2):
-  // a stiff spring k makes Acl's entries span k and 1 while its frequencies
-  // are sqrt(k); exponentials of the balanced matrix keep the relative
-  // accuracy that the unbalanced one loses (gap errors of 1e-8 at k = 1e9).
-  VectorXd D;
-  MatrixXd Ab;
-  std::vector<Monitor> monitors;  // w, wA in balanced coordinates
-  double Ab_norm1 = 0.0;          // ||Ab||_1
-  // Above kDenseExpMax states, Ab by rows when at most a tenth of it is
-  // non-zero (a chain's closed loop is banded): products with vectors then
-  // cost O(nnz), not O(n^2).
-  Eigen::SparseMatrix<double, Eigen::RowMajor> Ab_sparse;
-  bool use_sparse = false;
-  VectorXd times(const VectorXd& x) const {
-    return use_sparse ? VectorXd(Ab_sparse * x) : VectorXd(Ab * x);
-  }
-  RowVectorXd row_times(const RowVectorXd& w) const {
-    return use_sparse ? RowVectorXd(w * Ab_sparse) : RowVectorXd(w * Ab);
-  }
-  double rho = 0.0;  // spectral_radius_bound(Ab)
-
-  // Up to this many states e^{Ab tau} is formed (Padé with scaling and
-  // squaring, O(n^3)) and, on a sampling grid, reused; above it only its
-  // action on a vector is computed (O(n^2) per term): a chain of 100 carts
-  // (n = 201) spent 70% of its run in dense exponentials.
-  static constexpr int kDenseExpMax = 64;
-  bool dense_exp() const { return Ab.rows() <= kDenseExpMax; }
-
-  // e^{Ab tau} z in balanced coordinates. Above kDenseExpMax: the Taylor
-  // series of the action in s = ceil(||Ab tau||_1) substeps, so each substep
-  // has ||Ab tau/s||_1 <= 1 and its series, truncated once two consecutive
-  // terms are below eps/4 of the partial sum, converges like 1/k! (at most
-  // ~20 terms); the error is that of the dense exponential's (both are
-  // backward stable for ||Ab tau/s|| <= 1; Al-Mohy & Higham 2011 choose s
-  // and the degree more finely).
-  VectorXd expv(double tau, const VectorXd& z) const {
-    if (dense_exp()) return (Ab * tau).exp() * z;
-    const double a = Ab_norm1 * std::abs(tau);
-    const long steps = std::max(1L, static_cast<long>(std::ceil(a)));
-    const double dt = tau / static_cast<double>(steps);
-    VectorXd y = z, term(z.size());
-    for (long st = 0; st < steps; ++st) {
-      term = y;
-      VectorXd sum = y;
-      double prev = term.cwiseAbs().maxCoeff();
-      for (int k = 1; k <= 60; ++k) {
-        term = times(term);
-        term *= dt / static_cast<double>(k);
-        sum += term;
-        const double cur = term.cwiseAbs().maxCoeff();
-        const double bound = 0.25 * kEps * sum.cwiseAbs().maxCoeff();
-        if (cur <= bound && prev <= bound) break;
-        prev = cur;
-      }
-      y = sum;
-    }
-    return y;
-  }
-  VectorXd exp_apply(double tau, const VectorXd& x) const {
-    return D.cwiseProduct(expv(tau, x.cwiseQuotient(D)));
-  }
-};
-
-// Diagonal balancing by powers of 2 (Parlett–Reinsch): D such that the
-// off-diagonal row and column norms of D^{-1} A D are comparable.
-VectorXd balancing(const MatrixXd& A) {
-  const int n = static_cast<int>(A.rows());
-  VectorXd d = VectorXd::Ones(n);
-  MatrixXd B = A;
-  for (int sweep = 0; sweep < 50; ++sweep) {
-    bool changed = false;
-    for (int i = 0; i < n; ++i) {
-      double c = 0.0, r = 0.0;
-      for (int j = 0; j < n; ++j) {
-        if (j == i) continue;
-        c += std::abs(B(j, i));
-        r += std::abs(B(i, j));
-      }
-      if (c == 0.0 || r == 0.0) continue;
-      double f = 1.0;
-      const double s = c + r;
-      while (c < r / 2.0) {
-        c *= 2.0;
-        r /= 2.0;
-        f *= 2.0;
-      }
-      while (c >= r * 2.0) {
-        c /= 2.0;
-        r *= 2.0;
-        f /= 2.0;
-      }
-      if (c + r < 0.95 * s) {
-        changed = true;
-        d(i) *= f;
-        B.col(i) *= f;
-        B.row(i) /= f;
-      }
-    }
-    if (!changed) break;
-  }
-  return d;
-}
-
-struct EventResult {
-  bool ok = false;
-  std::string message;
-  VectorXd x_plus;
-  lcs::IndexSet mode;
-  VectorXd impulse;  // sum of the impulses applied (size k)
-  bool jumped = false;
-  bool accumulation = false;
-  double t_star = 0.0;  // extrapolated accumulation time (accumulation only)
-  std::string note;     // how an accumulation's limit was taken (Event::note)
-  long lcp_solves = 0;
-  std::vector<std::string> warnings;
-};
-
-// Ends a run that cannot make progress: `limit` consecutive events, each
-// less than 1e-4 of the fastest time scale (1/rho) after the one before and
-// each changing the state by less than 1e-6 of its size, are a livelock, not
-// physics: modes that alternate with impulses at the level of the gaps'
-// rounding (on the NAO legs before accumulations were taken: every 2e-9 s,
-// jumps of 8e-8 in a state of size 1.5, for ever). A real accumulation has
-// geometrically shrinking intervals and is taken as a limit long before.
-constexpr double kIdleJump = 1e-6;
-
-class LivelockGuard {
- public:
-  LivelockGuard(int limit, double rho, std::vector<std::string> names)
-      : limit_(limit), rho_(rho), names_(std::move(names)) {}
-  // "" while the run makes progress, else the failure message.
-  std::string after_event(double t, const VectorXd& x_minus, const VectorXd& x_plus,
-                          const lcs::IndexSet& old_mode, const EventResult& ev) {
-    const double dt = t - last_t_;
-    last_t_ = t;
-    const double quick = rho_ > 0.0 ? 1e-4 / rho_ : 1e-4 * std::max(1.0, std::abs(t));
-    const double jump = (x_plus - x_minus).cwiseAbs().maxCoeff();
-    const bool idle = dt <= quick && jump <= kIdleJump * x_minus.cwiseAbs().maxCoeff();
-    if (!idle) {
-      streak_ = 0;
-      involved_.clear();
-      return "";
-    }
-    if (streak_++ == 0) since_ = t;
-    for (int r : ev.mode)
-      if (std::find(old_mode.begin(), old_mode.end(), r) == old_mode.end()) involved_.insert(r);
-    for (int r : old_mode)
-      if (std::find(ev.mode.begin(), ev.mode.end(), r) == ev.mode.end()) involved_.insert(r);
-    for (int r = 0; r < static_cast<int>(ev.impulse.size()); ++r)
-      if (ev.impulse(r) != 0.0) involved_.insert(r);
-    if (streak_ < limit_) return "";
-    std::ostringstream msg;
-    msg.precision(6);
-    msg << "no progress at t = " << t << ": " << streak_ << " events in " << (t - since_)
-        << " s each changed the state by less than rounding, at contacts ";
-    bool first = true;
-    for (int r : involved_) {
-      msg << (first ? "" : ", ")
-          << (r < static_cast<int>(names_.size()) ? "'" + names_[r] + "'" : std::to_string(r));
-      first = false;
-    }
-    if (involved_.empty()) msg << "(none)";
-    msg << " (their modes alternate with impulses below rounding): the event-driven method "
-           "cannot resolve this contact configuration; a time-stepping method (Moreau–Jean) can";
-    return msg.str();
-  }
-
- private:
-  int limit_;
-  double rho_;
-  std::vector<std::string> names_;
-  int streak_ = 0;
-  double since_ = 0.0, last_t_ = -std::numeric_limits<double>::infinity();
-  std::set<int> involved_;
-};
-
-class EventDriven {
- public:
-  // `model` fits the dense LCS (Integrator::run checks).
-  EventDriven(const mech::Model& model, const Options& opt)
-      : model_(model), opt_(opt), sys_(model.as_lcs()) {
-    n_ = sys_.n();
-    k_ = sys_.k();
-    if (model.is_mechanical()) {
-      N_ = model.mechanical->dofs();
-      restitution_ = model.mechanical->restitution;
-    }
-    solver_ = lcp::make_solver(opt.lcp_solver);
-    impact_ = impact::make_impact_law(opt.impact);
-    impact_times_.assign(k_, {});
-    ldcp_.solver = solver_.get();
-    ldcp_data_ = lcs::ldcp_data(sys_);
-    rho_A_ = spectral_radius_bound(sys_.A);
-    ldcp_.data = &ldcp_data_;
-  }
-
-  Trajectory run(const VectorXd& x0_user);
-
- private:
-  VectorXd augment(const VectorXd& x) const {
-    if (!model_.is_mechanical()) return x;
-    VectorXd xa(n_);
-    xa << x, 1.0;
-    return xa;
-  }
-  VectorXd user(const VectorXd& xa) const {
-    return model_.is_mechanical() ? VectorXd(xa.head(2 * N_)) : xa;
-  }
-  bool is_zero(double value, double scale) const {
-    return std::abs(value) <= ldcp_.tol_rel * scale + ldcp_.tol_abs;
-  }
-
-  Phase make_phase(const lcs::IndexSet& mode, const lcs::IndexSet& undetermined, const VectorXd& xa,
-                   std::string& err) const;
-  EventResult process_event(double t, const VectorXd& xa);
-  double accumulation_time(int r, double t, double* ratio) const;
-  void project_onto(const std::vector<int>& rows, VectorXd& xa, bool positions) const;
-  EventResult process_mechanical(double t, const VectorXd& xa);
-  std::string take_accumulation_limit(int r, double t, double ratio, double t_star,
-                                      const VectorXd& gap, const VectorXd& gap_scale,
-                                      VectorXd& xa) const;
-  EventResult process_lcs(const VectorXd& xa);
-  void record(Trajectory& tr, double t, const VectorXd& xa, const Phase& ph) const;
-  VectorXd multipliers(const Phase& ph, const VectorXd& xa) const {
-    VectorXd u = VectorXd::Zero(k_);
-    if (!ph.mode.empty()) {
-      const VectorXd uI = ph.F * xa;
-      for (size_t i = 0; i < ph.mode.size(); ++i) u(ph.mode[i]) = uI(i);
-    }
-    return u;
-  }
-  double violation(const VectorXd& xa) const {
-    if (k_ == 0) return 0.0;
-    const VectorXd y = sys_.C * xa;  // D u is zero for mechanical models
-    return std::min(0.0, y.minCoeff());
-  }
-  double energy(const VectorXd& xa) const {
-    if (!model_.is_mechanical()) return 0.0;
-    return mech::total_energy(*model_.mechanical, xa.head(N_), xa.segment(N_, N_));
-  }
-
-  const mech::Model& model_;
-  const Options& opt_;
-  lcs::Lcs sys_;
-  int n_ = 0, k_ = 0, N_ = 0;
-  VectorXd restitution_;
-  std::unique_ptr<lcp::Solver> solver_;
-  std::unique_ptr<impact::ImpactLaw> impact_;
-  lcs::LdcpOptions ldcp_;
-  std::vector<std::vector<double>> impact_times_;  // last few impacts per contact
-  lcs::IndexSet ldcp_undetermined_;                // K of the last mode selection
-  lcs::LdcpData ldcp_data_;
-  double rho_A_ = 0.0;  // bound on the spectral radius of the free dynamics
-  mutable std::map<lcs::IndexSet, lcs::ModeFeedback> feedback_cache_;
-  mutable std::map<lcs::IndexSet, double> rho_cache_;
-};
-
-Phase EventDriven::make_phase(const lcs::IndexSet& mode, const lcs::IndexSet& undetermined,
-                              const VectorXd& xa, std::string& err) const {
-  Phase ph;
-  ph.mode = mode;
-  ph.Acl = sys_.A;
-  ph.F = MatrixXd::Zero(mode.size(), n_);
-  if (!mode.empty()) {
-    auto it = feedback_cache_.find(mode);
-    if (it == feedback_cache_.end())
-      it = feedback_cache_.emplace(mode, lcs::mode_feedback(sys_, mode)).first;
-    const lcs::ModeFeedback& fb = it->second;
-    if (!fb.ok) {
-      err = "mode feedback F_I unavailable: " + fb.message;
-      return ph;
-    }
-    ph.F = fb.F;
-    MatrixXd BI(n_, mode.size());
-    for (size_t i = 0; i < mode.size(); ++i) BI.col(i) = sys_.B.col(mode[i]);
-    ph.Acl += BI * ph.F;
-  }
-  for (int r = 0; r < k_; ++r) {
-    const auto in_mode = std::find(mode.begin(), mode.end(), r);
-    Monitor mon;
-    mon.constraint = r;
-    if (in_mode != mode.end()) {
-      mon.multiplier = true;
-      mon.w = ph.F.row(in_mode - mode.begin());
-    } else {
-      if (std::find(undetermined.begin(), undetermined.end(), r) != undetermined.end())
-        continue;  // y_r and u_r vanish identically in this mode (Remark 3.4.8)
-      mon.multiplier = false;
-      RowVectorXd w = sys_.C.row(r);
-      for (size_t i = 0; i < mode.size(); ++i) w += sys_.D(r, mode[i]) * ph.F.row(i);
-      mon.w = w;
-    }
-    ph.monitors.push_back(std::move(mon));
-  }
-  ph.D = balancing(ph.Acl);
-  ph.Ab = ph.D.cwiseInverse().asDiagonal() * ph.Acl * ph.D.asDiagonal();
-  ph.Ab_norm1 = ph.Ab.cwiseAbs().colwise().sum().maxCoeff();
-  if (!ph.dense_exp()) {
-    ph.Ab_sparse = ph.Ab.sparseView();
-    ph.use_sparse = ph.Ab_sparse.nonZeros() * 10 <= ph.Ab.size();
-  }
-  // Ab depends on the mode only: its bound (four n x n squarings) is kept.
-  auto rit = rho_cache_.find(mode);
-  if (rit == rho_cache_.end()) rit = rho_cache_.emplace(mode, spectral_radius_bound(ph.Ab)).first;
-  ph.rho = rit->second;
-  const VectorXd z = xa.cwiseQuotient(ph.D);
-  for (Monitor& mon : ph.monitors) {
-    mon.w = mon.w.cwiseProduct(ph.D.transpose());
-    mon.wA = ph.row_times(mon.w);
-    mon.scale = mon.w.cwiseAbs().dot(z.cwiseAbs());
-  }
-  return ph;
-}
-
-// Impacts of contact r at t_{k-3}, t_{k-2}, t_{k-1} and now t, whatever the
-// restitution (inelastic impacts accumulate too when they alternate between
-// coupled contacts): when the intervals shrink geometrically (two successive
-// ratios agree to kRatioAgreement) the remaining impacts sum to d r/(1-r) (d the last
-// interval, r the ratio); when that tail is below accumulation_tail max(1, t)
-// s, or the last interval is below accumulation_dt, the limit is taken.
-// Returns the accumulation time (and the ratio, 0 for the interval test),
-// or -1.
-// A ball's ratios agree exactly; impacts that alternate through a coupling
-// reach a constant ratio only as their intervals shrink (the rest of the
-// system drifts between impacts: 0.061, 0.060, 0.056 on the NAO legs' knee
-// and ankle), and they must be caught before the rounding of the gaps drives
-// them (there below 1e-8 s). 10 % agreement with a tail below 1e-6 s: the
-// limit then misses only motion within the tail, in which every contact
-// involved stays within its bounce amplitude of the limit.
-constexpr double kRatioAgreement = 0.1;
-
-double EventDriven::accumulation_time(int r, double t, double* ratio_out) const {
-  const auto& h = impact_times_[r];
-  *ratio_out = 0.0;
-  // A further round of the impact law at the same event is not an impact of
-  // a sequence (it repairs a jump that left a contact approaching).
-  if (h.empty() || h.back() >= t) return -1.0;
-  const double d2 = t - h.back();
-  if (d2 < opt_.accumulation_dt) return t;
-  if (h.size() < 3) return -1.0;
-  const double d1 = h[h.size() - 1] - h[h.size() - 2];
-  const double d0 = h[h.size() - 2] - h[h.size() - 3];
-  if (!(d1 > 0.0 && d0 > 0.0)) return -1.0;
-  const double ratio = d2 / d1, ratio0 = d1 / d0;
-  if (!(ratio < 1.0) || std::abs(ratio - ratio0) > kRatioAgreement * ratio) return -1.0;
-  const double tail = d2 * ratio / (1.0 - ratio);
-  *ratio_out = ratio;
-  return tail < opt_.accumulation_tail * std::max(1.0, std::abs(t)) ? t + tail : -1.0;
-}
-
-// The M-orthogonal projection onto E_J q + g_J = 0 (positions) or E_J v = 0
-// (velocities): the smallest change in the kinetic metric, as in Moreau's
-// rule; a least-squares solve copes with dependent rows. Used only for
-// corrections at rounding level.
-void EventDriven::project_onto(const std::vector<int>& rows, VectorXd& xa, bool positions) const {
-  if (rows.empty()) return;
-  const mech::MechanicalModel& m = *model_.mechanical;
-  MatrixXd EJ(rows.size(), N_);
-  VectorXd r(rows.size());
-  for (size_t i = 0; i < rows.size(); ++i) {
-    EJ.row(i) = m.E.row(rows[i]);
-    r(i) = positions ? m.E.row(rows[i]).dot(xa.head(N_)) + m.g(rows[i])
-                     : m.E.row(rows[i]).dot(xa.segment(N_, N_));
-  }
-  const Eigen::LLT<MatrixXd> llt(m.M);
-  const MatrixXd MinvEt = llt.solve(EJ.transpose());
-  const VectorXd lambda = (EJ * MinvEt).completeOrthogonalDecomposition().solve(r);
-  if (positions)
-    xa.head(N_) -= MinvEt * lambda;
-  else
-    xa.segment(N_, N_) -= MinvEt * lambda;
-}
-
-// The limit of an accumulation at contact r. The contacts that take part
-// are r and those with an impact since the first of r's last impacts that are
-// open by at most 1e-6 of their gap's scale. In the limit their gaps and
-// rates vanish (each impact shrinks the rates by the ratio), so the state is
-// projected, in the kinetic metric, onto E_J q + g_J = 0 and E_J v = 0: the
-// nearest limit state, which never gains kinetic energy. Mode selection then
-// decides their forces. Returns how the limit was taken (Event::note).
-std::string EventDriven::take_accumulation_limit(int r, double t, double ratio, double t_star,
-                                                 const VectorXd& gap, const VectorXd& gap_scale,
-                                                 VectorXd& xa) const {
-  const double since = impact_times_[r].empty() ? t : impact_times_[r].front();
-  std::vector<int> joined;
-  std::string names;
-  for (int s = 0; s < k_; ++s) {
-    const auto& h = impact_times_[s];
-    const bool took_part = s == r || (!h.empty() && h.back() >= since);
-    if (!took_part || gap(s) > 1e-6 * gap_scale(s)) continue;
-    names += (names.empty() ? "'" : ", '") + model_.mechanical->constraints[s] + "'";
-    joined.push_back(s);
-  }
-  const VectorXd x_before = xa;
-  project_onto(joined, xa, true);
-  project_onto(joined, xa, false);
-  const VectorXd dq = xa.head(N_) - x_before.head(N_);
-  const VectorXd dv = xa.segment(N_, N_) - x_before.segment(N_, N_);
-  const double moved = std::sqrt(dq.dot(model_.mechanical->M * dq));
-  const double slowed = std::sqrt(dv.dot(model_.mechanical->M * dv));
-  std::ostringstream note;
-  note.precision(6);
-  note << "impacts at " << names << " accumulate: ";
-  if (ratio > 0.0)
-    note << "their intervals shrink by the ratio " << ratio << ", so the remaining impacts take "
-         << (t_star - t) << " s (geometric tail d r/(1 - r))";
-  else
-    note << "two impacts of '" << model_.mechanical->constraints[r] << "' " << (t - since)
-         << " s apart or less (accumulation_dt)";
-  note << "; limit taken at t = " << t << ": their gaps and rates set to zero (positions moved by "
-       << moved << ", velocities by " << slowed
-       << " in the kinetic metric), then the limit mode up to t* = " << t_star;
-  return note.str();
-}
-
-EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
-  EventResult out;
-  out.impulse = VectorXd::Zero(k_);
-  VectorXd xa = xa0;
-  const mech::MechanicalModel& m = *model_.mechanical;
-  std::vector<int> closed, resting;  // zero gap; zero gap and zero rate
-  bool limit_taken = false;          // an accumulation's limit is being taken
-  for (int iter = 0; iter < 100; ++iter) {
-    closed.clear();
-    resting.clear();
-    const VectorXd q = xa.head(N_), v = xa.segment(N_, N_);
-    const VectorXd gap = m.E * q + m.g;
-    const VectorXd gap_scale = m.E.cwiseAbs() * q.cwiseAbs() + m.g.cwiseAbs();
-    const VectorXd rate = m.E * v;
-    const VectorXd rate_scale = m.E.cwiseAbs() * v.cwiseAbs();
-    impact::ImpactInput in;
-    in.model = &m;
-    in.q = q;
-    in.v = v;
-    bool approaching = false;
-    int accumulating = -1;  // a contact whose impacts accumulate at t_star
-    double acc_ratio = 0.0;
-    for (int r = 0; r < k_; ++r) {
-      // Zero within rounding, or within what the event time's resolution
-      // (a few ulp of t times the rate) leaves in the gap.
-      const double gap_tol = ldcp_.tol_rel * gap_scale(r) + ldcp_.tol_abs +
-                             16.0 * kEps * std::max(1.0, std::abs(t)) * std::abs(rate(r));
-      if (gap(r) < -gap_tol) {
-        std::ostringstream msg;
-        msg.precision(6);
-        msg << "constraint '" << m.constraints[r] << "' is violated at t = " << t
-            << " (gap = " << gap(r)
-            << "): the state is infeasible, E q + g >= 0 must hold (thesis §3.8)";
-        out.message = msg.str();
-        return out;
-      }
-      if (gap(r) > gap_tol) continue;
-      in.closed.push_back(r);
-      closed.push_back(r);
-      // A rate is zero within rounding of its terms, or within what rounding
-      // of the state leaves in it: eps times the velocities and positions
-      // times the fastest frequency (a stiff spring grazing its stop).
-      const double rate_noise = 64.0 * kEps * m.E.row(r).cwiseAbs().sum() *
-                                (v.cwiseAbs().maxCoeff() + rho_A_ * q.cwiseAbs().maxCoeff());
-      const double rate_tol = ldcp_.tol_rel * rate_scale(r) + ldcp_.tol_abs + rate_noise;
-      if (std::abs(rate(r)) <= rate_tol) resting.push_back(r);
-      if (rate(r) < -rate_tol) {
-        approaching = true;
-        double ratio = 0.0;
-        const double ts = limit_taken ? -1.0 : accumulation_time(r, t, &ratio);
-        if (ts >= t && ts >= out.t_star) {
-          accumulating = r;
-          acc_ratio = ratio;
-          out.t_star = ts;
-        }
-      }
-    }
-    if (accumulating >= 0) {
-      // Right-accumulation of impacts (Remark 3.4.11): the limit state has
-      // every contact that takes part in the accumulation closed (with
-      // alternating impacts the others are open by a gap of the order of the
-      // tail), and the remaining impacts are inelastic in the limit. Close
-      // those contacts (M-orthogonal projection of q), then apply the
-      // inelastic impact; the run continues from t_star in the limit mode.
-      limit_taken = true;
-      out.accumulation = true;
-      out.note =
-          take_accumulation_limit(accumulating, t, acc_ratio, out.t_star, gap, gap_scale, xa);
-      continue;
-    }
-    if (!approaching) break;
-    in.restitution = limit_taken ? VectorXd::Zero(k_) : VectorXd(restitution_);
-    const impact::ImpactResult ir = impact_->apply(in, *solver_);
-    out.lcp_solves += ir.lcp_solves;
-    if (!ir.ok) {
-      out.message = "impact at t = " + std::to_string(t) + ": " + ir.message;
-      return out;
-    }
-    if (!ir.admissible)
-      out.warnings.push_back("impact law '" + impact_->name() + "' at t = " + std::to_string(t) +
-                             " gave a non-admissible jump (negative impulse or E_J v+ < 0)" +
-                             (ir.message.empty() ? "" : ": " + ir.message));
-    xa.segment(N_, N_) = ir.v_after;
-    out.impulse += ir.impulse;
-    out.jumped = true;
-    for (int r : in.closed)
-      if (ir.impulse(r) > 0.0) {
-        auto& h = impact_times_[r];
-        if (h.empty() || h.back() != t) h.push_back(t);
-        if (h.size() > 4) h.erase(h.begin());
-      }
-    if (iter == 99) {
-      out.message =
-          "impacts at t = " + std::to_string(t) + " did not end after 100 rounds of the impact law";
-      return out;
-    }
-  }
-  // Put the closed gaps and the resting rates at exactly zero: they are zero
-  // up to the state's rounding, and mode selection must see them so.
-  project_onto(closed, xa, true);
-  project_onto(resting, xa, false);
-  lcs::LdcpOptions o = ldcp_;
-  o.regular_only = true;  // the state is now regular: contact forces and higher
-  const lcs::ModeSelection sel = lcs::select_mode(sys_, xa, o);
-  out.lcp_solves += sel.lcp_solves;
-  if (!sel.ok) {
-    out.message = "mode selection at t = " + std::to_string(t) + ": " + sel.message;
-    return out;
-  }
-  out.mode = sel.mode;
-  out.x_plus = xa;
-  out.ok = true;
-  ldcp_undetermined_ = sel.undetermined;
-  return out;
-}
-
-EventResult EventDriven::process_lcs(const VectorXd& xa0) {
-  EventResult out;
-  out.impulse = VectorXd::Zero(k_);
-  VectorXd xa = xa0;
-  // Theorem 3.6.3: with P-matrix leading coefficients at most one jump occurs;
-  // a few more rounds are allowed and then reported.
-  for (int iter = 0; iter < 4; ++iter) {
-    const lcs::ModeSelection sel = lcs::select_mode(sys_, xa, ldcp_);
-    out.lcp_solves += sel.lcp_solves;
-    if (!sel.ok) {
-      out.message = "mode selection: " + sel.message;
-      return out;
-    }
-    bool impulsive = false;
-    for (const auto& imp : sel.impulse)
-      if (!imp.isZero(0.0)) impulsive = true;
-    if (!impulsive) {
-      out.mode = sel.mode;
-      out.x_plus = xa;
-      out.ok = true;
-      ldcp_undetermined_ = sel.undetermined;
-      return out;
-    }
-    out.impulse += sel.impulse[0];
-    out.jumped = true;
-    xa = sel.x_plus;
-  }
-  out.message = "re-initialisation did not reach a regular state after 4 jumps";
-  return out;
-}
-
-EventResult EventDriven::process_event(double t, const VectorXd& xa) {
-  return model_.is_mechanical() ? process_mechanical(t, xa) : process_lcs(xa);
-}
+namespace detail {
 
 void EventDriven::record(Trajectory& tr, double t, const VectorXd& xa, const Phase& ph) const {
   tr.max_violation = std::min(tr.max_violation, violation(xa));
@@ -702,6 +41,76 @@ void EventDriven::record(Trajectory& tr, double t, const VectorXd& xa, const Pha
   s.y = sys_.C * xa + sys_.D * s.u;
   s.mode = ph.mode;
   tr.record_sample(std::move(s), opt_);
+}
+
+// How each monitor of `phase` starts at t from xstart (balanced): its noise
+// level, its first nonzero derivative, and the first sampling step (h_max,
+// shorter where a monitor starts at zero).
+EventDriven::MonitorStart EventDriven::monitor_start(const Phase& phase, const VectorXd& xstart,
+                                                     double t, double h_max) const {
+  MonitorStart st;
+  double& h_first = st.h_first;
+  h_first = h_max;
+  // Noise level of each monitor at the phase start: rounding of its terms
+  // plus the time quantisation of the event time (ulp(t) times its rate).
+  std::vector<double>& noise = st.noise;
+  noise.resize(phase.monitors.size());
+  for (size_t j = 0; j < phase.monitors.size(); ++j) {
+    const Monitor& mon = phase.monitors[j];
+    noise[j] = 64.0 * kEps * mon.w.cwiseAbs().sum() * xstart.cwiseAbs().maxCoeff() +
+               (16.0 * kEps * std::max(1.0, std::abs(t)) + opt_.event_time_tol) *
+                   std::abs(mon.wA.dot(xstart));
+  }
+  // Per monitor: the order m0 of its first nonzero derivative at the phase
+  // start (0 = the value itself; -1 = none up to n) and that derivative d0.
+  std::vector<int>& m0 = st.m0;
+  std::vector<double>& d0 = st.d0;
+  {
+    // Derivatives of the monitors at the phase start: d_m = w Acl^m x.
+    // A derivative is rounding noise when below the zero test of mode
+    // selection applied to the magnitudes of its terms |w| |Acl|^m |x|.
+    // Each monitor needs its first two nonzero derivatives only: the loop
+    // stops once every monitor has them (usually m <= 3), instead of
+    // always forming all n + 1 (O(n^3) per phase for large models).
+    const size_t nm = phase.monitors.size();
+    m0.assign(nm, -1);
+    d0.assign(nm, 0.0);
+    std::vector<char> done(nm, 0);
+    size_t remaining = nm;
+    VectorXd Amx = xstart;
+    VectorXd Amx_abs = xstart.cwiseAbs();
+    MatrixXd Acl_abs;
+    for (int m = 0; m <= n_ && remaining > 0; ++m) {
+      if (m > 0) {
+        if (m == 1) Acl_abs = phase.Ab.cwiseAbs();
+        Amx = phase.times(Amx);
+        Amx_abs = Acl_abs * Amx_abs;
+      }
+      for (size_t j = 0; j < nm; ++j) {
+        if (done[j]) continue;
+        const Monitor& mon = phase.monitors[j];
+        const double dm = mon.w * Amx;
+        const double zero =
+            m == 0 ? noise[j] : ldcp_.tol_rel * mon.w.cwiseAbs().dot(Amx_abs) + ldcp_.tol_abs;
+        if (std::abs(dm) <= zero) continue;
+        if (m0[j] < 0) {
+          m0[j] = m;
+          d0[j] = dm;
+          continue;
+        }
+        // Time scale of the first two nonzero Taylor terms:
+        // |d_m0| t^m0/m0! = |d_m| t^m/m!  ->  t = (|d_m0| m!/(m0! |d_m|))^(1/(m-m0))
+        const double ratio = std::abs(d0[j]) / std::abs(dm);
+        double f = 1.0;
+        for (int i = m0[j] + 1; i <= m; ++i) f *= i;
+        const double tau = std::pow(ratio * f, 1.0 / (m - m0[j]));
+        h_first = std::min(h_first, 0.25 * tau);
+        done[j] = 1;
+        --remaining;
+      }
+    }
+  }
+  return st;
 }
 
 Trajectory EventDriven::run(const VectorXd& x0_user) {
@@ -768,66 +177,12 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     double h_max = t_end - t;
     if (rho > 0.0) h_max = std::min(h_max, 0.5 / rho);
     h_max = std::min(h_max, (t_end - t) / 4.0 + 1e-300);
-    double h_first = h_max;
     const VectorXd xstart = xa.cwiseQuotient(phase.D);  // balanced
-    // Noise level of each monitor at the phase start: rounding of its terms
-    // plus the time quantisation of the event time (ulp(t) times its rate).
-    std::vector<double> noise(phase.monitors.size());
-    for (size_t j = 0; j < phase.monitors.size(); ++j) {
-      const Monitor& mon = phase.monitors[j];
-      noise[j] = 64.0 * kEps * mon.w.cwiseAbs().sum() * xstart.cwiseAbs().maxCoeff() +
-                 (16.0 * kEps * std::max(1.0, std::abs(t)) + opt_.event_time_tol) *
-                     std::abs(mon.wA.dot(xstart));
-    }
-    // Per monitor: the order m0 of its first nonzero derivative at the phase
-    // start (0 = the value itself; -1 = none up to n) and that derivative d0.
-    std::vector<int> m0;
-    std::vector<double> d0;
-    {
-      // Derivatives of the monitors at the phase start: d_m = w Acl^m x.
-      // A derivative is rounding noise when below the zero test of mode
-      // selection applied to the magnitudes of its terms |w| |Acl|^m |x|.
-      // Each monitor needs its first two nonzero derivatives only: the loop
-      // stops once every monitor has them (usually m <= 3), instead of
-      // always forming all n + 1 (O(n^3) per phase for large models).
-      const size_t nm = phase.monitors.size();
-      m0.assign(nm, -1);
-      d0.assign(nm, 0.0);
-      std::vector<char> done(nm, 0);
-      size_t remaining = nm;
-      VectorXd Amx = xstart;
-      VectorXd Amx_abs = xstart.cwiseAbs();
-      MatrixXd Acl_abs;
-      for (int m = 0; m <= n_ && remaining > 0; ++m) {
-        if (m > 0) {
-          if (m == 1) Acl_abs = phase.Ab.cwiseAbs();
-          Amx = phase.times(Amx);
-          Amx_abs = Acl_abs * Amx_abs;
-        }
-        for (size_t j = 0; j < nm; ++j) {
-          if (done[j]) continue;
-          const Monitor& mon = phase.monitors[j];
-          const double dm = mon.w * Amx;
-          const double zero =
-              m == 0 ? noise[j] : ldcp_.tol_rel * mon.w.cwiseAbs().dot(Amx_abs) + ldcp_.tol_abs;
-          if (std::abs(dm) <= zero) continue;
-          if (m0[j] < 0) {
-            m0[j] = m;
-            d0[j] = dm;
-            continue;
-          }
-          // Time scale of the first two nonzero Taylor terms:
-          // |d_m0| t^m0/m0! = |d_m| t^m/m!  ->  t = (|d_m0| m!/(m0! |d_m|))^(1/(m-m0))
-          const double ratio = std::abs(d0[j]) / std::abs(dm);
-          double f = 1.0;
-          for (int i = m0[j] + 1; i <= m; ++i) f *= i;
-          const double tau = std::pow(ratio * f, 1.0 / (m - m0[j]));
-          h_first = std::min(h_first, 0.25 * tau);
-          done[j] = 1;
-          --remaining;
-        }
-      }
-    }
+    const MonitorStart start = monitor_start(phase, xstart, t, h_max);
+    const std::vector<double>& noise = start.noise;
+    const std::vector<int>& m0 = start.m0;
+    const std::vector<double>& d0 = start.d0;
+    double h_first = start.h_first;
     h_first = std::max(h_first, 1e-15 * std::max(1.0, std::abs(t)));
 
     // March over the samples of this phase. A monitor is armed (watched for
@@ -1065,7 +420,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
   return tr;
 }
 
-}  // namespace
+}  // namespace detail
 
 // The method on input that Integrator::run has checked (trajectory.cpp).
 Trajectory integrate_event_driven(const mech::Model& model, const VectorXd& x0,
@@ -1088,7 +443,7 @@ Trajectory integrate_event_driven(const mech::Model& model, const VectorXd& x0,
         std::to_string(model.lcs_state_size()) + " > " + std::to_string(mech::kMaxDenseLcsState) +
         "); use a time-stepping method (--method moreau-jean) for models this large");
   if (const std::string bad = infeasible_start(model, x0); !bad.empty()) return refuse(bad);
-  EventDriven ed(model, opt);
+  detail::EventDriven ed(model, opt);
   return ed.run(x0);
 }
 

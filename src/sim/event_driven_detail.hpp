@@ -1,0 +1,218 @@
+// Private to src/sim: the event-driven method's types, shared by its files.
+//   event_driven.cpp      the main loop (EventDriven::run) and the entry point
+//   brent.hpp             roots of the monitored Bohl functions (Brent's method)
+//   phase.cpp             a phase: closed loop of a mode, balancing, spectral
+//                         bound, exponentials, the monitors (EventDriven::make_phase)
+//   reinitialisation.cpp  what happens at an event: impact law and mode
+//                         selection (mechanical), LDCP jumps (general LCS)
+//   accumulation.cpp      accumulations of impacts and their limit
+//   livelock.cpp          the guard against events that make no progress
+#pragma once
+
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
+#include <lcsim/sim/sim.hpp>
+#include <limits>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace lcsim::sim::detail {
+
+using Eigen::MatrixXd;
+using Eigen::RowVectorXd;
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+
+// An upper bound on the spectral radius, ||B^16||^(1/16) ||A|| with
+// B = A/||A|| (Gelfand's formula; 4 squarings, no eigen-decomposition).
+double spectral_radius_bound(const MatrixXd& A);
+
+struct Monitor {
+  RowVectorXd w;            // phi(t) = w x(t)
+  RowVectorXd wA;           // phi'(t) = w Acl x(t)
+  double scale = 0.0;       // |w| |x| scale for tolerances
+  int constraint = -1;      // which constraint
+  bool multiplier = false;  // true: u_i of an active constraint; false: free output y_i
+};
+
+struct Phase {
+  lcs::IndexSet mode;
+  MatrixXd Acl;  // closed-loop matrix
+  MatrixXd F;    // u_I = F x (|I| x n)
+  // Balanced coordinates z = x ./ D with Ab = D^{-1} Acl D (powers of 2):
+  // a stiff spring k makes Acl's entries span k and 1 while its frequencies
+  // are sqrt(k); exponentials of the balanced matrix keep the relative
+  // accuracy that the unbalanced one loses (gap errors of 1e-8 at k = 1e9).
+  VectorXd D;
+  MatrixXd Ab;
+  std::vector<Monitor> monitors;  // w, wA in balanced coordinates
+  double Ab_norm1 = 0.0;          // ||Ab||_1
+  // Above kDenseExpMax states, Ab by rows when at most a tenth of it is
+  // non-zero (a chain's closed loop is banded): products with vectors then
+  // cost O(nnz), not O(n^2).
+  Eigen::SparseMatrix<double, Eigen::RowMajor> Ab_sparse;
+  bool use_sparse = false;
+  VectorXd times(const VectorXd& x) const {
+    return use_sparse ? VectorXd(Ab_sparse * x) : VectorXd(Ab * x);
+  }
+  RowVectorXd row_times(const RowVectorXd& w) const {
+    return use_sparse ? RowVectorXd(w * Ab_sparse) : RowVectorXd(w * Ab);
+  }
+  double rho = 0.0;  // spectral_radius_bound(Ab)
+
+  // Up to this many states e^{Ab tau} is formed (Padé with scaling and
+  // squaring, O(n^3)) and, on a sampling grid, reused; above it only its
+  // action on a vector is computed (O(n^2) per term): a chain of 100 carts
+  // (n = 201) spent 70% of its run in dense exponentials.
+  static constexpr int kDenseExpMax = 64;
+  bool dense_exp() const { return Ab.rows() <= kDenseExpMax; }
+
+  // e^{Ab tau} z in balanced coordinates. Above kDenseExpMax: the Taylor
+  // series of the action in s = ceil(||Ab tau||_1) substeps, so each substep
+  // has ||Ab tau/s||_1 <= 1 and its series, truncated once two consecutive
+  // terms are below eps/4 of the partial sum, converges like 1/k! (at most
+  // ~20 terms); the error is that of the dense exponential's (both are
+  // backward stable for ||Ab tau/s|| <= 1; Al-Mohy & Higham 2011 choose s
+  // and the degree more finely).
+  VectorXd expv(double tau, const VectorXd& z) const;  // phase.cpp
+  VectorXd exp_apply(double tau, const VectorXd& x) const {
+    return D.cwiseProduct(expv(tau, x.cwiseQuotient(D)));
+  }
+};
+
+struct EventResult {
+  bool ok = false;
+  std::string message;
+  VectorXd x_plus;
+  lcs::IndexSet mode;
+  VectorXd impulse;  // sum of the impulses applied (size k)
+  bool jumped = false;
+  bool accumulation = false;
+  double t_star = 0.0;  // extrapolated accumulation time (accumulation only)
+  std::string note;     // how an accumulation's limit was taken (Event::note)
+  long lcp_solves = 0;
+  std::vector<std::string> warnings;
+};
+
+// Ends a run that cannot make progress: `limit` consecutive events, each
+// less than 1e-4 of the fastest time scale (1/rho) after the one before and
+// each changing the state by less than 1e-6 of its size, are a livelock, not
+// physics: modes that alternate with impulses at the level of the gaps'
+// rounding (on the NAO legs before accumulations were taken: every 2e-9 s,
+// jumps of 8e-8 in a state of size 1.5, for ever). A real accumulation has
+// geometrically shrinking intervals and is taken as a limit long before.
+constexpr double kIdleJump = 1e-6;
+
+class LivelockGuard {
+ public:
+  LivelockGuard(int limit, double rho, std::vector<std::string> names)
+      : limit_(limit), rho_(rho), names_(std::move(names)) {}
+  // "" while the run makes progress, else the failure message.
+  std::string after_event(double t, const VectorXd& x_minus, const VectorXd& x_plus,
+                          const lcs::IndexSet& old_mode, const EventResult& ev);
+
+ private:
+  int limit_;
+  double rho_;
+  std::vector<std::string> names_;
+  int streak_ = 0;
+  double since_ = 0.0, last_t_ = -std::numeric_limits<double>::infinity();
+  std::set<int> involved_;
+};
+
+class EventDriven {
+ public:
+  // `model` fits the dense LCS (Integrator::run checks).
+  EventDriven(const mech::Model& model, const Options& opt)
+      : model_(model), opt_(opt), sys_(model.as_lcs()) {
+    n_ = sys_.n();
+    k_ = sys_.k();
+    if (model.is_mechanical()) {
+      N_ = model.mechanical->dofs();
+      restitution_ = model.mechanical->restitution;
+    }
+    solver_ = lcp::make_solver(opt.lcp_solver);
+    impact_ = impact::make_impact_law(opt.impact);
+    impact_times_.assign(k_, {});
+    ldcp_.solver = solver_.get();
+    ldcp_data_ = lcs::ldcp_data(sys_);
+    rho_A_ = spectral_radius_bound(sys_.A);
+    ldcp_.data = &ldcp_data_;
+  }
+
+  Trajectory run(const VectorXd& x0_user);
+
+ private:
+  VectorXd augment(const VectorXd& x) const {
+    if (!model_.is_mechanical()) return x;
+    VectorXd xa(n_);
+    xa << x, 1.0;
+    return xa;
+  }
+  VectorXd user(const VectorXd& xa) const {
+    return model_.is_mechanical() ? VectorXd(xa.head(2 * N_)) : xa;
+  }
+  bool is_zero(double value, double scale) const {
+    return std::abs(value) <= ldcp_.tol_rel * scale + ldcp_.tol_abs;
+  }
+
+  Phase make_phase(const lcs::IndexSet& mode, const lcs::IndexSet& undetermined, const VectorXd& xa,
+                   std::string& err) const;
+  EventResult process_event(double t, const VectorXd& xa);
+  double accumulation_time(int r, double t, double* ratio) const;
+  void project_onto(const std::vector<int>& rows, VectorXd& xa, bool positions) const;
+  EventResult process_mechanical(double t, const VectorXd& xa);
+  std::string take_accumulation_limit(int r, double t, double ratio, double t_star,
+                                      const VectorXd& gap, const VectorXd& gap_scale,
+                                      VectorXd& xa) const;
+  EventResult process_lcs(const VectorXd& xa);
+  void record(Trajectory& tr, double t, const VectorXd& xa, const Phase& ph) const;
+  // A phase's start, per monitor: the noise level of its value, the order m0
+  // of its first nonzero derivative (0 = the value; -1 = none up to n) and
+  // that derivative d0; and the first sampling step.
+  struct MonitorStart {
+    std::vector<double> noise;
+    std::vector<int> m0;
+    std::vector<double> d0;
+    double h_first = 0.0;
+  };
+  MonitorStart monitor_start(const Phase& phase, const VectorXd& xstart, double t,
+                             double h_max) const;
+  VectorXd multipliers(const Phase& ph, const VectorXd& xa) const {
+    VectorXd u = VectorXd::Zero(k_);
+    if (!ph.mode.empty()) {
+      const VectorXd uI = ph.F * xa;
+      for (size_t i = 0; i < ph.mode.size(); ++i) u(ph.mode[i]) = uI(i);
+    }
+    return u;
+  }
+  double violation(const VectorXd& xa) const {
+    if (k_ == 0) return 0.0;
+    const VectorXd y = sys_.C * xa;  // D u is zero for mechanical models
+    return std::min(0.0, y.minCoeff());
+  }
+  double energy(const VectorXd& xa) const {
+    if (!model_.is_mechanical()) return 0.0;
+    return mech::total_energy(*model_.mechanical, xa.head(N_), xa.segment(N_, N_));
+  }
+
+  const mech::Model& model_;
+  const Options& opt_;
+  lcs::Lcs sys_;
+  int n_ = 0, k_ = 0, N_ = 0;
+  VectorXd restitution_;
+  std::unique_ptr<lcp::Solver> solver_;
+  std::unique_ptr<impact::ImpactLaw> impact_;
+  lcs::LdcpOptions ldcp_;
+  std::vector<std::vector<double>> impact_times_;  // last few impacts per contact
+  lcs::IndexSet ldcp_undetermined_;                // K of the last mode selection
+  lcs::LdcpData ldcp_data_;
+  double rho_A_ = 0.0;  // bound on the spectral radius of the free dynamics
+  mutable std::map<lcs::IndexSet, lcs::ModeFeedback> feedback_cache_;
+  mutable std::map<lcs::IndexSet, double> rho_cache_;
+};
+
+}  // namespace lcsim::sim::detail
