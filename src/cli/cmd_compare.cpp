@@ -60,8 +60,7 @@ void run_compare(const CompareArgs& a) {
   // ERP, so its exact counterpart is the nearest exact law (io::reference_law).
   const io::ReferenceLaw law = io::reference_law("bullet", opt.impact, model);
   const sim::Trajectory exact = io::run_reference(model, x0, law, opt);
-  if (exact.status != sim::RunStatus::kCompleted)
-    throw NumericalError("compare: the exact event-driven run failed: " + exact.message);
+  check_status(exact.status, "compare: the exact event-driven run failed: " + exact.message);
   if (!(a.stop_erp > 0.0 && a.stop_erp <= 1.0))
     throw io::InputError("--stop-erp: must lie in (0, 1] (got " + std::to_string(a.stop_erp) + ")");
   if (a.iterations < 1) throw io::InputError("--iterations: must be >= 1");
@@ -70,8 +69,7 @@ void run_compare(const CompareArgs& a) {
   ws.solver_iterations = a.iterations;
   const std::string bullet_solver = bullet::solver_description(model, ws);
   const sim::Trajectory bt = bullet::simulate_bullet(model, x0, opt, ws);
-  if (bt.status != sim::RunStatus::kCompleted)
-    throw NumericalError("compare: the Bullet run failed: " + bt.message);
+  check_status(bt.status, "compare: the Bullet run failed: " + bt.message);
   const bullet::Comparison c = bullet::compare_trajectories(exact, bt, 1e-9 * a.h);
   // What the Bullet scene does differently (lost restitution, explicit
   // springs, a scene run as rb6), as `simulate` prints it.

@@ -179,20 +179,11 @@ void run_map(const ImpactsArgs& a, const mech::Model& model) {
   std::cout << csv;
   std::cout.flush();
   if (a.plot.empty()) return;
-  const std::filesystem::path tmp = std::filesystem::temp_directory_path() /
-                                    ("lcsim_impact_map_" + std::to_string(::getpid()) + ".csv");
-  io::write_file_atomic(tmp, csv);
   const std::string title = spec.closed.empty()
                                 ? model.name + ": Moreau impact map (Figure 3.5)"
                                 : model.name + ": Moreau impact map, closed " + map.axes[0] +
                                       " (x), " + map.axes[1] + " (y) at q = " + fmt_vec(spec.q);
-  try {
-    draw_plot(impact_map_script(), tmp, a.plot, title, "--plot");
-  } catch (...) {
-    std::filesystem::remove(tmp);
-    throw;
-  }
-  std::filesystem::remove(tmp);
+  draw_plot_of_text(csv, "lcsim_impact_map.csv", impact_map_script(), a.plot, title, "--plot");
   std::cerr << "impact map written to " << a.plot << "\n";
 }
 
@@ -217,9 +208,8 @@ void setup(CLI::App& app) {
   auto* cmd = app.add_subcommand("impacts", "Compare impact rules on one state, or map them");
   cmd->add_option("model", a->model, "Model file (YAML, mechanical)")->required();
   cmd->add_option("--x0", a->x0, "State a,b,... (q then v); default: the model's");
-  std::string names;
-  for (const auto& n : impact::impact_law_names()) names += (names.empty() ? "" : ", ") + n;
-  cmd->add_option("--rules", a->rules, "all, or a comma list of: " + names);
+  cmd->add_option("--rules", a->rules,
+                  "all, or a comma list of: " + name_list(impact::impact_law_names()));
   cmd->add_option(
       "--restitution", a->restitution,
       "One coefficient for all constraints or one per constraint (default: the model's)");

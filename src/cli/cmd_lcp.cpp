@@ -67,10 +67,9 @@ void run_lcp(const LcpArgs& args) {
     if (!r.message.empty()) std::cout << "message:  " << r.message << "\n";
   }
   std::cout.flush();
-  if (!r.ok())
-    throw NumericalError(args.file + ": LCP not solved by " + solver->name() + ": " +
-                         std::string(lcp::to_string(r.status, "solved")) +
-                         (r.message.empty() ? "" : " (" + r.message + ")"));
+  check_status(r.status, args.file + ": LCP not solved by " + solver->name() + ": " +
+                             std::string(lcp::to_string(r.status, "solved")) +
+                             (r.message.empty() ? "" : " (" + r.message + ")"));
 }
 
 }  // namespace
@@ -80,9 +79,8 @@ LCSIM_REGISTER_COMMAND([](CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "lcp", "Solve the LCP w = M z + q, 0 <= z _|_ w >= 0 given by `M` and `q` in a YAML file");
   cmd->add_option("file", args->file, "LCP file (YAML with M: list of rows, q: list)")->required();
-  std::string known;
-  for (const auto& n : lcp::solver_names()) known += (known.empty() ? "" : ", ") + n;
-  cmd->add_option("--solver", args->solver, "LCP solver (default lemke): " + known);
+  cmd->add_option("--solver", args->solver,
+                  "LCP solver (default lemke): " + name_list(lcp::solver_names()));
   cmd->add_flag("--json", args->json, "print one JSON object");
   cmd->callback([args] { run_lcp(*args); });
 });

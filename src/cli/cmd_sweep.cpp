@@ -13,6 +13,7 @@
 #include <iostream>
 #include <lcsim/io/io.hpp>
 #include <lcsim/io/sweep.hpp>
+#include <lcsim/lcp/lcp.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -114,16 +115,7 @@ void run_sweep(const SweepArgs& a) {
     print_text(s, a.x0.empty() ? "the model" : "--x0");
   std::cout.flush();
   if (!a.plot.empty()) {
-    const std::filesystem::path tmp = std::filesystem::temp_directory_path() /
-                                      ("lcsim_sweep_" + std::to_string(::getpid()) + ".json");
-    io::write_file_atomic(tmp, j.dump(2));
-    try {
-      draw_plot(script, tmp, a.plot, model.name, "--plot");
-    } catch (...) {
-      std::filesystem::remove(tmp);
-      throw;
-    }
-    std::filesystem::remove(tmp);
+    draw_plot_of_text(j.dump(2), "lcsim_sweep.json", script, a.plot, model.name, "--plot");
     std::cerr << "work-precision diagram written to " << a.plot << "\n";
   }
   for (const auto& ref : s.references)
@@ -139,16 +131,17 @@ void setup(CLI::App& app) {
   cmd->add_option("model", a->model, "Model file (YAML)")->required();
   cmd->add_option("--x0", a->x0, "Initial state a,b,... (q then v); default: the model's");
   auto* t_end = cmd->add_option("--t-end", a->t_end, "Horizon (s); default: the model's t_end");
-  cmd->add_option("--methods", a->methods, "Comma-separated: event, euler, moreau-jean, bullet");
+  cmd->add_option("--methods", a->methods,
+                  "Comma-separated: " + name_list(sim::integrator_names()));
   cmd->add_option("--h", a->hs, "Comma-separated step sizes (s), e.g. 1e-2,1e-3,1e-4");
   cmd->add_option("--repeat", a->repeat, "Timing runs per point (median); default 3");
   cmd->add_option("--theta", a->theta, "Moreau–Jean theta in [0, 1]; default 0.5");
   cmd->add_option("--impact", a->impact,
                   "Impact law of the event method (and of the reference of methods without "
                   "a law of their own); default " +
-                      sim::Options{}.impact);
+                      sim::Options{}.impact + ": " + name_list(impact::impact_law_names()));
   cmd->add_flag("--force", a->force, "Run backward Euler even where it is not consistent");
-  cmd->add_option("--lcp", a->lcp, "LCP solver: pivot, lemke, pgs, enum");
+  cmd->add_option("--lcp", a->lcp, "LCP solver: " + name_list(lcp::solver_names()));
   cmd->add_flag("--json", a->json, "Print {\"rows\": [...]} as JSON");
   cmd->add_option("--plot", a->plot, "Draw the work-precision diagram (PNG) here");
   cmd->callback([a, t_end] {

@@ -1,6 +1,10 @@
 // The `lcsim` command line. Input errors are exceptions caught once here and
-// printed as one clear line with a non-zero exit (DESIGN.md, Conventions).
+// printed as one clear line with a non-zero exit (DESIGN.md, Conventions);
+// exit_code() is the one map from a status to the exit code.
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <iostream>
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
@@ -12,9 +16,57 @@ std::vector<CommandSetup>& command_registry() {
   static std::vector<CommandSetup> registry;
   return registry;
 }
+
+int exit_code(lcsim::Status status) {
+  switch (status) {
+    case lcsim::Status::kOk:
+      return 0;
+    case lcsim::Status::kInvalidInput:
+      return 2;
+    default:
+      return 3;
+  }
+}
+
+void check_status(lcsim::Status status, const std::string& message) {
+  if (status != lcsim::Status::kOk) throw StatusError(status, message);
+}
+
+std::string name_list(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+namespace {
+
+// SIGINT, SIGTERM: no temporary file and no half-written output remain
+// (outputs are renamed into place only when complete), exit 128 + signo.
+extern "C" void on_signal(int signo) {
+  io::remove_temporary_files();
+  ::_exit(128 + signo);
+}
+
+void install_signal_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  for (int s : {SIGINT, SIGTERM}) sigaction(s, &sa, nullptr);
+}
+
+int report(lcsim::Status status, const char* what) {
+  std::cerr << (status == lcsim::Status::kInvalidInput ? "lcsim: error: "
+                                                       : "lcsim: numerical failure: ")
+            << what << "\n";
+  return exit_code(status);
+}
+
+}  // namespace
 }  // namespace lcsim::cli
 
 int main(int argc, char** argv) {
+  using lcsim::Status;
+  lcsim::cli::install_signal_handlers();
   CLI::App app{"lcsim: linear complementarity systems and unilaterally constrained mechanics"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "lcsim 0.1.0");
@@ -24,14 +76,11 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   } catch (const lcsim::io::InputError& e) {
-    std::cerr << "lcsim: error: " << e.what() << "\n";
-    return 2;
+    return lcsim::cli::report(Status::kInvalidInput, e.what());
   } catch (const std::invalid_argument& e) {
-    std::cerr << "lcsim: error: " << e.what() << "\n";
-    return 2;
-  } catch (const lcsim::cli::NumericalError& e) {
-    std::cerr << "lcsim: numerical failure: " << e.what() << "\n";
-    return 3;
+    return lcsim::cli::report(Status::kInvalidInput, e.what());
+  } catch (const lcsim::cli::StatusError& e) {
+    return lcsim::cli::report(e.status(), e.what());
   } catch (const std::exception& e) {
     std::cerr << "lcsim: error: " << e.what() << "\n";
     return 1;

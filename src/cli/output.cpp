@@ -47,7 +47,14 @@ std::string temp_beside(const std::string& path) {
   ::umask(mask);
   (void)::fchmod(fd, 0666 & ~mask);
   ::close(fd);
+  io::track_temporary_file(name);
   return name;
+}
+
+// Removes a temporary made by temp_beside (or renamed away) from the table.
+void drop_temp(const std::string& name) {
+  ::unlink(name.c_str());
+  io::untrack_temporary_file(name);
 }
 
 std::string last_line(const fs::path& log) {
@@ -61,24 +68,26 @@ std::string last_line(const fs::path& log) {
 
 }  // namespace
 
-void check_writable(const std::string& path) {
-  const std::string tmp = temp_beside(path);
-  ::unlink(tmp.c_str());
-}
+void check_writable(const std::string& path) { drop_temp(temp_beside(path)); }
 
 fs::path find_plot_script(const std::string& name, const char* env_var) {
   if (const char* env = std::getenv(env_var)) return env;
-  std::vector<fs::path> roots = {fs::current_path()};
+  std::vector<fs::path> places;
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (!ec)
-    for (fs::path p = exe.parent_path(); !p.empty() && p != p.root_path(); p = p.parent_path())
-      roots.push_back(p);
-  for (const auto& r : roots)
-    if (fs::exists(r / "bench" / name)) return r / "bench" / name;
-  throw std::runtime_error("bench/" + name +
-                           " not found near the working directory or the lcsim binary (set " +
-                           env_var + ")");
+    places.push_back((exe.parent_path() / ".." / "share" / "lcsim" / name).lexically_normal());
+#ifdef LCSIM_SOURCE_DIR
+  places.push_back(fs::path(LCSIM_SOURCE_DIR) / "bench" / name);
+#endif
+  std::string looked;
+  for (const auto& p : places) {
+    if (fs::is_regular_file(p, ec)) return p;
+    looked += (looked.empty() ? "" : ", ") + p.string();
+  }
+  throw std::runtime_error("the plotting script " + name + " is not installed: looked in " +
+                           (looked.empty() ? std::string("no place") : looked) + " (set " +
+                           env_var + " to its path)");
 }
 
 void draw_plot(const fs::path& script, const fs::path& input, const std::string& out,
@@ -86,6 +95,7 @@ void draw_plot(const fs::path& script, const fs::path& input, const std::string&
   const std::string tmp = temp_beside(out);
   const fs::path log =
       fs::temp_directory_path() / ("lcsim_plot_" + std::to_string(::getpid()) + ".log");
+  io::track_temporary_file(log.string());
   std::vector<std::string> args{
       "/usr/bin/python3", script.string(), input.string(), tmp, "--title", title};
   std::vector<char*> argv;
@@ -109,17 +119,33 @@ void draw_plot(const fs::path& script, const fs::path& input, const std::string&
     why = std::string("cannot run /usr/bin/python3: ") + std::strerror(err);
   else if (!ok)
     why = "the plot script " + script.string() + " failed: " + last_line(log);
-  std::error_code ec;
-  fs::remove(log, ec);
-  if (ok && ::rename(tmp.c_str(), out.c_str()) != 0) {
-    why = out + ": cannot write: " + std::strerror(errno);
-    ::unlink(tmp.c_str());
-    throw io::InputError(option + ": " + why);
+  drop_temp(log.string());
+  if (ok && ::rename(tmp.c_str(), out.c_str()) == 0) {
+    io::untrack_temporary_file(tmp);
+    return;
   }
-  if (!ok) {
-    ::unlink(tmp.c_str());
-    throw std::runtime_error(option + ": " + why);
+  if (ok) why = out + ": cannot write: " + std::strerror(errno);
+  drop_temp(tmp);
+  if (ok) throw io::InputError(option + ": " + why);
+  throw std::runtime_error(option + ": " + why);
+}
+
+void draw_plot_of_text(const std::string& text, const std::string& name, const fs::path& script,
+                       const std::string& out, const std::string& title,
+                       const std::string& option) {
+  const fs::path n(name);
+  const fs::path tmp =
+      fs::temp_directory_path() /
+      (n.stem().string() + "_" + std::to_string(::getpid()) + n.extension().string());
+  io::write_file_atomic(tmp, text);
+  io::track_temporary_file(tmp.string());
+  try {
+    draw_plot(script, tmp, out, title, option);
+  } catch (...) {
+    drop_temp(tmp.string());
+    throw;
   }
+  drop_temp(tmp.string());
 }
 
 namespace {

@@ -1,7 +1,8 @@
 // Output files of the commands: every file a command writes appears whole or
 // not at all. Text goes through io::write_file_atomic; plots drawn by a Python
 // script are drawn into a temporary file beside the target and renamed into
-// place. Paths are checked before any work starts, so a typo in --out or
+// place; temporaries are tracked (io::track_temporary_file) so a signal
+// removes them. Paths are checked before any work starts, so a typo in --out or
 // --plot fails at once with one line, not after a long run.
 #pragma once
 
@@ -15,11 +16,11 @@ namespace lcsim::cli {
 // a folder. Creates and removes a temporary file to find out.
 void check_writable(const std::string& path);
 
-// The plotting script bench/<name> (a Python file shipped with lcsim): the
-// path in the environment variable `env_var` if set, else the first
-// bench/<name> found in the working directory or a parent folder of the
-// lcsim executable (the build tree sits inside the source tree).
-// std::runtime_error naming both when it is nowhere.
+// The plotting script <name> (a Python file of bench/ shipped with lcsim):
+// the path in the environment variable `env_var` if set, else
+// <dir of the lcsim binary>/../share/lcsim/<name> (installed), else the
+// source tree's bench/<name> (the build-tree binary; LCSIM_SOURCE_DIR is set
+// at build time). std::runtime_error listing where it looked when nowhere.
 std::filesystem::path find_plot_script(const std::string& name, const char* env_var);
 
 // Runs `/usr/bin/python3 script input <tmp> --title title` without a shell,
@@ -29,6 +30,13 @@ std::filesystem::path find_plot_script(const std::string& name, const char* env_
 // the script and the last line it printed (one line).
 void draw_plot(const std::filesystem::path& script, const std::filesystem::path& input,
                const std::string& out, const std::string& title, const std::string& option);
+
+// draw_plot with its input `text` in a temporary file of the system's
+// temporary folder (`name` with the process id before its extension), which
+// is removed afterwards, and by a signal (io::track_temporary_file).
+void draw_plot_of_text(const std::string& text, const std::string& name,
+                       const std::filesystem::path& script, const std::string& out,
+                       const std::string& title, const std::string& option);
 
 // Progress of a long run on stderr, fed by sim::Options::progress:
 //   lcsim: t = 12.5 of 100 (12 %), 3.1 s so far, about 22 s left

@@ -338,10 +338,13 @@ Scene read_scene(const std::string& yaml_text, const std::string& source) {
                "); a simulated joint moves no inertia about its axis");
   }
 
-  if (keys.count("initial")) {
-    const Keys ik = mapping(keys.at("initial"), source, "initial", {"q", "v"});
+  // The initial state: q0 at rest, except the positions and velocities that
+  // `initial` names; a scene without `initial` starts at q0 at rest.
+  {
     VectorXd x(2 * N);
     x << q0v, VectorXd::Zero(N);
+    const Keys ik =
+        keys.count("initial") ? mapping(keys.at("initial"), source, "initial", {"q", "v"}) : Keys{};
     for (const char* part : {"q", "v"}) {
       if (!ik.count(part)) continue;
       for (const auto& [jname, val] :

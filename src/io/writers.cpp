@@ -1,8 +1,11 @@
 // Writers: atomic file output, CSV trajectories, JSON run summaries.
 #include <fcntl.h>
+#include <pthread.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <charconv>
 #include <cstdio>
@@ -77,22 +80,77 @@ nlohmann::json index_set_json(const std::vector<int>& s) {
 
 }  // namespace
 
-void write_file_atomic(const std::filesystem::path& path, const std::string& content) {
+// ---- Temporary files, removed on a signal ----
+//
+// A fixed table of paths as char buffers: a signal handler may walk it and
+// unlink(2) each path (both async-signal-safe) while no allocation or lock is
+// involved. A slot is 0 (free), 1 (being filled) or 2 (holds a path).
+namespace {
+constexpr std::size_t kMaxTemporaryFiles = 32;
+constexpr std::size_t kMaxTemporaryPath = 4096;
+struct TemporarySlot {
+  std::atomic<int> state{0};
+  char path[kMaxTemporaryPath];
+};
+TemporarySlot g_temporary[kMaxTemporaryFiles];
+static_assert(std::atomic<int>::is_always_lock_free);
+}  // namespace
+
+void track_temporary_file(const std::string& path) {
+  if (path.size() >= kMaxTemporaryPath) return;  // not tracked: removed on errors only
+  for (auto& slot : g_temporary) {
+    int expected = 0;
+    if (!slot.state.compare_exchange_strong(expected, 1)) continue;
+    std::memcpy(slot.path, path.c_str(), path.size() + 1);
+    slot.state.store(2);
+    return;
+  }
+}
+
+void untrack_temporary_file(const std::string& path) {
+  for (auto& slot : g_temporary) {
+    int expected = 2;
+    if (slot.state.load() == 2 && path == slot.path &&
+        slot.state.compare_exchange_strong(expected, 1))
+      slot.state.store(0);
+  }
+}
+
+void remove_temporary_files() noexcept {
+  for (auto& slot : g_temporary)
+    if (slot.state.load() == 2) ::unlink(slot.path);
+}
+
+namespace {
+
+// A new empty file ".<name>.tmp-XXXXXX" beside `path`, tracked for removal on
+// a signal, with the mode a plain open would give `path`: the existing
+// file's, or 0666 less the umask. mkstemp creates it 0600; umask can only be
+// read by setting it, so it is set back at once.
+struct TemporaryFile {
+  int fd = -1;
+  std::string name;
+};
+[[noreturn]] void cannot_write(const std::string& where, int err) {
+  throw InputError(where + ": cannot write: " + std::strerror(err));
+}
+TemporaryFile temporary_beside(const std::filesystem::path& path) {
   const std::string where = path.string();
   if (!path.has_filename()) throw InputError(where + ": cannot write: not a file name");
   std::filesystem::path dir = path.parent_path();
   if (dir.empty()) dir = ".";
-  std::string name = (dir / (prefixed(".", path.filename().string()) + ".tmp-XXXXXX")).string();
-  const int fd = ::mkstemp(name.data());
-  if (fd < 0) throw InputError(where + ": cannot write: " + std::strerror(errno));
-  const auto give_up = [&](int err, bool close_fd) {
-    if (close_fd) ::close(fd);
-    ::unlink(name.c_str());
-    throw InputError(where + ": cannot write: " + std::strerror(err));
-  };
-  // mkstemp creates the file 0600; give it the mode a plain open would have:
-  // the existing file's, or 0666 less the umask (umask can only be read by
-  // setting it, so it is set back at once).
+  TemporaryFile t;
+  t.name = (dir / (prefixed(".", path.filename().string()) + ".tmp-XXXXXX")).string();
+  // Signals wait while the file is made and tracked: a SIGINT between the
+  // two would leave it behind.
+  sigset_t all, old;
+  sigfillset(&all);
+  ::pthread_sigmask(SIG_BLOCK, &all, &old);
+  t.fd = ::mkstemp(t.name.data());
+  const int mkstemp_errno = errno;
+  if (t.fd >= 0) track_temporary_file(t.name);
+  ::pthread_sigmask(SIG_SETMASK, &old, nullptr);
+  if (t.fd < 0) cannot_write(where, mkstemp_errno);
   struct stat st {};
   mode_t mode;
   if (::stat(where.c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
@@ -102,22 +160,43 @@ void write_file_atomic(const std::filesystem::path& path, const std::string& con
     ::umask(mask);
     mode = 0666 & ~mask;
   }
-  if (::fchmod(fd, mode) != 0) give_up(errno, true);
+  if (::fchmod(t.fd, mode) != 0) {
+    const int err = errno;
+    ::close(t.fd);
+    ::unlink(t.name.c_str());
+    untrack_temporary_file(t.name);
+    cannot_write(where, err);
+  }
+  return t;
+}
+
+// All of `data` to fd; 0 or the errno of the failure.
+int write_all(int fd, const char* data, std::size_t size) {
   std::size_t done = 0;
-  while (done < content.size()) {
-    const ssize_t n = ::write(fd, content.data() + done, content.size() - done);
+  while (done < size) {
+    const ssize_t n = ::write(fd, data + done, size - done);
     if (n < 0) {
       if (errno == EINTR) continue;
-      give_up(errno, true);
+      return errno;
     }
     done += static_cast<std::size_t>(n);
   }
-  if (::fsync(fd) != 0) give_up(errno, true);
-  if (::close(fd) != 0) give_up(errno, false);
-  if (::rename(name.c_str(), where.c_str()) != 0) give_up(errno, false);
+  return 0;
 }
 
-std::string trajectory_csv(const mech::Model& model, const sim::Trajectory& traj) {
+// fsync, close and rename the temporary into place: 0 or the errno. The
+// temporary is untracked once it is gone (renamed or removed).
+int finish_temporary(TemporaryFile& t, const std::string& where, int err) {
+  if (err == 0 && ::fsync(t.fd) != 0) err = errno;
+  if (::close(t.fd) != 0 && err == 0) err = errno;
+  t.fd = -1;
+  if (err == 0 && ::rename(t.name.c_str(), where.c_str()) != 0) err = errno;
+  if (err != 0) ::unlink(t.name.c_str());
+  untrack_temporary_file(t.name);
+  return err;
+}
+
+std::vector<std::string> csv_header(const mech::Model& model) {
   const int n = model.state_size();
   const int k = model.num_constraints();
   std::vector<std::string> header{"t"};
@@ -133,38 +212,104 @@ std::string trajectory_csv(const mech::Model& model, const sim::Trajectory& traj
     for (int i = 1; i <= k; ++i) header.push_back(prefixed("y", std::to_string(i)));
   }
   header.push_back("mode");
+  return header;
+}
 
-  std::string out;
+void append_csv_header(std::string& out, const mech::Model& model) {
+  const std::vector<std::string> header = csv_header(model);
   for (std::size_t i = 0; i < header.size(); ++i)
     out += prefixed(i ? "," : "", csv_field(header[i]));
   out += '\n';
-  // u and y may be empty in a sample (e.g. an event-only record): blank cells.
-  const auto append_vector = [&](const VectorXd& v, int size, const char* what, std::size_t row) {
-    if (v.size() != 0 && v.size() != size)
-      throw std::logic_error("trajectory_csv: sample " + std::to_string(row) + " has " + what +
-                             " of size " + std::to_string(v.size()) + ", expected " +
-                             std::to_string(size));
-    for (int j = 0; j < size; ++j) {
-      out += ',';
-      if (v.size() != 0) append_number(out, v(j));
-    }
-  };
-  for (std::size_t r = 0; r < traj.samples.size(); ++r) {
-    const sim::Sample& s = traj.samples[r];
-    if (s.x.size() != n)
-      throw std::logic_error("trajectory_csv: sample " + std::to_string(r) +
-                             " has a state of size " + std::to_string(s.x.size()) + ", expected " +
-                             std::to_string(n));
-    append_number(out, s.t);
-    append_vector(s.x, n, "x", r);
-    append_vector(s.u, k, "u", r);
-    append_vector(s.y, k, "y", r);
+}
+
+// u and y may be empty in a sample (e.g. an event-only record): blank cells.
+void append_csv_vector(std::string& out, const VectorXd& v, int size, const char* what,
+                       std::size_t row) {
+  if (v.size() != 0 && v.size() != size)
+    throw std::logic_error("trajectory_csv: sample " + std::to_string(row) + " has " + what +
+                           " of size " + std::to_string(v.size()) + ", expected " +
+                           std::to_string(size));
+  for (int j = 0; j < size; ++j) {
     out += ',';
-    for (std::size_t j = 0; j < s.mode.size(); ++j)
-      out += prefixed(j ? ";" : "", std::to_string(s.mode[j]));
-    out += '\n';
+    if (v.size() != 0) append_number(out, v(j));
   }
+}
+
+// Row `r` of the CSV: t, x, u, y, mode.
+void append_csv_row(std::string& out, const sim::Sample& s, int n, int k, std::size_t r) {
+  if (s.x.size() != n)
+    throw std::logic_error("trajectory_csv: sample " + std::to_string(r) + " has a state of size " +
+                           std::to_string(s.x.size()) + ", expected " + std::to_string(n));
+  append_number(out, s.t);
+  append_csv_vector(out, s.x, n, "x", r);
+  append_csv_vector(out, s.u, k, "u", r);
+  append_csv_vector(out, s.y, k, "y", r);
+  out += ',';
+  for (std::size_t j = 0; j < s.mode.size(); ++j)
+    out += prefixed(j ? ";" : "", std::to_string(s.mode[j]));
+  out += '\n';
+}
+
+}  // namespace
+
+void write_file_atomic(const std::filesystem::path& path, const std::string& content) {
+  TemporaryFile t = temporary_beside(path);
+  const int err =
+      finish_temporary(t, path.string(), write_all(t.fd, content.data(), content.size()));
+  if (err != 0) cannot_write(path.string(), err);
+}
+
+std::string trajectory_csv(const mech::Model& model, const sim::Trajectory& traj) {
+  std::string out;
+  append_csv_header(out, model);
+  const int n = model.state_size(), k = model.num_constraints();
+  for (std::size_t r = 0; r < traj.samples.size(); ++r)
+    append_csv_row(out, traj.samples[r], n, k, r);
   return out;
+}
+
+// ---- TrajectoryCsvWriter ----
+
+TrajectoryCsvWriter::TrajectoryCsvWriter(const std::filesystem::path& path,
+                                         const mech::Model& model)
+    : path_(path.string()), n_(model.state_size()), k_(model.num_constraints()) {
+  TemporaryFile t = temporary_beside(path);
+  fd_ = t.fd;
+  temporary_ = std::move(t.name);
+  append_csv_header(buffer_, model);
+}
+
+TrajectoryCsvWriter::~TrajectoryCsvWriter() {
+  if (fd_ < 0) return;
+  ::close(fd_);
+  ::unlink(temporary_.c_str());
+  untrack_temporary_file(temporary_);
+}
+
+void TrajectoryCsvWriter::write(const sim::Sample& s) noexcept {
+  if (fd_ < 0 || error_ != 0 || !logic_error_.empty()) return;
+  try {
+    append_csv_row(buffer_, s, n_, k_, rows_++);
+  } catch (const std::exception& e) {
+    logic_error_ = e.what();
+    return;
+  }
+  if (buffer_.size() >= kBufferBytes) flush();
+}
+
+void TrajectoryCsvWriter::flush() noexcept {
+  if (error_ == 0) error_ = write_all(fd_, buffer_.data(), buffer_.size());
+  buffer_.clear();
+}
+
+void TrajectoryCsvWriter::commit() {
+  if (fd_ < 0) throw std::logic_error("TrajectoryCsvWriter::commit: called twice");
+  if (!logic_error_.empty()) throw std::logic_error(logic_error_);
+  flush();
+  TemporaryFile t{fd_, temporary_};
+  fd_ = -1;
+  const int err = finish_temporary(t, path_, error_);
+  if (err != 0) cannot_write(path_, err);
 }
 
 nlohmann::json trajectory_json(const mech::Model& model, const sim::Trajectory& traj) {

@@ -159,7 +159,9 @@ TEST(Scene, DoublePendulumAwayFromEquilibrium) {
   EXPECT_EQ(m.E.coeff(1, 0), -1.0);
   EXPECT_EQ(m.g(1), 1.5);
   EXPECT_EQ(m.g(2), 2.0);
-  EXPECT_FALSE(model.initial.size());  // no initial: in the file
+  // No `initial` in the file: q0 at rest, (0.3, -0.2, 0, 0) exactly (the
+  // absolute joint positions of q0, docs/model-format.md).
+  EXPECT_EQ(model.initial, (VectorXd(4) << t1, t2, 0.0, 0.0).finished());
 }
 
 // The arm with a gripper: 6 joints, 2 simulated. Expected M by a method

@@ -173,6 +173,80 @@ TEST(TrajectoryCsv, WrongStateSizeIsAProgrammingError) {
   EXPECT_THROW(trajectory_csv(two_carts_model(), tr), std::logic_error);
 }
 
+// The streaming writer: while the run goes only a temporary exists beside
+// the target; commit() puts exactly trajectory_csv's text (the hand-written
+// rows above) in place; no commit, nothing.
+TEST(TrajectoryCsvWriter, CommitGivesTheCsvAndNothingElse) {
+  const fs::path dir = scratch_dir("stream");
+  const fs::path file = dir / "t.csv";
+  const sim::Trajectory tr = hand_made();
+  {
+    TrajectoryCsvWriter w(file, two_carts_model());
+    for (const auto& s : tr.samples) w.write(s);
+    EXPECT_EQ(entries(dir),
+              std::vector<std::string>{w.temporary_path().substr(dir.string().size() + 1)});
+    EXPECT_EQ(fs::path(w.temporary_path()).filename().string().rfind(".t.csv.tmp-", 0), 0u);
+    w.commit();
+  }
+  EXPECT_EQ(slurp(file), trajectory_csv(two_carts_model(), tr));
+  EXPECT_EQ(entries(dir), std::vector<std::string>{"t.csv"});
+  {
+    // A run that failed: the writer goes away without commit; the old file stays.
+    TrajectoryCsvWriter w(dir / "t.csv", two_carts_model());
+    w.write(tr.samples[0]);
+  }
+  EXPECT_EQ(slurp(file), trajectory_csv(two_carts_model(), tr));
+  EXPECT_EQ(entries(dir), std::vector<std::string>{"t.csv"});
+}
+
+// Rows past the 1 MiB buffer go to disk as they come: 20000 rows of the
+// hand-made sample, the same text as trajectory_csv of them held in memory.
+TEST(TrajectoryCsvWriter, LongRunsAreFlushedAndWhole) {
+  const fs::path dir = scratch_dir("stream_long");
+  sim::Trajectory tr;
+  tr.samples.assign(20000, hand_made().samples[0]);
+  for (std::size_t i = 0; i < tr.samples.size(); ++i) tr.samples[i].t = 1e-3 * i;
+  TrajectoryCsvWriter w(dir / "t.csv", two_carts_model());
+  for (const auto& s : tr.samples) w.write(s);
+  EXPECT_GT(fs::file_size(w.temporary_path()), 0u);  // flushed before commit
+  w.commit();
+  EXPECT_EQ(slurp(dir / "t.csv"), trajectory_csv(two_carts_model(), tr));
+}
+
+TEST(TrajectoryCsvWriter, UnwritableTargetFailsAtOnce) {
+  const fs::path dir = scratch_dir("stream_bad");
+  EXPECT_THROW(TrajectoryCsvWriter(dir / "no" / "t.csv", two_carts_model()), InputError);
+  EXPECT_TRUE(entries(dir).empty());
+}
+
+// A wrong sample is a programming error, reported at commit (write must not
+// throw: it runs inside the integrator); nothing is written.
+TEST(TrajectoryCsvWriter, WrongSampleIsReportedAtCommit) {
+  const fs::path dir = scratch_dir("stream_wrong");
+  sim::Trajectory tr = hand_made();
+  tr.samples[0].x = VectorXd::Zero(5);
+  {
+    TrajectoryCsvWriter w(dir / "t.csv", two_carts_model());
+    w.write(tr.samples[0]);
+    EXPECT_THROW(w.commit(), std::logic_error);
+  }
+  EXPECT_TRUE(entries(dir).empty());
+}
+
+// What a signal handler calls: every tracked temporary is removed, the
+// others are not touched.
+TEST(TemporaryFiles, RemovedOnRequest) {
+  const fs::path dir = scratch_dir("tracked");
+  TrajectoryCsvWriter w(dir / "t.csv", two_carts_model());
+  std::ofstream(dir / "other.txt") << "keep";
+  const std::string mine = (dir / ".mine.tmp").string();
+  std::ofstream(mine) << "x";
+  track_temporary_file(mine);
+  remove_temporary_files();
+  EXPECT_EQ(entries(dir), std::vector<std::string>{"other.txt"});
+  untrack_temporary_file(mine);
+}
+
 TEST(TrajectoryJson, RoundTrip) {
   const sim::Trajectory tr = hand_made();
   const std::string text = trajectory_json(two_carts_model(), tr).dump(2);

@@ -67,6 +67,40 @@ void write_file_atomic(const std::filesystem::path& path, const std::string& con
 // otherwise), u1.., y1.., mode (active constraints joined by ';').
 std::string trajectory_csv(const mech::Model& model, const sim::Trajectory& traj);
 
+// The same CSV streamed to disk as a run goes (sim::Options::sample_sink), so
+// a long run's output never has to fit in memory: rows go to a temporary
+// file beside `path` (".<name>.tmp-XXXXXX"), which commit() renames into
+// place; a writer destroyed without commit() (a failed or refused run, an
+// exception) removes it. So `path` appears whole or not at all.
+// The constructor throws InputError when no file can be created beside
+// `path`; write() never throws (a sink must not): a write error is kept and
+// thrown by commit() as InputError "<path>: cannot write: <reason>".
+class TrajectoryCsvWriter {
+ public:
+  TrajectoryCsvWriter(const std::filesystem::path& path, const mech::Model& model);
+  ~TrajectoryCsvWriter();
+  TrajectoryCsvWriter(const TrajectoryCsvWriter&) = delete;
+  TrajectoryCsvWriter& operator=(const TrajectoryCsvWriter&) = delete;
+  void write(const sim::Sample& sample) noexcept;
+  void commit();
+  const std::string& temporary_path() const { return temporary_; }
+
+ private:
+  void flush() noexcept;
+  static constexpr std::size_t kBufferBytes = 1 << 20;
+  std::string path_, temporary_, buffer_, logic_error_;
+  int n_ = 0, k_ = 0, fd_ = -1, error_ = 0;
+  std::size_t rows_ = 0;
+};
+
+// The temporary files of the writers above (and of any caller that tracks
+// its own) are kept in a fixed table, so that a signal handler can remove
+// them: remove_temporary_files() is async-signal-safe (unlink(2) over a
+// table of char buffers; at most 32 files, paths under 4096 bytes).
+void track_temporary_file(const std::string& path);
+void untrack_temporary_file(const std::string& path);
+void remove_temporary_files() noexcept;
+
 // `text` cut at every `sep` ("a,,b" gives "a", "", "b"; "" gives none): the
 // comma lists of names and ranges the commands take.
 std::vector<std::string> split(const std::string& text, char sep);
