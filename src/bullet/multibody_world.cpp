@@ -239,7 +239,6 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const io::Scene& se
   };
   const mech::MechanicalModel& m = *model.mechanical;
   const int N = m.dofs(), k = m.num_constraints();
-  if (const std::string bad = check_run(model, x0, opt); !bad.empty()) return fail(bad);
 
   // The scene's own forces: K and f without the linearised gravity.
   const io::UrdfLinearisation& lin = setup.lin;

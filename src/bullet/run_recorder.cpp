@@ -7,18 +7,6 @@ namespace lcsim::bullet {
 
 using Eigen::VectorXd;
 
-std::string check_run(const mech::Model& model, const Eigen::VectorXd& x0,
-                      const sim::Options& opt) {
-  const int N = model.mechanical->dofs();
-  if (x0.size() != 2 * N)
-    return "bullet: initial state has " + std::to_string(x0.size()) + " entries, the model needs " +
-           std::to_string(2 * N);
-  if (const std::string bad = sim::check_step_options(opt, false); !bad.empty())
-    return "bullet: " + bad;
-  if (const std::string bad = sim::infeasible_start(model, x0); !bad.empty())
-    return "bullet: " + bad;
-  return "";
-}
 
 RunRecorder::RunRecorder(const mech::MechanicalModel& m, const sim::Options& opt,
                          sim::Trajectory& tr, const VectorXd& q0, const VectorXd& v0)

@@ -15,10 +15,7 @@ namespace lcsim::bullet {
 // every mode change (an impact when a gained constraint was approached, a
 // release when constraints were only lost, else a contact), max_violation,
 // steps, lcp_solves, energies (of the model at Bullet's states).
-// The checks both scenes make before a run: "" when usable, else the
-// failure message ("bullet: initial state has ...", a bad step, an
-// infeasible start).
-std::string check_run(const mech::Model& model, const Eigen::VectorXd& x0, const sim::Options& opt);
+
 
 class RunRecorder {
  public:

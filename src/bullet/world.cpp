@@ -298,7 +298,6 @@ sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>&
   };
   const mech::MechanicalModel& m = *model.mechanical;
   const int N = m.dofs(), k = m.num_constraints();
-  if (const std::string bad = check_run(model, x0, opt); !bad.empty()) return fail(bad);
   VectorXd q = x0.head(N), v = x0.tail(N);
   if (m.D.norm() > 0.0)
     tr.add_warning(
@@ -385,8 +384,27 @@ sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>&
 
 }  // namespace
 
+namespace {
+sim::OptionsUsed bullet_options_used() {
+  sim::OptionsUsed u;  // Bullet's own contact solver and restitution
+  u.h = u.needs_mechanical = true;
+  return u;
+}
+}  // namespace
+
 sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
-                                const sim::Options& opt, const WorldSettings& s) {
+                                const sim::Options& options, const WorldSettings& s) {
+  // The library's one check of a run's input, as sim::Integrator::run makes.
+  sim::Options opt = options;
+  if (!opt.t_end && std::isfinite(model.t_end)) opt.t_end = model.t_end;
+  if (const std::string why = sim::check_run(model, x0, opt, "bullet", bullet_options_used());
+      !why.empty()) {
+    sim::Trajectory tr;
+    tr.method = "bullet";
+    tr.status = sim::RunStatus::kInvalidInput;
+    tr.message = why;
+    return tr;
+  }
   const Plan p = plan_of(model, s);  // throws for an inexpressible model
   sim::Trajectory tr = p.scene ? simulate_multibody(model, *p.scene, p.joint_limits, x0, opt, s)
                                : simulate_rb6(model, p.rb6_limits, x0, opt, s);
@@ -399,11 +417,7 @@ namespace {
 class BulletIntegrator : public sim::Integrator {
  public:
   std::string name() const override { return "bullet"; }
-  sim::OptionsUsed options_used() const override {
-    sim::OptionsUsed u;  // Bullet's own contact solver and restitution
-    u.h = true;
-    return u;
-  }
+  sim::OptionsUsed options_used() const override { return bullet_options_used(); }
   sim::Trajectory integrate(const mech::Model& model, const VectorXd& x0,
                             const sim::Options& opt) const override {
     return simulate_bullet(model, x0, opt);

@@ -139,6 +139,15 @@ std::string check_run(const mech::Model& model, const VectorXd& x0, const Option
     if (!std::isfinite(x0(i)))
       return "initial state[" + std::to_string(i) + "]: not finite (got " + short_number(x0(i)) +
              ")";
+  if (used.needs_mechanical && !model.is_mechanical())
+    return "method '" + std::string(method) + "' needs a mechanical model ('" + model.name +
+           "' is a general LCS; the methods 'event' and 'euler' take one)";
+  if (used.dense_lcs && model.lcs_state_size() > mech::kMaxDenseLcsState)
+    return "method '" + std::string(method) +
+           "' works on the dense LCS (matrix exponentials and LCPs of size n = 2N + 1), and " +
+           "model '" + model.name + "' has size " + std::to_string(model.lcs_state_size()) +
+           ", more than the " + std::to_string(mech::kMaxDenseLcsState) +
+           " it allows; method 'moreau-jean' works on the sparse model";
   if (!opt.t_end) return "no horizon: set Options::t_end, or t_end in the model";
   if (std::string m = check_values(opt, used); !m.empty()) return m;
   if (std::string m = ignored_options(opt, method, used); !m.empty()) return m;

@@ -86,26 +86,11 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
   }
   const int n = sys.n(), k = sys.k();
   VectorXd x(n);
-  if (x0_user.size() != model.state_size()) {
-    tr.status = RunStatus::kNumericalFailure;
-    tr.message = "euler: initial state has " + std::to_string(x0_user.size()) +
-                 " entries, the model needs " + std::to_string(model.state_size());
-    tr.final_state = x0_user;
-    return tr;
-  }
-  if (const std::string bad = infeasible_start(model, x0_user); !bad.empty()) {
-    tr.status = RunStatus::kNumericalFailure;
-    tr.message = "euler: " + bad;
-    tr.final_state = x0_user;
-    return tr;
-  }
   if (mech)
     x << x0_user, 1.0;
   else
     x = x0_user;
   tr.energy_initial = energy(x);
-  if (const std::string err = check_step_options(opt, false); !err.empty())
-    return fail("euler: " + err, x);
 
   // Consistency guard (§7.3, Example 7.3.3): with a leading row index
   // rho_i >= 3 backward Euler produces impulses of order h^{1-rho_i} and does

@@ -139,7 +139,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     phase = make_phase(ev.mode, ldcp_undetermined_, ev.x_plus, err);
     if (!err.empty()) fail(err);
   }
-  if (tr.status == RunStatus::kNumericalFailure) {
+  if (tr.status != RunStatus::kCompleted) {
     tr.final_state = x0_user;
     tr.energy_final = tr.energy_initial;
     return tr;
@@ -352,6 +352,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
       msg << "more than " << events_in_window << " events in less than unit time near t = " << t
           << ": the event times accumulate without a limit the simulator can take";
       fail(msg.str());
+      tr.status = RunStatus::kEventLimit;
       xa = x_minus;
       break;
     }
@@ -379,6 +380,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     }
     if (const std::string why = livelock.after_event(t, x_minus, xa, old_mode, ev); !why.empty()) {
       fail(why);
+      tr.status = RunStatus::kEventLimit;
       break;
     }
     Event e;
@@ -434,15 +436,6 @@ Trajectory integrate_event_driven(const mech::Model& model, const VectorXd& x0,
     tr.final_state = x0;
     return tr;
   };
-  // The exact method is dense in the state: matrix exponentials of size n
-  // (2N+1 for N coordinates) cost O(n^3) per evaluation. Refused before any
-  // dense matrix is built.
-  if (model.lcs_state_size() > mech::kMaxDenseLcsState)
-    return refuse(
-        "the exact event-driven method is dense in the state (matrix exponentials of size " +
-        std::to_string(model.lcs_state_size()) + " > " + std::to_string(mech::kMaxDenseLcsState) +
-        "); use a time-stepping method (--method moreau-jean) for models this large");
-  if (const std::string bad = infeasible_start(model, x0); !bad.empty()) return refuse(bad);
   detail::EventDriven ed(model, opt);
   return ed.run(x0);
 }

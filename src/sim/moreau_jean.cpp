@@ -87,22 +87,8 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
   tr.method = "moreau-jean";
   tr.t_end = *opt.t_end;
   tr.impact_law = "moreau-restitution";  // the law inside the velocity LCP
-  if (!model.is_mechanical()) {
-    tr.status = RunStatus::kNumericalFailure;
-    tr.message = "moreau-jean: needs a mechanical model ('" + model.name +
-                 "' is a general LCS; use euler or event)";
-    tr.final_state = x0;
-    return tr;
-  }
   const mech::MechanicalModel& m = *model.mechanical;
   const int N = m.dofs(), k = m.num_constraints();
-  if (x0.size() != 2 * N) {
-    tr.status = RunStatus::kNumericalFailure;
-    tr.message = "moreau-jean: initial state has " + std::to_string(x0.size()) +
-                 " entries, the model needs " + std::to_string(2 * N);
-    tr.final_state = x0;
-    return tr;
-  }
   const MjOperators ops(m, N > opt.sparse_dofs_threshold);
   VectorXd q = x0.head(N), v = x0.tail(N);
   tr.energy_initial = ops.energy(q, v);
@@ -119,10 +105,6 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     tr.message = msg;
     return finish();
   };
-  if (const std::string err = check_step_options(opt, true); !err.empty())
-    return fail("moreau-jean: " + err);
-  if (const std::string bad = infeasible_start(model, x0); !bad.empty())
-    return fail("moreau-jean: " + bad);
   std::unique_ptr<lcp::Solver> solver;
   try {
     solver = lcp::make_solver(opt.lcp_solver);

@@ -37,7 +37,7 @@ class EulerIntegrator : public Integrator {
   std::string name() const override { return "euler"; }
   OptionsUsed options_used() const override {
     OptionsUsed u;  // every impact inelastic: Options::impact is not read
-    u.h = u.lcp_solver = u.force = true;
+    u.h = u.lcp_solver = u.force = u.dense_lcs = true;
     return u;
   }
   Trajectory integrate(const mech::Model& model, const VectorXd& x0,
@@ -51,7 +51,7 @@ class MoreauJeanIntegrator : public Integrator {
   std::string name() const override { return "moreau-jean"; }
   OptionsUsed options_used() const override {
     OptionsUsed u;  // its impact law is restitution inside the step LCP
-    u.h = u.theta = u.lcp_solver = u.linear_algebra = true;
+    u.h = u.theta = u.lcp_solver = u.linear_algebra = u.needs_mechanical = true;
     return u;
   }
   Trajectory integrate(const mech::Model& model, const VectorXd& x0,

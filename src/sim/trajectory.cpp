@@ -65,18 +65,6 @@ std::string short_number(double x) {
   return s.str();
 }
 
-std::string check_step_options(const Options& opt, bool theta_used) {
-  const auto fmt = short_number;
-  if (!(*opt.t_end > 0.0) || !std::isfinite(*opt.t_end))
-    return "t_end must be a finite number > 0 (got " + fmt(*opt.t_end) + ")";
-  if (!(opt.h > 0.0) || !std::isfinite(opt.h))
-    return "step h must be a finite number > 0 (got " + fmt(opt.h) + ")";
-  if (*opt.t_end / opt.h > 1e9)
-    return "t_end / h = " + fmt(*opt.t_end / opt.h) + " steps is more than 1e9";
-  if (theta_used && !(opt.theta >= 0.0 && opt.theta <= 1.0))
-    return "theta must lie in [0, 1] (got " + fmt(opt.theta) + ")";
-  return "";
-}
 
 namespace {}  // namespace
 
@@ -90,7 +78,7 @@ class EventDrivenIntegrator : public Integrator {
   std::string name() const override { return "event"; }
   OptionsUsed options_used() const override {
     OptionsUsed u;
-    u.impact = u.lcp_solver = u.event_search = true;
+    u.impact = u.lcp_solver = u.event_search = u.dense_lcs = true;
     return u;
   }
   Trajectory integrate(const mech::Model& model, const VectorXd& x0,

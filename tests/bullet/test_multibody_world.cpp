@@ -43,7 +43,8 @@ BulletRun compare_at(const mech::Model& m, const Eigen::VectorXd& x0, double h, 
   o.t_end = t_end;
   o.h = h;
   o.dt_out = std::max(1.0, std::round(t_end / (2000 * h))) * h;
-  const sim::Trajectory ex = sim::simulate_event_driven(m, x0, o);
+  const auto event = sim::make_integrator("event");  // it has no step: keep_used resets h
+  const sim::Trajectory ex = event->run(m, x0, sim::keep_used(o, event->options_used()));
   EXPECT_EQ(ex.status, sim::RunStatus::kCompleted) << ex.message;
   BulletRun r;
   r.bullet = simulate_bullet(m, x0, o, s);

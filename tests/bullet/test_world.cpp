@@ -158,7 +158,7 @@ TEST(BulletWorld, InexpressibleModelsAreRefusedNamingTheConstraint) {
 TEST(BulletWorld, InfeasibleStartAndUnreproducibleSettingsAreReported) {
   mech::Model ball = load("ball.yaml");  // e = 0.5
   sim::Trajectory tr = bullet_run(ball, Eigen::Vector2d(-0.1, 0.0), 1e-3, 0.0);
-  EXPECT_EQ(tr.status, sim::RunStatus::kNumericalFailure);
+  EXPECT_EQ(tr.status, sim::RunStatus::kInvalidInput);
   EXPECT_NE(tr.message.find("constraint 'ground' is violated at t = 0 (gap = -0.1)"),
             std::string::npos)
       << tr.message;

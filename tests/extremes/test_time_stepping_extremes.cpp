@@ -316,7 +316,7 @@ TEST_P(SimultaneousImpactsStepping, ChainStopsAtOnce) {
        {std::pair{kMj05, 1.01 * h / 2}, {kMj1, 1.01 * h}, {kEuler, 1e-9}}) {
     const auto tr = step(s, model, x0, 2.0, h);
     if (s.method[0] == 'e' && N == 1000) {
-      EXPECT_EQ(tr.status, sim::RunStatus::kNumericalFailure);
+      EXPECT_EQ(tr.status, sim::RunStatus::kInvalidInput);
       EXPECT_NE(tr.message.find("more than the 1001"), std::string::npos) << tr.message;
       continue;
     }
@@ -484,7 +484,7 @@ TEST(SteppingExtremes, InfeasibleStartIsRefused) {
   b.constraints = {"floor"};
   for (const Scheme& s : {kMj05, kMj1, kEuler}) {
     const auto tr = step(s, wrap(b), Eigen::Vector2d(-0.1, 0), 1.0, 1e-3);
-    EXPECT_EQ(tr.status, sim::RunStatus::kNumericalFailure) << label(s);
+    EXPECT_EQ(tr.status, sim::RunStatus::kInvalidInput) << label(s);
     EXPECT_NE(tr.message.find("floor"), std::string::npos) << label(s) << ": " << tr.message;
   }
 }

@@ -238,14 +238,14 @@ TEST(TimeStepping, TripleIntegratorGuardAndBlowUp) {
 TEST(TimeStepping, FailuresAreReportedNotThrown) {
   const mech::Model lcs_model = load("triple_integrator.yaml");
   const auto tr = run("moreau-jean", lcs_model, lcs_model.initial, 1.0, 1e-2);
-  EXPECT_EQ(tr.status, sim::RunStatus::kNumericalFailure);
+  EXPECT_EQ(tr.status, sim::RunStatus::kInvalidInput);
   EXPECT_NE(tr.message.find("mechanical"), std::string::npos);
   const mech::Model carts = load("two_carts.yaml");
   const auto bad_h = run("euler", carts, carts.initial, 1.0, -1.0);
-  EXPECT_EQ(bad_h.status, sim::RunStatus::kNumericalFailure);
+  EXPECT_EQ(bad_h.status, sim::RunStatus::kInvalidInput);
   EXPECT_TRUE(bad_h.final_state.allFinite());
   const auto bad_theta = run("moreau-jean", carts, carts.initial, 1.0, 1e-2, 1.5);
-  EXPECT_EQ(bad_theta.status, sim::RunStatus::kNumericalFailure);
+  EXPECT_EQ(bad_theta.status, sim::RunStatus::kInvalidInput);
 }
 
 // Output grid: with dt_out a multiple of h the samples fall on it exactly, and

@@ -159,6 +159,11 @@ struct OptionsUsed {
   bool event_search = false;    // event_time_tol, max_events*, livelock_events, accumulation_*
   bool force = false;           // backward Euler's consistency override
   bool linear_algebra = false;  // sparse_dofs_threshold, pivot_max_active
+  // Not options, what the method needs of the model: a mechanical one
+  // (Moreau–Jean, Bullet), or an LCS small enough to be dense (the exact
+  // method and backward Euler: mech::kMaxDenseLcsState).
+  bool needs_mechanical = false;
+  bool dense_lcs = false;
 };
 
 class Integrator {
@@ -221,7 +226,6 @@ std::string infeasible_start(const mech::Model& model, const VectorXd& x0);
 // - the step grid: n steps of h, the last shortened so that t_n = t_end
 //   (h "divides" t_end when t_end / h is an integer to 1e-9 relative);
 // - the output sampler on the grid dt_out (every step when dt_out = 0);
-// - the checks of t_end, h and (when used) theta: "" when usable.
 struct StepGrid {
   long n = 0;
   double h = 0.0;
@@ -238,7 +242,6 @@ class OutputSampler {
   double dt_out_;
   double next_;
 };
-std::string check_step_options(const Options& opt, bool theta_used);
 
 // A number with six significant digits, as the integrators' messages print it
 // ("0.001", "3.16228e+04").
