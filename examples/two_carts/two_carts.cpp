@@ -22,7 +22,8 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "%s: not a mechanical model\n", argv[1]);
       return 2;
     }
-    lcsim::sim::Options opt;  // defaults; t_end unset: the model's horizon
+    lcsim::sim::Options opt;                             // defaults, but the horizon:
+    opt.t_end = model.t_end;                             // the model's own (3 s in the file)
     auto method = lcsim::sim::make_integrator("event");  // the exact method
     // The model's initial state (q then v), as the file gives it.
     const lcsim::sim::Trajectory traj = method->run(model, model.initial, opt);
