@@ -88,6 +88,7 @@ else
   #    (CPU user time of one -O1 -g1 ASan+UBSan compile of each file, flags
   #    from build-asan/compile_commands.json, /usr/bin/time -f %U; the
   #    libraries are shared by all, so the test files are what a subset saves):
+  #    extremes/test_time_stepping_extremes.cpp 75 s,
   #    extremes/test_event_driven_extremes.cpp 65 s,
   #    bullet/test_multibody_world.cpp 45 s, bullet/test_world.cpp 14 s,
   #    against lcp/solvers_test.cpp 28 s, sim/test_coupled_contacts.cpp 31 s,
