@@ -1,6 +1,7 @@
 # Every dependency comes from a Debian 12 package and is found here; a missing
 # one stops the configuration with the name of the package that provides it.
 include(FindPkgConfig)
+include(${CMAKE_CURRENT_LIST_DIR}/LcsimImportedTargets.cmake)
 
 macro(lcsim_require_package name debian)
   find_package(${name} ${ARGN} QUIET)
@@ -10,7 +11,7 @@ macro(lcsim_require_package name debian)
 endmacro()
 
 macro(lcsim_require_pkgconfig prefix module debian)
-  pkg_check_modules(${prefix} QUIET IMPORTED_TARGET ${module})
+  lcsim_import_pkgconfig(${prefix} ${module})
   if(NOT ${prefix}_FOUND)
     message(FATAL_ERROR "lcsim: pkg-config module '${module}' not found. Install the Debian package: apt-get install ${debian}")
   endif()
@@ -26,6 +27,7 @@ lcsim_require_package(yaml-cpp libyaml-cpp-dev)
 lcsim_require_package(CLI11 libcli11-dev)
 lcsim_require_package(nlohmann_json nlohmann-json3-dev)
 lcsim_require_package(urdfdom liburdfdom-dev)
+lcsim_import_urdfdom()
 lcsim_require_pkgconfig(BULLET bullet-float64 libbullet-dev)
 lcsim_require_pkgconfig(IPOPT ipopt coinor-libipopt-dev)
 if(LCSIM_BUILD_TESTS)
