@@ -424,18 +424,9 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
 
 }  // namespace detail
 
-// The method on input that Integrator::run has checked (trajectory.cpp).
+// The method on input that Integrator::run has checked (simulate.cpp).
 Trajectory integrate_event_driven(const mech::Model& model, const VectorXd& x0,
                                   const Options& opt) {
-  const auto refuse = [&](const std::string& why) {
-    Trajectory tr;
-    tr.method = "event";
-    tr.t_end = *opt.t_end;
-    tr.status = RunStatus::kNumericalFailure;
-    tr.message = why;
-    tr.final_state = x0;
-    return tr;
-  };
   detail::EventDriven ed(model, opt);
   return ed.run(x0);
 }
