@@ -31,8 +31,9 @@ struct Scaling {
   VectorXd unscale(const VectorXd& z_scaled) const { return c.cwiseProduct(z_scaled); }
 };
 Scaling scale(const MatrixXd& M, const VectorXd& q, VectorXd r, VectorXd c);
-// 2^-e with 2^(e - 1) <= m < 2^e (1 if m is 0 or not finite): the power of
-// two that brings a row of largest magnitude m to [0.5, 1), exactly.
+// 2^-e with 2^(e - 1) <= m < 2^e (1 if m is 0 or not finite, e clamped to
+// [-1000, 1000]): the power of two that brings a row of largest magnitude m
+// to [0.5, 1), exactly.
 double row_scale(double m);
 // r_i = 2^-e_i with 2^(e_i - 1) <= max_j |M_ij| < 2^e_i (|q_i| for a zero row,
 // 1 if both vanish), c = 1: powers of two, so M' and q' are exact.

@@ -40,6 +40,10 @@ Result solve_scaled(const Solver& first, const MatrixXd& M, const VectorXd& q, c
   const std::string bad = detail::validate_all(M, q, opt);
   if (!bad.empty()) return detail::invalid(bad);
   const detail::Scaling sc = detail::symmetric_scaling(M, q);
+  // A subnormal diagonal (1 / sqrt(M_ii) ~ 1e155) can overflow the scaled
+  // problem: solve the original one then.
+  if (!sc.M.allFinite() || !sc.q.allFinite())
+    return solve_with_fallbacks(first, M, q, opt, attempts, tried);
   const Result r = solve_with_fallbacks(first, sc.M, sc.q, opt, attempts, tried);
   if (r.z.size() != q.size()) return r;
   Result out = detail::finish(M, q, sc.unscale(r.z), r.status, opt, r.message);

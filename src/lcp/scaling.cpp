@@ -1,4 +1,5 @@
 // The one way the LCP layer rescales an LCP (row equilibration, symmetric scaling).
+#include <algorithm>
 #include <cmath>
 #include <lcsim/lcp/lcp.hpp>
 #include <utility>
@@ -10,7 +11,9 @@ namespace lcsim::lcp::detail {
 double row_scale(double m) {
   int e = 0;
   if (m > 0.0 && std::isfinite(m)) std::frexp(m, &e);  // m = f 2^e, f in [0.5, 1)
-  return std::ldexp(1.0, -e);
+  // Clamped so that the factor itself stays a normal number (a subnormal
+  // row, e ~ -1070, would otherwise give 2^1070 = inf).
+  return std::ldexp(1.0, -std::clamp(e, -1000, 1000));
 }
 
 Scaling scale(const MatrixXd& M, const VectorXd& q, VectorXd r, VectorXd c) {

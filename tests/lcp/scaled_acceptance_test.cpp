@@ -153,5 +153,21 @@ TEST(LcpScaledAcceptance, BadlyScaledRowsSolvedOrRefusedNeverWrong) {
   EXPECT_EQ(solved[all.size() - 1], kProblems);
 }
 
+TEST(LcpScaledAcceptance, SubnormalDiagonalIsNotInvalidInputInSolveScaled) {
+  // Found by fuzz_lcp: M_11 = 1.36e-312 (subnormal) gives 1 / sqrt(M_11)
+  // ~ 8.6e155 in solve_scaled's diagonal scaling and an overflowing scaled
+  // problem, which was then reported as kInvalidInput on well-formed data.
+  MatrixXd M(2, 2);
+  M << 2, 7.02445990853128e-251, 1.35144606937101e-312, 1.35675105884842e-312;
+  VectorXd q(2);
+  q << 8.29195511698081e-317, 0;
+  ASSERT_TRUE(validate(M, q).empty());
+  const Result r = solve_scaled(*make_solver("pivot"), M, q, Options{});
+  EXPECT_NE(r.status, Status::kInvalidInput) << r.message;
+  // q >= 0: z = 0 solves it (w = q >= 0); the accepted z must pass the test.
+  ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_LE(test::row_scaled_residual(M, q, r.z), 1e-12);
+}
+
 }  // namespace
 }  // namespace lcsim::lcp
