@@ -58,16 +58,11 @@ Result evaluate(const MatrixXd& M, const VectorXd& q, const VectorXd& z) {
   if (z.size() != q.size())
     return detail::invalid("z has size " + std::to_string(z.size()) + ", expected " +
                            std::to_string(q.size()));
-  // Status kSolved iff z passes the default acceptance test (Options{}.tolerance).
+  // Status kSolved iff z passes the acceptance test at the default Options{}.tolerance.
   return detail::finish(M, q, z, Status::kSolved, Options{}, "");
 }
 
 namespace detail {
-
-double acceptance(const VectorXd& q, const Options& opt) {
-  const double qn = q.size() ? q.cwiseAbs().maxCoeff() : 0.0;
-  return opt.tolerance * (1.0 + qn);
-}
 
 std::string validate_all(const MatrixXd& M, const VectorXd& q, const Options& opt) {
   std::string bad = validate(M, q);
@@ -97,35 +92,6 @@ Result invalid(std::string message) {
   Result r;
   r.status = Status::kInvalidInput;
   r.message = std::move(message);
-  return r;
-}
-
-Result finish(const MatrixXd& M, const VectorXd& q, VectorXd z, Status claimed, const Options& opt,
-              std::string message) {
-  Result r;
-  r.z = std::move(z);
-  r.w = M * r.z + q;
-  r.residual = r.z.cwiseMin(r.w).cwiseAbs().maxCoeff();
-  r.min_z = std::min(0.0, r.z.minCoeff());
-  r.min_w = std::min(0.0, r.w.minCoeff());
-  r.status = claimed;
-  r.message = std::move(message);
-  const bool finite = r.z.allFinite() && r.w.allFinite();
-  if (!finite) {
-    r.status = Status::kNumericalFailure;
-    r.message = "non-finite values in the solution" + (r.message.empty() ? "" : ": " + r.message);
-    return r;
-  }
-  if (claimed == Status::kSolved) {
-    const double acc = acceptance(q, opt);
-    if (!(r.residual <= acc && r.min_z >= -acc && r.min_w >= -acc)) {
-      std::ostringstream os;
-      os << "residual check failed: residual " << r.residual << ", min z " << r.min_z << ", min w "
-         << r.min_w << " against tolerance " << acc;
-      r.status = Status::kNumericalFailure;
-      r.message = os.str();
-    }
-  }
   return r;
 }
 

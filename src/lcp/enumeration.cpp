@@ -1,6 +1,8 @@
 // Enumeration of all 2^k complementary bases (k <= 16): the test oracle.
 // For each index set a, solve M_aa z_a = -q_a (skipping singular M_aa) and
-// keep z when z_a >= 0 and w = M z + q >= 0 within the acceptance tolerance.
+// keep z when it passes the acceptance test (scaled_residual <= tolerance).
+// Runs on the row-equilibrated LCP (lcp.hpp): the rank decision on M_aa is
+// then relative to rows of one size, and the test is invariant under it.
 // Only solutions at nonsingular complementary bases are found; when M is
 // singular the solution set may be a polyhedron whose vertices these are.
 #include <algorithm>
@@ -16,10 +18,12 @@ namespace {
 
 constexpr int kMaxEnumeration = 16;
 
-EnumerationResult enumerate(const MatrixXd& M, const VectorXd& q, const Options& opt) {
+EnumerationResult enumerate(const MatrixXd& M0, const VectorXd& q0, const Options& opt) {
   EnumerationResult out;
-  const int k = static_cast<int>(q.size());
-  const double acc = detail::acceptance(q, opt);
+  const int k = static_cast<int>(q0.size());
+  const detail::Scaling eq = detail::equilibrate_rows(M0, q0);
+  const MatrixXd& M = eq.M;
+  const VectorXd& q = eq.q;
   std::vector<int> alpha;
   VectorXd z(k), w(k);
   for (unsigned mask = 0; mask < (1u << k); ++mask) {
@@ -33,11 +37,9 @@ EnumerationResult enumerate(const MatrixXd& M, const VectorXd& q, const Options&
       if (!lu.isInvertible()) continue;
       z(alpha) = -lu.solve(q(alpha));
     }
-    if (z.minCoeff() < -acc) continue;
+    if (z.minCoeff() < -opt.tolerance * z.cwiseAbs().maxCoeff()) continue;
     z = z.cwiseMax(0.0);
-    w.noalias() = M * z;
-    w += q;
-    if (w.minCoeff() < -acc || z.cwiseMin(w).cwiseAbs().maxCoeff() > acc) continue;
+    if (!(scaled_residual(M, q, z) <= opt.tolerance)) continue;
     const double tol = 1e-9 * (1.0 + z.cwiseAbs().maxCoeff());
     const bool seen =
         std::any_of(out.solutions.begin(), out.solutions.end(),

@@ -1,19 +1,21 @@
 #include <cmath>
 #include <lcsim/lcp/lcp.hpp>
 
+#include "lcp/detail.hpp"
+
 namespace lcsim::lcp {
 
 Result solve_with_fallbacks(const Solver& first, const MatrixXd& M, const VectorXd& q,
                             const Options& opt, int* attempts, std::string* tried) {
+  // A z that passes the acceptance test is a solution, whatever its solver
+  // claimed; one that does not stays the solver's result.
   const auto accept = [&](Result r) {
     if (r.ok() || r.z.size() != q.size() || !r.z.allFinite()) return r;
-    Result chk = evaluate(M, q, r.z);
-    const double t = opt.tolerance * (1.0 + (q.size() ? q.cwiseAbs().maxCoeff() : 0.0));
-    if (chk.residual <= t && chk.min_z >= -t && chk.min_w >= -t) {
-      chk.status = Status::kSolved;
-      return chk;
-    }
-    return r;
+    Result chk = detail::finish(M, q, r.z, Status::kSolved, opt, "");
+    if (!chk.ok()) return r;
+    chk.pivots = r.pivots;
+    chk.iterations = r.iterations;
+    return chk;
   };
   const auto note = [&](const std::string& name) {
     if (attempts) ++*attempts;
@@ -35,19 +37,18 @@ Result solve_with_fallbacks(const Solver& first, const MatrixXd& M, const Vector
 
 Result solve_scaled(const Solver& first, const MatrixXd& M, const VectorXd& q, const Options& opt,
                     int* attempts, std::string* tried) {
-  const Eigen::Index n = q.size();
-  VectorXd d(n);
-  for (Eigen::Index i = 0; i < n; ++i) d(i) = M(i, i) > 0.0 ? 1.0 / std::sqrt(M(i, i)) : 1.0;
-  const VectorXd qd = d.cwiseProduct(q);
-  const double s = n && qd.cwiseAbs().maxCoeff() > 0.0 ? qd.cwiseAbs().maxCoeff() : 1.0;
-  const MatrixXd Ms = d.asDiagonal() * M * d.asDiagonal();
-  const Result r = solve_with_fallbacks(first, Ms, qd / s, opt, attempts, tried);
-  if (r.z.size() != n) return r;
-  Result out = evaluate(M, q, s * d.cwiseProduct(r.z));
-  out.status = r.status;
+  const std::string bad = detail::validate_all(M, q, opt);
+  if (!bad.empty()) return detail::invalid(bad);
+  const detail::Scaling sc = detail::symmetric_scaling(M, q);
+  // A subnormal diagonal (1 / sqrt(M_ii) ~ 1e155) can overflow the scaled
+  // problem: solve the original one then.
+  if (!sc.M.allFinite() || !sc.q.allFinite())
+    return solve_with_fallbacks(first, M, q, opt, attempts, tried);
+  const Result r = solve_with_fallbacks(first, sc.M, sc.q, opt, attempts, tried);
+  if (r.z.size() != q.size()) return r;
+  Result out = detail::finish(M, q, sc.unscale(r.z), r.status, opt, r.message);
   out.pivots = r.pivots;
   out.iterations = r.iterations;
-  out.message = r.message;
   return out;
 }
 

@@ -156,19 +156,21 @@ class LemkeTableau {
   std::vector<int> ties_;
 };
 
-Result lemke(const MatrixXd& M, const VectorXd& q, const Options& opt) {
+// Pivots on the row-equilibrated (Ms, qs) (lcp.hpp), judges z on (M, q).
+Result lemke(const MatrixXd& M, const VectorXd& q, const MatrixXd& Ms, const VectorXd& qs,
+             const Options& opt) {
   const int k = static_cast<int>(q.size());
   if (q.minCoeff() >= 0.0) return detail::finish(M, q, VectorXd::Zero(k), Status::kSolved, opt, "");
   const int cap = opt.max_pivots > 0 ? opt.max_pivots : 50 * k + 1000;
   const int refactor_every = std::max(64, k);
 
-  LemkeTableau t(M, q);
+  LemkeTableau t(Ms, qs);
   // Initial pivot: z0 enters in the row of the most negative q_i. Among exact
   // ties the largest index keeps every row of [x_B, B^{-1}] lexicographically
   // positive: row i becomes (q_i - q_r, e_i - e_r), positive iff i < r on a tie.
   int r = 0;
   for (int i = 1; i < k; ++i)
-    if (q(i) <= q(r)) r = i;
+    if (qs(i) <= qs(r)) r = i;
   t.column(t.z0());
   int leaving = t.basic(r);
   t.pivot(r, t.z0());
@@ -219,7 +221,8 @@ Result solve_lemke(const MatrixXd& M, const VectorXd& q, const Options& opt) {
   const std::string bad = detail::validate_all(M, q, opt);
   if (!bad.empty()) return detail::invalid(bad);
   try {
-    return lemke(M, q, opt);
+    const detail::Scaling eq = detail::equilibrate_rows(M, q);
+    return lemke(M, q, eq.M, eq.q, opt);
   } catch (const std::exception& e) {
     Result r;
     r.status = Status::kNumericalFailure;

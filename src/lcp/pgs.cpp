@@ -22,14 +22,27 @@ Result pgs(const MatrixXd& M, const VectorXd& q, const Options& opt) {
       return detail::finish(M, q, VectorXd::Zero(k), Status::kNumericalFailure, opt,
                             "PGS needs a positive diagonal; M(" + std::to_string(i) + "," +
                                 std::to_string(i) + ") = " + std::to_string(M(i, i)));
-  const double acc = detail::acceptance(q, opt);
+  // Half the acceptance tolerance: the running w and s drift by rounding
+  // before the fresh confirmation below.
+  const double acc = 0.5 * opt.tolerance;
   VectorXd z = opt.warm_start ? VectorXd(opt.warm_start->cwiseMax(0.0)) : VectorXd::Zero(k);
   VectorXd w = M * z + q;
+  const MatrixXd absM = M.cwiseAbs();
+  VectorXd s = absM * z + q.cwiseAbs();  // row magnitudes s_i of scaled_residual (z >= 0)
   const VectorXd inv_diag = M.diagonal().cwiseInverse();
   const double omega = opt.relaxation;
   int it = 0;
-  auto residual = [&] { return z.cwiseMin(w).cwiseAbs().maxCoeff(); };
-  bool converged = residual() <= 0.5 * acc;
+  // The row-scaled residual (lcp.hpp) from the running w and s, O(k).
+  auto residual = [&] {
+    const double zn = z.maxCoeff();
+    double worst = 0.0;
+    for (int i = 0; i < k; ++i) {
+      const double a = zn > 0.0 ? z(i) / zn : 0.0, b = s(i) > 0.0 ? w(i) / s(i) : 0.0;
+      worst = std::max(worst, std::abs(std::min(a, b)));
+    }
+    return worst;
+  };
+  bool converged = residual() <= acc;
   while (!converged && it < opt.max_iterations) {
     for (int i = 0; i < k; ++i) {
       const double zi = std::max(0.0, z(i) - omega * w(i) * inv_diag(i));
@@ -37,14 +50,17 @@ Result pgs(const MatrixXd& M, const VectorXd& q, const Options& opt) {
       if (dz != 0.0) {
         z(i) = zi;
         w.noalias() += dz * M.col(i);
+        s.noalias() += dz * absM.col(i);  // z_i, zi >= 0: |zi| - |z_i| = dz
       }
     }
     ++it;
-    if (residual() <= 0.5 * acc) {
-      // Confirm against a fresh w (the running update drifts by rounding).
+    if (residual() <= acc) {
+      // Confirm against a fresh w and s (the running updates drift by rounding).
       w.noalias() = M * z;
       w += q;
-      converged = residual() <= 0.5 * acc;
+      s.noalias() = absM * z;
+      s += q.cwiseAbs();
+      converged = residual() <= acc;
     }
   }
   Result r = detail::finish(

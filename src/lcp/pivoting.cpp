@@ -36,12 +36,16 @@ Result principal_pivoting(const MatrixXd& M, const VectorXd& q, const Options& o
   using Idx = Eigen::Matrix<int, Eigen::Dynamic, 1, Eigen::ColMajor, MaxK, 1>;
   const int k = static_cast<int>(q.size());
   const int cap = opt.max_pivots > 0 ? opt.max_pivots : (k <= 20 ? (1 << k) + 10 : 50 * k + 1000);
-  const double eps = detail::kPivotZero * detail::acceptance(q, opt);
+  // A quarter of the acceptance tolerance, each row against its own scale
+  // (scaled_residual in lcp.hpp): row i is infeasible when z_i < -eps ||z||
+  // or w_i < -eps s_i, s_i = |q_i| + sum_j |M_ij| |z_j|. The margin leaves
+  // room for rounding before the acceptance test of finish().
+  const double eps = detail::kPivotZero * opt.tolerance;
   const bool symmetric = is_symmetric(M);
 
   Idx in = Idx::Zero(k);  // in(i): z_i basic (w_i = 0)
   Idx alpha(k), infeasible(k);
-  Vec z = Vec::Zero(k), w = q, qa(k), za(k);
+  Vec z = Vec::Zero(k), w = q, s = q.cwiseAbs(), qa(k), za(k);
   Mat Maa(k, k);
   Eigen::LLT<Mat> llt(k);
   Eigen::PartialPivLU<Mat> lu(k);
@@ -55,8 +59,9 @@ Result principal_pivoting(const MatrixXd& M, const VectorXd& q, const Options& o
   };
   while (true) {
     int n_inf = 0;
+    const double zn = z.cwiseAbs().maxCoeff();
     for (int i = 0; i < k; ++i)
-      if (in(i) ? z(i) < -eps : w(i) < -eps) infeasible(n_inf++) = i;
+      if (in(i) ? z(i) < -eps * zn : w(i) < -eps * s(i)) infeasible(n_inf++) = i;
     if (n_inf == 0) return done(Status::kSolved, "");
     if (iterations >= cap)
       return done(Status::kIterationLimit, "cap of " + std::to_string(cap) + " pivots reached");
@@ -95,6 +100,13 @@ Result principal_pivoting(const MatrixXd& M, const VectorXd& q, const Options& o
         }
       }
       if (!solved) {
+        // Rows equilibrated by powers of two (exact; lcp.hpp) so that the
+        // rank test below sees rows of one size.
+        for (int r = 0; r < na; ++r) {
+          const double d = detail::row_scale(Maa.row(r).cwiseAbs().maxCoeff());
+          Maa.row(r) *= d;
+          qa(r) *= d;
+        }
         lu.compute(Maa);
         if (!(lu.rcond() > 1e-14))
           return done(Status::kNumericalFailure, "singular principal submatrix of order " +
@@ -105,6 +117,11 @@ Result principal_pivoting(const MatrixXd& M, const VectorXd& q, const Options& o
     }
     w.noalias() = M * z;
     w += q;
+    for (int i = 0; i < k; ++i) {
+      double si = std::abs(q(i));
+      for (int j = 0; j < k; ++j) si += std::abs(M(i, j)) * std::abs(z(j));
+      s(i) = si;
+    }
     if (!z.allFinite() || !w.allFinite())
       return done(Status::kNumericalFailure, "non-finite values in a principal pivot");
   }

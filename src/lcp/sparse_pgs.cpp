@@ -68,7 +68,10 @@ Result sparse_pgs(const SparseRowMatrix& M, const VectorXd& q, const Options& op
     }
   }
   VectorXd z = opt.warm_start ? VectorXd(opt.warm_start->cwiseMax(0.0)) : VectorXd::Zero(n);
-  const double tol = detail::acceptance(q, opt);
+  // The sweeps' own stopping rule, absolute in the units of q (as before the
+  // row-scaled acceptance of the dense solvers; Moreau–Jean's steps depend
+  // on it): tolerance (1 + ||q||_inf).
+  const double tol = opt.tolerance * (1.0 + q.cwiseAbs().maxCoeff());
   for (int sweeps = 1; sweeps <= opt.max_iterations; ++sweeps) {
     if (sweep(M, q, diag, z) > tol) continue;
     const VectorXd w = M * z + q;

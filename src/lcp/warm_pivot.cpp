@@ -38,23 +38,28 @@ const Result& WarmPivot::solve(const MatrixXd& M, long version, const VectorXd& 
     llt_.solveInPlace(zj_);
     zj_ = -zj_;
   }
-  // The acceptance test; w = M z + q with z zero off J.
-  const double acc = detail::acceptance(q, opt);
-  const double margin = kMargin * detail::kPivotZero * acc;
+  // The pivoting solver's test, row by row (pivoting.cpp), with a margin;
+  // w = M z + q with z zero off J.
+  const double zn = nj > 0 ? zj_.cwiseAbs().maxCoeff() : 0.0;
+  const double eps = kMargin * detail::kPivotZero * opt.tolerance;
   for (int c = 0; c < nj; ++c)
-    if (!(zj_(c) > margin)) return reject();  // also refuses NaN
+    if (!(zj_(c) > eps * zn)) return reject();  // also refuses NaN
   Result& r = result_;
   r.w.resize(na);
   r.residual = 0.0;
   r.min_w = 0.0;
   int next = 0;  // J_ is sorted
   for (int a = 0; a < na; ++a) {
-    double w = q(a);
-    for (int c = 0; c < nj; ++c) w += M(a, J_[c]) * zj_(c);
+    double w = q(a), scale = std::abs(q(a));  // scale: |q_a| + sum_c |M_ac| |z_c|
+    for (int c = 0; c < nj; ++c) {
+      w += M(a, J_[c]) * zj_(c);
+      scale += std::abs(M(a, J_[c]) * zj_(c));
+    }
     r.w(a) = w;
+    const double margin = eps * scale;
     if (next < nj && J_[next] == a) {
       ++next;
-      if (!(std::abs(w) <= acc)) return reject();
+      if (!(std::abs(w) <= opt.tolerance * scale)) return reject();
       r.residual = std::max(r.residual, std::abs(w));  // min(z_a, w_a) = w_a: z_a > margin
       r.min_w = std::min(r.min_w, w);
     } else if (!(w > margin)) {

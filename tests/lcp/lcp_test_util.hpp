@@ -1,6 +1,8 @@
 // Random LCP generators for the LCP tests (fixed seeds, reproducible).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <lcsim/lcp/lcp.hpp>
 #include <random>
 
@@ -49,6 +51,30 @@ inline void random_psd_lcp(int k, int m, std::mt19937& rng, MatrixXd& M, VectorX
   VectorXd z = VectorXd::Zero(k), w = VectorXd::Zero(k);
   for (int i = 0; i < k; ++i) (u(rng) < 0.5 ? z(i) : w(i)) = u(rng);
   q = w - M * z;
+}
+
+// The row-scaled residual recomputed here, independently of the library's
+// scaled_residual (lcp.hpp): per row, z_i against ||z||_inf and w_i against
+// s_i = |q_i| + sum_j |M_ij| |z_j|, worst |min| over the rows.
+inline double row_scaled_residual(const MatrixXd& M, const VectorXd& q, const VectorXd& z) {
+  const VectorXd w = M * z + q;
+  const VectorXd s = M.cwiseAbs() * z.cwiseAbs() + q.cwiseAbs();
+  const double zn = z.lpNorm<Eigen::Infinity>();
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < z.size(); ++i) {
+    const double a = zn == 0.0 ? 0.0 : z(i) / zn;
+    const double b = s(i) == 0.0 ? 0.0 : w(i) / s(i);
+    worst = std::max(worst, std::abs(std::min(a, b)));
+  }
+  return worst;
+}
+
+// Positive row scales 10^U(lo, hi): D M, D q has the same solutions as M, q.
+inline VectorXd random_row_scales(int k, double lo, double hi, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(lo, hi);
+  VectorXd d(k);
+  for (int i = 0; i < k; ++i) d(i) = std::pow(10.0, u(rng));
+  return d;
 }
 
 }  // namespace lcsim::lcp::test

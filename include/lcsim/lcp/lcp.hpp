@@ -30,10 +30,14 @@ struct Result {
   VectorXd w;             // M z + q
   int pivots = 0;         // pivoting solvers: number of pivots
   int iterations = 0;     // iterative solvers: sweeps
-  double residual = 0.0;  // natural residual ||min(z, w)||_inf
-  double min_z = 0.0;     // most negative entry of z (0 if none negative)
-  double min_w = 0.0;     // most negative entry of w (0 if none negative)
-  std::string message;    // human-readable detail ("" when solved cleanly)
+  double residual = 0.0;  // natural residual ||min(z, w)||_inf (unscaled diagnostics)
+  // The acceptance measure: the worst row of scaled_residual() below, in
+  // [0, 1]; "solved" means scaled_residual <= Options::tolerance.
+  double scaled_residual = 0.0;
+  int worst_row = -1;   // the row attaining scaled_residual (-1 if k = 0)
+  double min_z = 0.0;   // most negative entry of z (0 if none negative)
+  double min_w = 0.0;   // most negative entry of w (0 if none negative)
+  std::string message;  // human-readable detail ("" when solved cleanly)
   bool ok() const { return status == Status::kSolved; }
 };
 
@@ -41,11 +45,26 @@ struct Result {
 Result evaluate(const MatrixXd& M, const VectorXd& q, const VectorXd& z);
 // ||min(z, w)||_inf with w = M z + q.
 double natural_residual(const MatrixXd& M, const VectorXd& q, const VectorXd& z);
+// The row-scaled residual, the one acceptance measure of every solver:
+//   max_i |min(z_i / ||z||_inf, w_i / s_i)|,  s_i = |q_i| + sum_j |M_ij| |z_j|,
+// (0/0 read as 0). s_i is the magnitude of the terms that form w_i, so w_i is
+// judged against its own row, whatever the scale of the other rows (computing
+// w_i alone already costs rounding ~ k eps s_i); z is judged against
+// ||z||_inf because the principal solves that produce z are normwise backward
+// stable: an entry below tol ||z||_inf is zero to working accuracy. The value
+// lies in [0, 1] and is invariant under positive row scaling of (M, q) and
+// under scaling of z; a negative z_i or w_i counts with its magnitude. Sets
+// *worst_row to the row attaining it (-1 if k = 0). Infinity on size mismatch.
+double scaled_residual(const MatrixXd& M, const VectorXd& q, const VectorXd& z,
+                       int* worst_row = nullptr);
 // Empty string if (M, q) is a well-formed LCP, else what is wrong.
 std::string validate(const MatrixXd& M, const VectorXd& q);
 
 struct Options {
-  // Accept a solution when residual <= tolerance * (1 + ||q||_inf).
+  // The one acceptance tolerance: a z is "solved" when scaled_residual(M, q, z)
+  // <= tolerance, i.e. every row i has z_i >= -tol ||z||_inf, w_i >= -tol s_i
+  // and min(z_i / ||z||_inf, w_i / s_i) within tol (see scaled_residual). 1e-12
+  // leaves ~1e4 eps for the rounding of a k <= 100 solve and refinement.
   double tolerance = 1e-12;
   // Pivoting solvers: cap on pivots (0 = default, 50 * k + 1000 for Lemke).
   int max_pivots = 0;
@@ -55,6 +74,13 @@ struct Options {
   const VectorXd* warm_start = nullptr;  // initial z (projected onto z >= 0)
 };
 
+// The pivoting solvers (Lemke, enumeration) pivot on the row-equilibrated LCP
+// (R M, R q), R = diag(2^-e_i) with 2^e_i ~ max_j |M_ij|: exact in floating
+// point and the same solution set (0 <= z ⟂ R w >= 0 iff 0 <= z ⟂ w >= 0), so
+// a row of size 1 next to a row of size 1e12 keeps its weight in ratio tests
+// and rank decisions. Principal pivoting and PGS, whose decisions are signs
+// and row-wise updates, test each row against its own scale instead.
+//
 // Lemke's complementary pivoting with covering vector e = (1,...,1) and
 // lexicographic degeneracy resolution (no cycling on degenerate q or ties).
 // Returns kRayTermination on a secondary ray.
@@ -110,7 +136,8 @@ std::vector<std::string> solver_names();
 
 // The LCP solved by `first`, then, while unsolved, by Lemke, PGS and (k <= 12)
 // enumeration, each skipped if it is `first`. A result that is not kSolved is
-// still accepted when its z satisfies the LCP to opt.tolerance (1 + |q|_inf)
+// still accepted when its z passes the acceptance test (scaled_residual <=
+// opt.tolerance)
 // (Lemke can stop on a ray with a complementary z in hand on a singular M).
 // What impacts, mode selection and time steps do when the configured solver
 // fails: dependent constraints make their matrices PSD, not P, and principal
@@ -123,10 +150,12 @@ Result solve_with_fallbacks(const Solver& first, const MatrixXd& M, const Vector
 // solve_with_fallbacks on the diagonally scaled problem
 //   (D M D) z' + D q / s,  D = diag(1 / sqrt(M_ii)) (1 where M_ii <= 0),
 //   s = max |D q| (1 if 0),  z = s D z',
-// so that the acceptance tolerance is relative to the problem's own scale: a
-// step LCP whose matrix is h^2 E M^-1 E' (backward Euler, ~1e-16 at h = 1e-8)
-// otherwise accepts multipliers anywhere within tolerance / 1e-16. The result
-// is unscaled (z, w, residual in the original units).
+// (the same detail::Scaling as the solvers' row equilibration, with columns
+// scaled too so that a symmetric M stays symmetric and its diagonal becomes
+// 1): a step LCP whose matrix is h^2 E M^-1 E' (backward Euler, ~1e-16 at
+// h = 1e-8) reaches the solvers with unit diagonal and unit q. The result is
+// unscaled (z, w, residuals in the original units) and its status is decided
+// by the acceptance test on the original (M, q).
 Result solve_scaled(const Solver& first, const MatrixXd& M, const VectorXd& q, const Options& opt,
                     int* attempts = nullptr, std::string* tried = nullptr);
 
