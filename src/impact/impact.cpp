@@ -187,7 +187,8 @@ std::optional<VectorXd> solve_impact_lcp(const MatrixXd& W, const VectorXd& q,
   }
   out.lcp_status = res.status;
   if (!res.ok()) {
-    out.message = "impact LCP failed (" + tried + "): " + std::string(lcp::to_string(res.status, "solved")) +
+    out.message = "impact LCP failed (" + tried +
+                  "): " + std::string(lcp::to_string(res.status, "solved")) +
                   (res.message.empty() ? "" : " (" + res.message + ")");
     return std::nullopt;
   }
@@ -214,13 +215,20 @@ ImpactResult moreau_newton(const ImpactInput& in, const lcp::Solver& solver) {
   }
   // M^{-1} E_J' (e∘z) = ebar (w - v) + M^{-1} E_J' ((e - ebar)∘z), ebar the
   // mean restitution on the support: exact in w when the restitution is equal.
+  // The support counts impulses that change some rate by more than rounding
+  // (kRelTol of the largest approach rate, through the diagonal of W): a
+  // solver may leave a degenerate contact (rate 0, impulse 0) basic at 1e-17.
+  double tiny = 0.0;
+  for (Eigen::Index i = 0; i < zi.size(); ++i)
+    if (s->W(i, i) > 0.0) tiny = std::max(tiny, std::abs(s->a(i)) / s->W(i, i));
+  tiny *= kRelTol;
   double ebar = 0.0;
   int support = 0;
   for (Eigen::Index i = 0; i < zi.size(); ++i)
-    if (zi(i) > 0.0) ebar += s->e_J(i), ++support;
+    if (zi(i) > tiny) ebar += s->e_J(i), ++support;
   if (support > 0) ebar /= support;
   const VectorXd de = (s->e_J.array() - ebar).matrix().cwiseProduct(zi);
-  detail::finish(in, *s, zi + s->e_J.cwiseProduct(zi), w + ebar * (w - in.v) + s->MinvEt * de, 0.0,
+  detail::finish(in, *s, zi + s->e_J.cwiseProduct(zi), w + ebar * (w - in.v) + s->MinvEt * de, tiny,
                  out);
   out.ok = true;
   return out;

@@ -208,8 +208,16 @@ TEST(ImpactProperties, DependentConstraintsShareTheJump) {
     if (all.solutions.size() > 1) ++multiple;
     for (const Eigen::VectorXd& z : all.solutions) {
       const Eigen::VectorXd jz = ri.model.M.toDense().llt().solve(EJ.transpose() * z);
-      // Enumeration solves singular subsystems by least squares: 1e-8 relative.
-      EXPECT_LE(m_norm(ri.model.M, jz - jump), 1e-8 * scale) << "case " << c;
+      // Enumeration solves singular subsystems by least squares: 1e-8
+      // relative. Relative to the larger of |v| and the jump's own terms
+      // M^{-1} |E_J'| |z|: the LCP layer accepts a z row by row against
+      // |q_i| + sum_j |W_ij| |z_j| (lcp::scaled_residual), so on a nearly
+      // singular W a solution whose large entries cancel is exact only to
+      // that scale (case 938: error 3.6e-8 against the former bound 4.2e-9).
+      const Eigen::VectorXd terms =
+          ri.model.M.toDense().llt().solve(EJ.cwiseAbs().transpose() * z.cwiseAbs());
+      EXPECT_LE(m_norm(ri.model.M, jz - jump), 1e-8 * std::max(scale, m_norm(ri.model.M, terms)))
+          << "case " << c;
     }
   }
   std::printf("dependent constraints: %d cases checked, %d with several impulses\n", checked,
