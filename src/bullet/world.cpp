@@ -396,15 +396,8 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
                                 const sim::Options& options, const WorldSettings& s) {
   // The library's one check of a run's input, as sim::Integrator::run makes.
   sim::Options opt = options;
-  if (!opt.t_end && std::isfinite(model.t_end)) opt.t_end = model.t_end;
-  if (const std::string why = sim::check_run(model, x0, opt, "bullet", bullet_options_used());
-      !why.empty()) {
-    sim::Trajectory tr;
-    tr.method = "bullet";
-    tr.status = sim::RunStatus::kInvalidInput;
-    tr.message = why;
-    return tr;
-  }
+  if (auto refused = sim::refuse_invalid_run(model, x0, opt, "bullet", bullet_options_used()))
+    return std::move(*refused);
   const Plan p = plan_of(model, s);  // throws for an inexpressible model
   sim::Trajectory tr = p.scene ? simulate_multibody(model, *p.scene, p.joint_limits, x0, opt, s)
                                : simulate_rb6(model, p.rb6_limits, x0, opt, s);

@@ -1,6 +1,6 @@
 // The checked entry points of a run: Integrator::run and sim::simulate.
+#include <cmath>
 #include <lcsim/sim/sim.hpp>
-#include <stdexcept>
 
 namespace lcsim::sim {
 
@@ -14,12 +14,19 @@ Trajectory refused(std::string method, std::string message) {
 }
 }  // namespace
 
+std::optional<Trajectory> refuse_invalid_run(const mech::Model& model, const VectorXd& x0,
+                                             Options& opt, std::string_view method,
+                                             const OptionsUsed& used) {
+  if (!opt.t_end && std::isfinite(model.t_end)) opt.t_end = model.t_end;
+  if (std::string why = check_run(model, x0, opt, method, used); !why.empty())
+    return refused(std::string(method), std::move(why));
+  return std::nullopt;
+}
+
 Trajectory Integrator::run(const mech::Model& model, const VectorXd& x0, const Options& opt) const {
   Options resolved = opt;
-  if (!resolved.t_end && std::isfinite(model.t_end)) resolved.t_end = model.t_end;
-  const OptionsUsed used = options_used();
-  if (std::string why = check_run(model, x0, resolved, name(), used); !why.empty())
-    return refused(name(), std::move(why));
+  if (auto refused_run = refuse_invalid_run(model, x0, resolved, name(), options_used()))
+    return std::move(*refused_run);
   return integrate(model, x0, resolved);
 }
 

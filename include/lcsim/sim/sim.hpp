@@ -201,6 +201,15 @@ std::vector<std::string> integrator_names();
 std::string check_run(const mech::Model& model, const VectorXd& x0, const Options& opt,
                       std::string_view method, const OptionsUsed& used);
 
+// What every checked entry does before its method (Integrator::run, and
+// bullet::simulate_bullet, which takes more than an Integrator): fills an
+// unset opt.t_end with the model's, then check_run. A refused trajectory
+// (status kInvalidInput, the message, nothing integrated) when the input is
+// bad, else nullopt and `opt` is ready for the method.
+std::optional<Trajectory> refuse_invalid_run(const mech::Model& model, const VectorXd& x0,
+                                             Options& opt, std::string_view method,
+                                             const OptionsUsed& used);
+
 // `opt` with the options that `used` does not read reset to their defaults:
 // one set of options applied to several methods (a sweep, a study) keeps for
 // each what it reads.
