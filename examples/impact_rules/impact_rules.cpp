@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
     for (const std::string& name : lcsim::impact::impact_law_names()) {
       const lcsim::impact::ImpactResult r =
           lcsim::impact::make_impact_law(name)->apply(in, *solver);
-      if (!r.ok) {
+      if (!r.ok()) {
         std::printf("%-20s failed: %s\n", name.c_str(), r.message.c_str());
         continue;
       }

@@ -63,7 +63,7 @@ TEST(MoreauImpact, InelasticInvariantsOnRandomModels) {
     ++checked;
     const double tol = 1e-8;
     const lcsim::impact::ImpactResult r = law->apply(in, *solver);
-    ASSERT_TRUE(r.ok) << "trial " << trial << ": " << r.message;
+    ASSERT_TRUE(r.ok()) << "trial " << trial << ": " << r.message;
     const VectorXd rate = E * r.v_after;  // E_J v+
     const double vnorm = in.v.norm();
     EXPECT_LE(r.energy_after, r.energy_before * (1.0 + tol)) << "trial " << trial;

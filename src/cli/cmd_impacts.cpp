@@ -104,7 +104,7 @@ void run_compare(const ImpactsArgs& a, const mech::Model& model) {
 
   std::string failures;
   for (const auto& [name, r] : results)
-    if (!r.ok) failures += (failures.empty() ? "" : "; ") + name + ": " + r.message;
+    if (!r.ok()) failures += (failures.empty() ? "" : "; ") + name + ": " + r.message;
   if (a.json) {
     nlohmann::json j;
     j["model"] = model.name;
@@ -119,7 +119,7 @@ void run_compare(const ImpactsArgs& a, const mech::Model& model) {
       after << in.q, r.v_after;
       nlohmann::json mode = nlohmann::json::array();
       for (int i : r.mode) mode.push_back(m.constraints[i]);
-      js[name] = {{"ok", r.ok},
+      js[name] = {{"ok", r.ok()},
                   {"state_after", io::to_json(after)},
                   {"impulse", io::to_json(r.impulse)},
                   {"mode", mode},
@@ -139,7 +139,7 @@ void run_compare(const ImpactsArgs& a, const mech::Model& model) {
     std::printf("%-19s %-28s %-24s %-18s %-12s %-12s %-10s %s\n", "rule", "velocity after",
                 "impulse", "mode", "T before", "T after", "worst Ev+", "note");
     for (const auto& [name, r] : results) {
-      std::string note = r.ok ? (r.admissible ? "" : "NOT ADMISSIBLE ") : "FAILED ";
+      std::string note = r.ok() ? (r.admissible ? "" : "NOT ADMISSIBLE ") : "FAILED ";
       note += r.message;
       std::printf("%-19s %-28s %-24s %-18s %-12.6g %-12.6g %-10.3g %s\n", name.c_str(),
                   fmt_vec(r.v_after).c_str(), fmt_vec(r.impulse).c_str(),

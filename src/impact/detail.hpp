@@ -20,7 +20,7 @@ struct Setup {
 
 // Validates the input and fills `out` with the no-impact defaults (v_after = v,
 // zero impulse, energy_before = energy_after). Returns nullopt when there is
-// nothing more to do: out.ok says whether the input was valid (an empty J is a
+// nothing more to do: out.ok() says whether the input was valid (an empty J is a
 // valid input with no impact).
 std::optional<Setup> prepare(const ImpactInput& in, ImpactResult& out);
 

@@ -17,6 +17,7 @@ std::optional<Setup> prepare(const ImpactInput& in, ImpactResult& out) {
   out = ImpactResult{};
   if (in.model == nullptr) {
     out.message = "impact input has no model";
+    out.status = Status::kInvalidInput;
     return std::nullopt;
   }
   const mech::MechanicalModel& m = *in.model;
@@ -24,11 +25,13 @@ std::optional<Setup> prepare(const ImpactInput& in, ImpactResult& out) {
   if (in.v.size() != N) {
     out.message = "pre-impact velocity has " + std::to_string(in.v.size()) +
                   " entries, the model has " + std::to_string(N) + " coordinates";
+    out.status = Status::kInvalidInput;
     return std::nullopt;
   }
   for (size_t i = 0; i < in.closed.size(); ++i) {
     if (in.closed[i] < 0 || in.closed[i] >= k || (i > 0 && in.closed[i] <= in.closed[i - 1])) {
       out.message = "closed set must be sorted distinct indices in [0, " + std::to_string(k) + ")";
+      out.status = Status::kInvalidInput;
       return std::nullopt;
     }
   }
@@ -43,6 +46,7 @@ std::optional<Setup> prepare(const ImpactInput& in, ImpactResult& out) {
   else {
     out.message = "restitution has " + std::to_string(in.restitution.size()) +
                   " entries, the model has " + std::to_string(k) + " constraints";
+    out.status = Status::kInvalidInput;
     return std::nullopt;
   }
   out.v_after = in.v;
@@ -50,7 +54,7 @@ std::optional<Setup> prepare(const ImpactInput& in, ImpactResult& out) {
   out.energy_before = mech::kinetic_energy(m, in.v);
   out.energy_after = out.energy_before;
   if (in.closed.empty()) {
-    out.ok = true;
+    out.status = Status::kOk;
     return std::nullopt;
   }
   const int nj = static_cast<int>(in.closed.size());
@@ -230,7 +234,7 @@ ImpactResult moreau_newton(const ImpactInput& in, const lcp::Solver& solver) {
   const VectorXd de = (s->e_J.array() - ebar).matrix().cwiseProduct(zi);
   detail::finish(in, *s, zi + s->e_J.cwiseProduct(zi), w + ebar * (w - in.v) + s->MinvEt * de, tiny,
                  out);
-  out.ok = true;
+  out.status = Status::kOk;
   return out;
 }
 

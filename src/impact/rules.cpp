@@ -23,7 +23,7 @@ ImpactResult moreau_restitution(const ImpactInput& in, const lcp::Solver& solver
     detail::finish(in, *s, ref->impulse_J, ref->v_after, 0.0, out);
   else
     detail::finish(in, *s, *z, in.v + s->MinvEt * *z, 0.0, out);
-  out.ok = true;
+  out.status = Status::kOk;
   return out;
 }
 
@@ -73,7 +73,7 @@ ImpactResult sequential(const ImpactInput& in) {
   std::ostringstream msg;
   if (converged) {
     msg << "converged after " << impacts << " pairwise impacts (" << sweeps << " sweeps)";
-    out.ok = true;
+    out.status = Status::kOk;
   } else {
     msg << "sequential: not converged after " << impacts
         << " pairwise impacts (cap); closed contacts still approach";
@@ -113,7 +113,7 @@ ImpactResult flip_rule(const ImpactInput& in) {
   // The selected mode is I itself, whatever the signs of the impulse.
   out.mode.clear();
   for (int i : sel) out.mode.push_back(in.closed[i]);
-  out.ok = true;
+  out.status = Status::kOk;
   if (!out.admissible) {
     std::ostringstream msg;
     msg << "not an admissible solution:";

@@ -199,7 +199,7 @@ ImpactMap impact_map(const mech::MechanicalModel& m, const ImpactMapSpec& s) {
       cell.before << grid_point(s.axis1, i), grid_point(s.axis2, j);
       in.v = cell_velocity(rows ? &*rows : nullptr, s.v0, cell.before);
       const impact::ImpactResult r = law->apply(in, *solver);
-      if (!r.ok) {
+      if (!r.ok()) {
         map.failure = s.law + " failed at v = " + vec_text(in.v) + ": " + r.message;
         return map;
       }

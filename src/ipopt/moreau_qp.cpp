@@ -154,7 +154,7 @@ ImpactResult moreau_qp(const ImpactInput& in) {
   const double vs = std::max(in.v.cwiseAbs().maxCoeff(), 1e-300);
   if (in.v.cwiseAbs().maxCoeff() == 0.0) {  // at rest: nothing to project
     detail::finish(in, *s, VectorXd::Zero(in.closed.size()), in.v, 0.0, out);
-    out.ok = true;
+    out.status = Status::kOk;
     return out;
   }
   Ipopt::SmartPtr<ImpactQp> qp = new ImpactQp(in.model->M, s->EJ, in.v / vs);
@@ -211,7 +211,7 @@ ImpactResult moreau_qp(const ImpactInput& in) {
   const VectorXd extra = s->e_J.cwiseProduct(lambda);
   const VectorXd impulse = lambda + extra;
   detail::finish(in, *s, impulse, w + s->MinvEt * extra, threshold, out);
-  out.ok = true;
+  out.status = Status::kOk;
   if (kkt) {
     out.message = "Ipopt: " + status_name(st) + ", KKT conditions checked to 1e-9";
     return out;

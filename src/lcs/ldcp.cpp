@@ -79,7 +79,7 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
   out.x_plus = x0;
   out.impulse.assign(n, VectorXd::Zero(k));
   if (k == 0) {
-    out.ok = true;
+    out.status = Status::kOk;
     return out;
   }
 
@@ -261,7 +261,7 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
     jump += AjBu;
   }
   out.x_plus = x0 + jump;
-  out.ok = true;
+  out.status = Status::kOk;
   return out;
 }
 

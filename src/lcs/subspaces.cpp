@@ -239,7 +239,7 @@ Projection projection(const Lcs& sys, const IndexSet& I) {
     why << name << " is not autonomous: Ker [B_.I; D_II] has dimension " << ker_dim
         << " (some inputs of the mode act on neither x nor y, Lemma 3.3.3)";
   }
-  out.ok = direct_sum && ker_dim == 0;
+  out.status = (direct_sum && ker_dim == 0) ? Status::kOk : Status::kNumericalFailure;
   out.message = why.str();
   return out;
 }
@@ -250,7 +250,7 @@ ModeFeedback mode_feedback(const Lcs& sys, const IndexSet& I) {
   ModeFeedback out;
   out.F = MatrixXd::Zero(m, n);
   if (m == 0) {
-    out.ok = true;
+    out.status = Status::kOk;
     return out;
   }
   // Leading rows of the mode's own system (A, B_.I, C_I., D_II): these equal
@@ -289,7 +289,7 @@ ModeFeedback mode_feedback(const Lcs& sys, const IndexSet& I) {
     return out;
   }
   out.F = -Mc.colPivHouseholderQr().solve(R);
-  out.ok = true;
+  out.status = Status::kOk;
   return out;
 }
 

@@ -178,7 +178,7 @@ PassivityCertificateCheck verify_passivity_certificate(const Lcs& sys, const Mat
   } else if (out.lmi_max_eigenvalue > tol) {
     os << "[A'K+KA, KB-C'; B'K-C, -(D+D')] has eigenvalue " << out.lmi_max_eigenvalue << " > 0";
   } else {
-    out.ok = true;
+    out.status = Status::kOk;
   }
   out.message = os.str();
   return out;
@@ -227,7 +227,7 @@ WellPosednessReport analyze_well_posedness(const Lcs& sys) {
   passed.push_back("G + G^* >= 0 at " + std::to_string(points) + " points with Re l >= 0");
 
   const auto cert = verify_passivity_certificate(sys, MatrixXd::Identity(r.n, r.n));
-  if (cert.ok) {
+  if (cert.ok()) {
     r.passive = "yes";
     r.passivity_reason =
         "certificate K = I: [A'+A, B-C'; B'-C, -(D+D')] <= 0 holds (largest eigenvalue " +

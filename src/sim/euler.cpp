@@ -19,10 +19,11 @@ namespace {
 using Eigen::MatrixXd;
 
 struct EulerFactors {
-  MatrixXd Phi;   // (I - hA)^{-1}
-  MatrixXd PhiB;  // h (I - hA)^{-1} B
-  MatrixXd G;     // D + h C (I - hA)^{-1} B, the LCP matrix of step 4
-  bool ok = false;
+  MatrixXd Phi;                               // (I - hA)^{-1}
+  MatrixXd PhiB;                              // h (I - hA)^{-1} B
+  MatrixXd G;                                 // D + h C (I - hA)^{-1} B, the LCP matrix of step 4
+  Status status = Status::kNumericalFailure;  // kOk when computed; message says why not
+  bool ok() const { return status == Status::kOk; }
   std::string message;
 };
 
@@ -40,8 +41,8 @@ EulerFactors euler_factors(const lcs::Lcs& sys, double h) {
   f.Phi = lu.inverse();
   f.PhiB = h * (f.Phi * sys.B);
   f.G = sys.D + sys.C * f.PhiB;
-  f.ok = f.Phi.allFinite() && f.G.allFinite();
-  if (!f.ok) f.message = "I - hA is too ill-conditioned at h = " + short_number(h);
+  f.status = (f.Phi.allFinite() && f.G.allFinite()) ? Status::kOk : Status::kNumericalFailure;
+  if (!f.ok()) f.message = "I - hA is too ill-conditioned at h = " + short_number(h);
   return f;
 }
 
@@ -117,11 +118,11 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
 
   const StepGrid grid = StepGrid::of(*opt.t_end, opt.h);
   EulerFactors F = euler_factors(sys, grid.h);
-  if (!F.ok) return fail("euler: " + F.message, x);
+  if (!F.ok()) return fail("euler: " + F.message, x);
   EulerFactors F_last;
   if (grid.h_last != grid.h) {
     F_last = euler_factors(sys, grid.h_last);
-    if (!F_last.ok) return fail("euler: last step: " + F_last.message, x);
+    if (!F_last.ok()) return fail("euler: last step: " + F_last.message, x);
   }
 
   OutputSampler sampler(opt.dt_out);

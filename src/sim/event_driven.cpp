@@ -133,7 +133,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
   for (const auto& w : ev.warnings) tr.add_warning(w);
   std::string err;
   Phase phase;
-  if (!ev.ok) {
+  if (!ev.ok()) {
     fail(ev.message);
   } else {
     phase = make_phase(ev.mode, ldcp_undetermined_, ev.x_plus, err);
@@ -359,7 +359,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     ev = process_event(t, x_minus);
     tr.lcp_solves += ev.lcp_solves;
     for (const auto& w : ev.warnings) tr.add_warning(w);
-    if (!ev.ok) {
+    if (!ev.ok()) {
       fail(ev.message);
       xa = x_minus;
       break;

@@ -84,7 +84,8 @@ struct Phase {
 };
 
 struct EventResult {
-  bool ok = false;
+  Status status = Status::kNumericalFailure;  // kOk when computed; message says why not
+  bool ok() const { return status == Status::kOk; }
   std::string message;
   VectorXd x_plus;
   lcs::IndexSet mode;

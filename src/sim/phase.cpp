@@ -104,7 +104,7 @@ Phase EventDriven::make_phase(const lcs::IndexSet& mode, const lcs::IndexSet& un
     if (it == feedback_cache_.end())
       it = feedback_cache_.emplace(mode, lcs::mode_feedback(sys_, mode)).first;
     const lcs::ModeFeedback& fb = it->second;
-    if (!fb.ok) {
+    if (!fb.ok()) {
       err = "mode feedback F_I unavailable: " + fb.message;
       return ph;
     }

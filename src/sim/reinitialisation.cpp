@@ -85,7 +85,7 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
     in.restitution = limit_taken ? VectorXd::Zero(k_) : VectorXd(restitution_);
     const impact::ImpactResult ir = impact_->apply(in, *solver_);
     out.lcp_solves += ir.lcp_solves;
-    if (!ir.ok) {
+    if (!ir.ok()) {
       out.message = "impact at t = " + std::to_string(t) + ": " + ir.message;
       return out;
     }
@@ -116,13 +116,13 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
   o.regular_only = true;  // the state is now regular: contact forces and higher
   const lcs::ModeSelection sel = lcs::select_mode(sys_, xa, o);
   out.lcp_solves += sel.lcp_solves;
-  if (!sel.ok) {
+  if (!sel.ok()) {
     out.message = "mode selection at t = " + std::to_string(t) + ": " + sel.message;
     return out;
   }
   out.mode = sel.mode;
   out.x_plus = xa;
-  out.ok = true;
+  out.status = Status::kOk;
   ldcp_undetermined_ = sel.undetermined;
   return out;
 }
@@ -136,7 +136,7 @@ EventResult EventDriven::process_lcs(const VectorXd& xa0) {
   for (int iter = 0; iter < 4; ++iter) {
     const lcs::ModeSelection sel = lcs::select_mode(sys_, xa, ldcp_);
     out.lcp_solves += sel.lcp_solves;
-    if (!sel.ok) {
+    if (!sel.ok()) {
       out.message = "mode selection: " + sel.message;
       return out;
     }
@@ -146,7 +146,7 @@ EventResult EventDriven::process_lcs(const VectorXd& xa0) {
     if (!impulsive) {
       out.mode = sel.mode;
       out.x_plus = xa;
-      out.ok = true;
+      out.status = Status::kOk;
       ldcp_undetermined_ = sel.undetermined;
       return out;
     }

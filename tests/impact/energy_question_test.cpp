@@ -37,7 +37,7 @@ TEST(Section822, NewtonWithDifferentCoefficientsGainsEnergy) {
   const auto m = testing::three_balls();
   const ImpactResult r =
       moreau_newton(testing::input(m, vec({4, 0, -1}), {0, 1}, vec({1, 0})), pivot());
-  ASSERT_TRUE(r.ok) << r.message;
+  ASSERT_TRUE(r.ok()) << r.message;
   // Small integers throughout: exact up to rounding of a few flops.
   EXPECT_NEAR(r.impulse(0), 6.0, 1e-14);  // (1 + 1) * 3
   EXPECT_NEAR(r.impulse(1), 2.0, 1e-14);  // (1 + 0) * 2
@@ -52,7 +52,7 @@ TEST(Section822, NewtonWithDifferentCoefficientsGainsEnergy) {
   for (const char* name : {"moreau-restitution", "sequential"}) {
     const ImpactResult s = make_impact_law(name)->apply(
         testing::input(m, vec({4, 0, -1}), {0, 1}, vec({1, 0})), pivot());
-    ASSERT_TRUE(s.ok) << name << ": " << s.message;
+    ASSERT_TRUE(s.ok()) << name << ": " << s.message;
     EXPECT_LE(s.energy_after, s.energy_before) << name;
   }
 }
@@ -69,7 +69,7 @@ TEST(Section822, NewtonIsNotWellDefinedForDependentConstraints) {
   const auto in = testing::input(m, vec({-1}), {0, 1}, vec({0, 1}));
   for (const char* s : {"lemke", "pivot", "pgs"}) {
     const ImpactResult r = moreau_newton(in, *lcp::make_solver(s));
-    ASSERT_TRUE(r.ok) << s << ": " << r.message;
+    ASSERT_TRUE(r.ok()) << s << ": " << r.message;
     // lambda1 + lambda2 = 1 (the inelastic jump to 0) whatever the solver...
     EXPECT_NEAR(r.impulse(0) + r.impulse(1) / 2.0, 1.0, 1e-9) << s;
     // ...but v+ = lambda2 anywhere in [0, 1].
@@ -99,7 +99,7 @@ TEST(Section822, RandomSearchFindsGainsOnlyWithInadmissibleJumps) {
     for (int i = 0; i < k; ++i) e(i) = binary ? std::round(u01(rng)) : u01(rng);
     const ImpactInput in = testing::input(ri.model, ri.v, ri.closed, e);
     const ImpactResult r = moreau_newton(in, pivot());
-    ASSERT_TRUE(r.ok) << r.message;
+    ASSERT_TRUE(r.ok()) << r.message;
     if (r.energy_before <= 0.0) continue;
     const double rel = (r.energy_after - r.energy_before) / r.energy_before;
     // The identity, on the closed set.

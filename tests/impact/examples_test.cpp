@@ -61,7 +61,7 @@ TEST(Example383, MoreauAndItsMinimisationSelectTheHookAlone) {
   for (const char* rule : {"moreau", "moreau-qp"}) {
     SCOPED_TRACE(rule);
     const ImpactResult r = run(rule, in);
-    ASSERT_TRUE(r.ok) << r.message;
+    ASSERT_TRUE(r.ok()) << r.message;
     const double tol = std::string(rule) == "moreau" ? 1e-14 : 1e-8;
     expect_near(r.v_after, vec({0.5, 0.5}), tol);
     expect_near(r.impulse, vec({0.0, 1.5}), tol);
@@ -77,7 +77,7 @@ TEST(Example383, MoreauAndItsMinimisationSelectTheHookAlone) {
 TEST(Example383, RuleOf177SelectsBothAndNeedsAPullingStop) {
   const auto m = testing::hook_model();
   const ImpactResult r = run("flip", input(m, vec({-1, 2}), {0, 1}));
-  ASSERT_TRUE(r.ok) << r.message;
+  ASSERT_TRUE(r.ok()) << r.message;
   EXPECT_EQ(r.mode, (IndexSet{0, 1}));
   expect_near(r.impulse, vec({-1.0, 2.0}), 1e-14);
   expect_near(r.v_after, vec({0.0, 0.0}), 1e-14);
@@ -92,7 +92,7 @@ TEST(Example383, RulesAgreeWhenTheFlipImpulseIsNonnegative) {
   const auto m = testing::hook_model();
   const auto in = input(m, vec({-1, 0}), {0, 1});
   const ImpactResult mo = run("moreau", in), fl = run("flip", in);
-  ASSERT_TRUE(mo.ok && fl.ok);
+  ASSERT_TRUE(mo.ok() && fl.ok());
   expect_near(mo.v_after, vec({0, 0}), 1e-14);
   expect_near(fl.v_after, mo.v_after, 1e-14);
   expect_near(fl.impulse, mo.impulse, 1e-14);
@@ -104,7 +104,7 @@ TEST(Example383, RulesAgreeWhenTheFlipImpulseIsNonnegative) {
 TEST(Example141, MoreauGivesOneThirdEach) {
   const auto m = testing::three_balls();
   const ImpactResult r = run("moreau", input(m, vec({1, 0, 0}), {0, 1}));
-  ASSERT_TRUE(r.ok) << r.message;
+  ASSERT_TRUE(r.ok()) << r.message;
   expect_near(r.v_after, vec({1.0 / 3, 1.0 / 3, 1.0 / 3}), 1e-14);
   expect_near(r.impulse, vec({2.0 / 3, 1.0 / 3}), 1e-14);
   EXPECT_EQ(r.mode, (IndexSet{0, 1}));
@@ -118,7 +118,7 @@ TEST(Example141, SequentialReproducesThePrintedIteratesAndConverges) {
   auto in = input(m, vec({1, 0, 0}), {0, 1});
   in.record_iterates = true;
   const ImpactResult r = run("sequential", in);
-  ASSERT_TRUE(r.ok) << r.message;
+  ASSERT_TRUE(r.ok()) << r.message;
   const std::vector<Eigen::VectorXd> printed = {vec({1, 0, 0}),
                                                 vec({0.5, 0.5, 0}),
                                                 vec({0.5, 0.25, 0.25}),
@@ -142,7 +142,7 @@ TEST(Example141, SequentialReportsTheCap) {
   auto in = input(m, vec({1, 0, 0}), {0, 1});
   in.max_iterations = 5;
   const ImpactResult r = run("sequential", in);
-  EXPECT_FALSE(r.ok);
+  EXPECT_FALSE(r.ok());
   EXPECT_EQ(r.iterations, 5);
   EXPECT_NE(r.message.find("not converged"), std::string::npos) << r.message;
 }
@@ -153,19 +153,19 @@ TEST(NewtonsCradle, SimultaneousAndSequentialPartButKeepEnergy) {
   const auto m = testing::three_balls();
   const auto in = input(m, vec({1, 0, 0}), {0, 1}, vec({1, 1}));
   const ImpactResult nw = run("newton", in);
-  ASSERT_TRUE(nw.ok) << nw.message;
+  ASSERT_TRUE(nw.ok()) << nw.message;
   expect_near(nw.v_after, vec({-1.0 / 3, 2.0 / 3, 2.0 / 3}), 1e-14);
   expect_near(nw.impulse, vec({4.0 / 3, 2.0 / 3}), 1e-14);
   EXPECT_NEAR(nw.energy_after, 0.5, 1e-14);
   const ImpactResult sq = run("sequential", in);
-  ASSERT_TRUE(sq.ok) << sq.message;
+  ASSERT_TRUE(sq.ok()) << sq.message;
   expect_near(sq.v_after, vec({0, 0, 1}), 1e-15);
   EXPECT_EQ(sq.iterations, 2);
   EXPECT_NEAR(sq.energy_after, 0.5, 1e-15);
   // With one coefficient for all contacts, restitution inside the LCP
   // (Moreau–Jean) is the same map as Newton's on the inelastic impulse.
   const ImpactResult mj = run("moreau-restitution", in);
-  ASSERT_TRUE(mj.ok) << mj.message;
+  ASSERT_TRUE(mj.ok()) << mj.message;
   expect_near(mj.v_after, nw.v_after, 1e-14);
 }
 
@@ -173,7 +173,7 @@ TEST(ImpactRules, NoClosedContactMeansNoImpact) {
   const auto m = testing::three_balls();
   for (const auto& name : impact_law_names()) {
     const ImpactResult r = run(name, input(m, vec({1, 0, 0}), {}));
-    EXPECT_TRUE(r.ok) << name;
+    EXPECT_TRUE(r.ok()) << name;
     expect_near(r.v_after, vec({1, 0, 0}), 0.0);
     EXPECT_EQ(r.impulse.size(), 2);
   }
@@ -200,7 +200,7 @@ TEST(ImpactRules, NearlyDependentRowsGiveTheExactVelocity) {
           std::tuple{"moreau-restitution", 0.5, vec({0.5, 0})}}) {
       SCOPED_TRACE(std::string(rule) + " d " + std::to_string(d));
       const ImpactResult r = run(rule, input(m, vec({-1, 0}), {0, 1}, vec({e, e})));
-      ASSERT_TRUE(r.ok) << rule << " d " << d << ": " << r.message;
+      ASSERT_TRUE(r.ok()) << rule << " d " << d << ": " << r.message;
       expect_near(r.v_after, v_after, 1e-14);
       EXPECT_NEAR(r.impulse.sum(), 4 * (1 + e), 1e-12) << rule << " d " << d;
       EXPECT_GE(r.impulse.minCoeff(), 0.0) << rule << " d " << d;
@@ -213,7 +213,7 @@ TEST(ImpactRules, BadInputIsAResultNotAnException) {
   const auto m = testing::three_balls();
   for (const auto& name : impact_law_names()) {
     const ImpactResult r = run(name, input(m, vec({1, 0}), {0}));
-    EXPECT_FALSE(r.ok) << name;
+    EXPECT_FALSE(r.ok()) << name;
     EXPECT_NE(r.message.find("velocity"), std::string::npos) << r.message;
   }
 }

@@ -69,7 +69,7 @@ TEST(ImpactMap, ClosedMapCellsAreTheLawAppliedToTheHandBuiltVelocity) {
       in.v = Eigen::Vector3d(w1, w1 - w2, 0.7);
       in.closed = {0, 1};
       const impact::ImpactResult r = law->apply(in, *solver);
-      ASSERT_TRUE(r.ok) << r.message;
+      ASSERT_TRUE(r.ok()) << r.message;
       EXPECT_EQ(c.mode, r.mode) << "w = " << w1 << ", " << w2;
       const Eigen::Vector2d after = EJ * r.v_after;
       EXPECT_NEAR(c.after(0), after(0), 1e-13);

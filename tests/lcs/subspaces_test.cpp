@@ -91,13 +91,13 @@ TEST(Subspaces, UnconstrainedModeIsWholeSpaceAndNoJump) {
   EXPECT_EQ(consistent_subspace(s, {}).basis.cols(), 4);  // V_{} = R^4
   EXPECT_EQ(jump_space(s, {}).basis.cols(), 0);           // T_{} = {0}
   const auto P = projection(s, {});
-  ASSERT_TRUE(P.ok) << P.message;
+  ASSERT_TRUE(P.ok()) << P.message;
   EXPECT_LT((P.P - MatrixXd::Identity(4, 4)).norm(), kExact);
 }
 
 TEST(Projection, TwoCartsExample345) {
   const auto P = projection(two_carts(), {0});
-  ASSERT_TRUE(P.ok) << P.message;
+  ASSERT_TRUE(P.ok()) << P.message;
   // Example 3.4.5 / §3.7: the left cart's velocity is reset to zero.
   EXPECT_LT((P.P * Eigen::Vector4d(0, -1, -1, 0) - Eigen::Vector4d(0, -1, 0, 0)).norm(), kExact);
   EXPECT_LT((P.P * Eigen::Vector4d(0, 1, -1, 0) - Eigen::Vector4d(0, 1, 0, 0)).norm(), kExact);
@@ -114,12 +114,12 @@ TEST(Projection, HookModeExample383) {
   EXPECT_EQ(V.cols(), 2);
   EXPECT_EQ(T.cols(), 2);
   const auto P = projection(s, {1});
-  ASSERT_TRUE(P.ok) << P.message;
+  ASSERT_TRUE(P.ok()) << P.message;
   EXPECT_LT((P.P * Eigen::Vector4d(0, 0, -1, 2) - Eigen::Vector4d(0, 0, 0.5, 0.5)).norm(), kExact);
   // Both constraints active: only rest at q = 0 is consistent.
   EXPECT_EQ(consistent_subspace(s, {0, 1}).basis.cols(), 0);
   const auto P01 = projection(s, {0, 1});
-  ASSERT_TRUE(P01.ok) << P01.message;
+  ASSERT_TRUE(P01.ok()) << P01.message;
   EXPECT_LT(P01.P.norm(), kExact);
 }
 
@@ -130,7 +130,7 @@ TEST(Projection, TripleIntegratorModeHasNoConsistentState) {
   EXPECT_EQ(consistent_subspace(s, {0}).basis.cols(), 0);
   EXPECT_EQ(jump_space(s, {0}).basis.cols(), 3);
   const auto P = projection(s, {0});
-  ASSERT_TRUE(P.ok) << P.message;
+  ASSERT_TRUE(P.ok()) << P.message;
   EXPECT_LT((P.P * Eigen::Vector3d(1, -2, 3)).norm(), kExact);
   EXPECT_LT(P.P.norm(), kExact);
 }
@@ -143,10 +143,10 @@ TEST(Projection, InvertibleFeedthroughMode) {
   EXPECT_EQ(consistent_subspace(s, {0}).basis.cols(), 4);
   EXPECT_EQ(jump_space(s, {0}).basis.cols(), 0);
   const auto P = projection(s, {0});
-  ASSERT_TRUE(P.ok) << P.message;
+  ASSERT_TRUE(P.ok()) << P.message;
   EXPECT_LT((P.P - MatrixXd::Identity(4, 4)).norm(), kExact);
   const auto F = mode_feedback(s, {0});
-  ASSERT_TRUE(F.ok) << F.message;
+  ASSERT_TRUE(F.ok()) << F.message;
   // F = -D^{-1} C = (-1/2, 0, 0, 0).
   EXPECT_LT((F.F - (MatrixXd(1, 4) << -0.5, 0, 0, 0).finished()).norm(), kExact);
 }
@@ -157,10 +157,10 @@ TEST(Projection, NonAutonomousModeIsRefused) {
   Lcs s = two_carts();
   s.B.setZero();
   const auto P = projection(s, {0});
-  EXPECT_FALSE(P.ok);
+  EXPECT_FALSE(P.ok());
   EXPECT_NE(P.message.find("not autonomous"), std::string::npos) << P.message;
   const auto F = mode_feedback(s, {0});
-  EXPECT_FALSE(F.ok);
+  EXPECT_FALSE(F.ok());
   EXPECT_FALSE(F.message.empty());
 }
 
@@ -172,10 +172,10 @@ TEST(Projection, DuplicateConstraintIsNotAutonomous) {
   s.C = (MatrixXd(2, 4) << 1, 0, 0, 0, 1, 0, 0, 0).finished();
   s.D = MatrixXd::Zero(2, 2);
   const auto P = projection(s, {0, 1});
-  EXPECT_FALSE(P.ok);
+  EXPECT_FALSE(P.ok());
   EXPECT_NE(P.message.find("Ker [B_.I; D_II]"), std::string::npos) << P.message;
   const auto F = mode_feedback(s, {0, 1});
-  EXPECT_FALSE(F.ok);
+  EXPECT_FALSE(F.ok());
   EXPECT_NE(F.message.find("singular"), std::string::npos) << F.message;
 }
 
@@ -187,7 +187,7 @@ TEST(Projection, RejectsBadIndexSets) {
 // F_I keeps V_I invariant under A + B_.I F_I and C_I x = 0 there (§3.4.1).
 void expect_feedback_invariance(const Lcs& s, const IndexSet& I) {
   const auto F = mode_feedback(s, I);
-  ASSERT_TRUE(F.ok) << F.message;
+  ASSERT_TRUE(F.ok()) << F.message;
   const MatrixXd V = consistent_subspace(s, I).basis;
   MatrixXd BI(s.n(), static_cast<int>(I.size())), CI(static_cast<int>(I.size()), s.n());
   for (std::size_t a = 0; a < I.size(); ++a) {
@@ -207,7 +207,7 @@ void expect_feedback_invariance(const Lcs& s, const IndexSet& I) {
 TEST(ModeFeedback, TwoCartsConstrainedMode) {
   const Lcs s = two_carts();
   const auto F = mode_feedback(s, {0});
-  ASSERT_TRUE(F.ok) << F.message;
+  ASSERT_TRUE(F.ok()) << F.message;
   // §3.7 step four (with DESIGN.md's sign fix): y'' = -2x1 + x2 + u, so
   // F = -(C A^2) = (2, -1, 0, 0), and on V_{1} u = -x2.
   EXPECT_LT((F.F - (MatrixXd(1, 4) << 2, -1, 0, 0).finished()).norm(), kExact);
@@ -257,8 +257,8 @@ TEST_P(ScaleInvariance, SameSubspacesAndProjection) {
       EXPECT_LT((orthogonal_projector(V) - orthogonal_projector(V0)).norm(), kExact);
       EXPECT_LT((orthogonal_projector(T) - orthogonal_projector(T0)).norm(), kExact);
       const auto P0 = projection(base, I), P = projection(s, I);
-      ASSERT_EQ(P.ok, P0.ok);
-      if (P.ok) {
+      ASSERT_EQ(P.ok(), P0.ok());
+      if (P.ok()) {
         EXPECT_LT((P.P - P0.P).norm(), kExact);
       }
     }
@@ -351,7 +351,7 @@ TEST(Projection, MechanicalModeIsMoreausProjection) {
       EXPECT_EQ(consistent_subspace(m.sys, I).basis.cols(), 2 * N + 1 - 2 * a);
       EXPECT_EQ(jump_space(m.sys, I).basis.cols(), 2 * a);
       const auto P = projection(m.sys, I);
-      ASSERT_TRUE(P.ok) << P.message;
+      ASSERT_TRUE(P.ok()) << P.message;
       // The closed form and P both lose ~cond(M) * eps relative accuracy
       // (mass ratio up to 1e6 -> ~1e-10); 1e-8 relative to |x| leaves a margin.
       EXPECT_LT((P.P * x - expected).norm(), 1e-8 * x.norm())

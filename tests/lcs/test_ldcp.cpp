@@ -44,7 +44,7 @@ Lcs hook() {  // Example 3.8.3
 // weight 1), the constrained mode, and the jump to (0,-1,0,0).
 TEST(Ldcp, TwoCartsImpact) {
   const auto sel = select_mode(two_carts(), Vector4d(0, -1, -1, 0));
-  ASSERT_TRUE(sel.ok) << sel.message;
+  ASSERT_TRUE(sel.ok()) << sel.message;
   EXPECT_EQ(sel.mode, (IndexSet{0}));
   EXPECT_NEAR(sel.impulse[0](0), 1.0, 1e-12);
   for (size_t j = 1; j < sel.impulse.size(); ++j) EXPECT_EQ(sel.impulse[j](0), 0.0);
@@ -54,7 +54,7 @@ TEST(Ldcp, TwoCartsImpact) {
 // §3.7 at (0,0,0,1): LDCP_4 selects the unconstrained mode (y^4 = 1 > 0).
 TEST(Ldcp, TwoCartsReleaseSelectsUnconstrained) {
   const auto sel = select_mode(two_carts(), Vector4d(0, 0, 0, 1));
-  ASSERT_TRUE(sel.ok) << sel.message;
+  ASSERT_TRUE(sel.ok()) << sel.message;
   EXPECT_TRUE(sel.mode.empty());
   EXPECT_TRUE(sel.undetermined.empty());
   EXPECT_LE((sel.x_plus - Vector4d(0, 0, 0, 1)).norm(), 0.0);
@@ -65,23 +65,23 @@ TEST(Ldcp, RegularConstrainedState) {
   LdcpOptions o;
   o.regular_only = true;
   const auto sel = select_mode(two_carts(), Vector4d(0, -1, 0, 0), o);
-  ASSERT_TRUE(sel.ok) << sel.message;
+  ASSERT_TRUE(sel.ok()) << sel.message;
   EXPECT_EQ(sel.mode, (IndexSet{0}));
   // regular_only refuses the irregular (0,-1,-1,0) with a message, no guess.
   const auto bad = select_mode(two_carts(), Vector4d(0, -1, -1, 0), o);
-  EXPECT_FALSE(bad.ok);
+  EXPECT_FALSE(bad.ok());
   EXPECT_NE(bad.message.find("not regular"), std::string::npos);
 }
 
 // Example 3.8.3 at (0,0,-1,2): the hook alone, jump to (0,0,½,½).
 TEST(Ldcp, HookOnlyMode) {
   const auto sel = select_mode(hook(), Vector4d(0, 0, -1, 2));
-  ASSERT_TRUE(sel.ok) << sel.message;
+  ASSERT_TRUE(sel.ok()) << sel.message;
   EXPECT_EQ(sel.mode, (IndexSet{1}));
   EXPECT_LE((sel.x_plus - Vector4d(0, 0, 0.5, 0.5)).norm(), 1e-12);
   // The same jump as the projection onto V_{hook} along T_{hook} (§3.4.2).
   const auto P = projection(hook(), IndexSet{1});
-  ASSERT_TRUE(P.ok) << P.message;
+  ASSERT_TRUE(P.ok()) << P.message;
   EXPECT_LE((P.P * Vector4d(0, 0, -1, 2) - sel.x_plus).norm(), 1e-12);
 }
 
@@ -98,7 +98,7 @@ TEST(Ldcp, TripleIntegratorDeltaPrime) {
   s.C(0, 0) = 1;
   s.D = MatrixXd::Zero(1, 1);
   const auto sel = select_mode(s, Eigen::Vector3d(0, -1, 0));
-  ASSERT_TRUE(sel.ok) << sel.message;
+  ASSERT_TRUE(sel.ok()) << sel.message;
   EXPECT_EQ(sel.mode, (IndexSet{0}));
   EXPECT_NEAR(sel.impulse[1](0), 1.0, 1e-12);  // coefficient of delta'
   EXPECT_NEAR(sel.impulse[0](0), 0.0, 1e-12);

@@ -161,11 +161,11 @@ TEST(Passivity, VelocityOutputMassSpringNeedsItsEnergyCertificate) {
   EXPECT_EQ(r.passive, "unknown") << r.passivity_reason;
   const MatrixXd K = (MatrixXd(2, 2) << k, 0, 0, m).finished();
   const auto cert = verify_passivity_certificate(s, K);
-  EXPECT_TRUE(cert.ok) << cert.message;
+  EXPECT_TRUE(cert.ok()) << cert.message;
   // LMI = diag(0, -2d) exactly: largest eigenvalue 0.
   EXPECT_NEAR(cert.lmi_max_eigenvalue, 0.0, kExact);
-  EXPECT_FALSE(verify_passivity_certificate(s, MatrixXd::Identity(2, 2)).ok);
-  EXPECT_FALSE(verify_passivity_certificate(s, -K).ok);
+  EXPECT_FALSE(verify_passivity_certificate(s, MatrixXd::Identity(2, 2)).ok());
+  EXPECT_FALSE(verify_passivity_certificate(s, -K).ok());
 }
 
 TEST(Passivity, ReasonIsAlwaysStated) {

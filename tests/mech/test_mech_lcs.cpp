@@ -41,10 +41,10 @@ TEST(Ldcp, JumpEqualsProjectionOnRandomMechanicalModels) {
     for (int i = 0; i < N; ++i) x(N + i) = U(gen);
     x(2 * N) = 1.0;
     const auto sel = select_mode(sys, x);
-    ASSERT_TRUE(sel.ok) << sel.message;
+    ASSERT_TRUE(sel.ok()) << sel.message;
     if (sel.mode.empty()) continue;
     const auto P = projection(sys, sel.mode);
-    ASSERT_TRUE(P.ok) << P.message;
+    ASSERT_TRUE(P.ok()) << P.message;
     EXPECT_LE((P.P * x - sel.x_plus).norm(), 1e-9 * (1.0 + x.norm())) << "trial " << trial;
     // Moreau: the post-jump rates of the active constraints vanish.
     const VectorXd rates = m.E * sel.x_plus.segment(N, N);

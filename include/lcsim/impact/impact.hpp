@@ -20,7 +20,8 @@ using Eigen::VectorXd;
 using IndexSet = std::vector<int>;
 
 struct ImpactResult {
-  bool ok = false;
+  Status status = Status::kNumericalFailure;  // kOk when computed; message says why not
+  bool ok() const { return status == Status::kOk; }
   std::string message;
   VectorXd v_after;  // post-impact velocity (N)
   VectorXd impulse;  // per constraint (k, zero outside the closed set)

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <lcsim/core/status.hpp>
 #include <lcsim/lcp/lcp.hpp>
 #include <string>
 #include <vector>
@@ -67,7 +68,8 @@ JumpSpace jump_space(const Lcs& sys, const IndexSet& I);
 // V_I ⊕ T_I != R^n, i.e. mode I is not autonomous (Lemma 3.3.3).
 struct Projection {
   MatrixXd P;
-  bool ok = false;
+  Status status = Status::kNumericalFailure;  // kOk when computed; message says why not
+  bool ok() const { return status == Status::kOk; }
   std::string message;
 };
 Projection projection(const Lcs& sys, const IndexSet& I);
@@ -78,7 +80,8 @@ Projection projection(const Lcs& sys, const IndexSet& I);
 // ok = false when script M_II is singular.
 struct ModeFeedback {
   MatrixXd F;
-  bool ok = false;
+  Status status = Status::kNumericalFailure;  // kOk when computed; message says why not
+  bool ok() const { return status == Status::kOk; }
   std::string message;
 };
 ModeFeedback mode_feedback(const Lcs& sys, const IndexSet& I);
@@ -109,7 +112,8 @@ WellPosednessReport analyze_well_posedness(const Lcs& sys);
 // Theorem 3.6.7, extended to the impulsive levels -n+1..0). Requires script M
 // to be a P-matrix for uniqueness; a failing LCP is reported, not hidden.
 struct ModeSelection {
-  bool ok = false;
+  Status status = Status::kNumericalFailure;  // kOk when computed; message says why not
+  bool ok() const { return status == Status::kOk; }
   std::string message;
   IndexSet mode;          // I: constraints with lexicographically positive u
   IndexSet undetermined;  // K: u and y identically zero so far (Remark 3.4.8)
@@ -195,7 +199,8 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
 namespace lcsim::lcs {
 
 struct PassivityCertificateCheck {
-  bool ok = false;
+  Status status = Status::kNumericalFailure;  // kOk when computed; message says why not
+  bool ok() const { return status == Status::kOk; }
   double lmi_max_eigenvalue = 0.0;  // largest eigenvalue of L(K) (must be <= ~0)
   double k_min_eigenvalue = 0.0;    // smallest eigenvalue of K (must be > 0)
   std::string message;
