@@ -53,7 +53,8 @@ sim::Trajectory step_run(const std::string& method, const mech::Model& model, co
 std::string diag(const sim::Trajectory& tr) {
   std::string s;
   if (tr.status != sim::RunStatus::kCompleted) s += " FAILED: " + tr.message;
-  for (const auto& w : tr.warning_messages) s += " [warn: " + w + "]";
+  for (const auto& w : tr.warnings)
+    s += " [warn x" + std::to_string(w.count) + ": " + w.message + "]";
   return s;
 }
 

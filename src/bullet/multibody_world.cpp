@@ -45,7 +45,6 @@
 #include <btBulletDynamicsCommon.h>
 
 #include <Eigen/Eigenvalues>
-#include <chrono>
 #include <cmath>
 #include <lcsim/bullet/bullet.hpp>
 #include <memory>
@@ -165,7 +164,8 @@ std::unique_ptr<MbWorld> build(const io::Scene& setup, const mech::MechanicalMod
 void warn(sim::Trajectory& tr, const mech::MechanicalModel& m, const MatrixXd& K_s,
           const sim::Options& opt) {
   if (m.D.norm() > 0.0)
-    tr.add_warning(
+    tr.warn(
+        "bullet-explicit-damping", 0.0,
         "bullet: dampers are explicit joint torques -D v (stable only for h small against M/D)");
   // Springs are explicit torques (symplectic Euler): stable for omega h <= 2,
   // omega^2 the largest eigenvalue of K_s x = omega^2 M(q0) x.
@@ -174,17 +174,18 @@ void warn(sim::Trajectory& tr, const mech::MechanicalModel& m, const MatrixXd& K
                                                                 Eigen::EigenvaluesOnly);
     const double w = std::sqrt(std::max(0.0, es.eigenvalues().maxCoeff()));
     if (w * opt.h > 2.0)
-      tr.add_warning(
-          "bullet: springs are explicit joint torques, unstable for omega h > 2: omega = " +
-          fmt(w) + " rad/s gives omega h = " + fmt(w * opt.h) + " at h = " + fmt(opt.h) +
-          "; expect growth, or reduce h");
+      tr.warn("bullet-explicit-springs", 0.0,
+              "bullet: springs are explicit joint torques, unstable for omega h > 2: omega = " +
+                  fmt(w) + " rad/s gives omega h = " + fmt(w * opt.h) + " at h = " + fmt(opt.h) +
+                  "; expect growth, or reduce h");
   }
   for (int i = 0; i < m.num_constraints(); ++i)
     if (m.restitution(i) > 0.0) {
-      tr.add_warning(
-          "bullet: restitution is lost: Bullet's multibody joint limits are inelastic "
-          "(btMultiBodyJointLimitConstraint has no bounce); constraint '" +
-          m.constraints[static_cast<std::size_t>(i)] + "' has e = " + fmt(m.restitution(i)));
+      tr.warn("bullet-restitution-lost", 0.0,
+              "bullet: restitution is lost: Bullet's multibody joint limits are inelastic "
+              "(btMultiBodyJointLimitConstraint has no bounce); constraint '" +
+                  m.constraints[static_cast<std::size_t>(i)] +
+                  "' has e = " + fmt(m.restitution(i)));
       break;
     }
 }
@@ -225,7 +226,6 @@ std::string multibody_description(const WorldSettings& s) {
 sim::Trajectory simulate_multibody(const mech::Model& model, const io::Scene& setup,
                                    const std::vector<JointLimit>& limits, const VectorXd& x0,
                                    const sim::Options& opt, const WorldSettings& s) {
-  const auto wall0 = std::chrono::steady_clock::now();
   sim::Trajectory tr;
   tr.method = "bullet " + multibody_description(s);
   tr.t_end = *opt.t_end;
@@ -233,8 +233,6 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const io::Scene& se
   auto fail = [&](const std::string& msg) {
     tr.status = sim::RunStatus::kNumericalFailure;
     tr.message = msg;
-    tr.wall_time_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     return std::move(tr);  // only ever returned from the run: no copy of the samples
   };
   const mech::MechanicalModel& m = *model.mechanical;
@@ -296,7 +294,6 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const io::Scene& se
     v = v_next;
   }
   rec.finish();
-  tr.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return tr;
 }
 

@@ -7,7 +7,6 @@ namespace lcsim::bullet {
 
 using Eigen::VectorXd;
 
-
 RunRecorder::RunRecorder(const mech::MechanicalModel& m, const sim::Options& opt,
                          sim::Trajectory& tr, const VectorXd& q0, const VectorXd& v0)
     : m_(m), opt_(opt), tr_(tr), sampler_(opt.dt_out), q_(q0), v_(v0) {

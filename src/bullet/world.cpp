@@ -284,7 +284,6 @@ namespace {
 
 sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>& limits,
                              const VectorXd& x0, const sim::Options& opt, const WorldSettings& s) {
-  const auto wall0 = std::chrono::steady_clock::now();
   sim::Trajectory tr;
   tr.method = "bullet " + rb6_description(s);
   tr.t_end = *opt.t_end;
@@ -292,16 +291,14 @@ sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>&
   auto fail = [&](const std::string& msg) {
     tr.status = sim::RunStatus::kNumericalFailure;
     tr.message = msg;
-    tr.wall_time_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     return std::move(tr);  // only ever returned from the run: no copy of the samples
   };
   const mech::MechanicalModel& m = *model.mechanical;
   const int N = m.dofs(), k = m.num_constraints();
   VectorXd q = x0.head(N), v = x0.tail(N);
   if (m.D.norm() > 0.0)
-    tr.add_warning(
-        "bullet: dampers are explicit forces -D v (stable only for h small against M/D)");
+    tr.warn("bullet-explicit-damping", 0.0,
+            "bullet: dampers are explicit forces -D v (stable only for h small against M/D)");
   // Springs are explicit forces too (symplectic Euler): stable for omega h <= 2
   // with omega the fastest frequency, bounded here by Gershgorin on M^-1 K
   // (M is diagonal in this scene).
@@ -313,10 +310,10 @@ sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>&
       w2 = std::max(w2, row / m.M.coeff(j, j));  // K symmetric: column sums = row sums
     }
     if (std::sqrt(w2) * opt.h > 2.0)
-      tr.add_warning(
-          "bullet: springs are explicit forces -K q, unstable for omega h > 2: omega <= " +
-          fmt(std::sqrt(w2)) + " rad/s gives omega h up to " + fmt(std::sqrt(w2) * opt.h) +
-          " at h = " + fmt(opt.h) + "; expect growth, or reduce h");
+      tr.warn("bullet-explicit-springs", 0.0,
+              "bullet: springs are explicit forces -K q, unstable for omega h > 2: omega <= " +
+                  fmt(std::sqrt(w2)) + " rad/s gives omega h up to " + fmt(std::sqrt(w2) * opt.h) +
+                  " at h = " + fmt(opt.h) + "; expect growth, or reduce h");
   }
   // Measured (a ball dropped on a 6DOF2 lower limit, e = 0.5, h = 1e-3,
   // Bullet 3.24 from Debian): no rebound at the pinned stop ERP 0.2 (nor at
@@ -324,11 +321,11 @@ sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>&
   // lcsim keeps ERP 0.2 (what the comparisons were measured with) and says so.
   for (int i = 0; i < k; ++i)
     if (m.restitution(i) > 0.0 && s.stop_erp < 1.0) {
-      tr.add_warning(
-          "bullet: restitution is lost or reduced: Bullet 3.24 applies a limit's bounce "
-          "only near stop ERP 1 (this scene uses " +
-          fmt(s.stop_erp) + "; at 0.2 nothing rebounds); constraint '" + m.constraints[i] +
-          "' has e = " + fmt(m.restitution(i)));
+      tr.warn("bullet-restitution-lost", 0.0,
+              "bullet: restitution is lost or reduced: Bullet 3.24 applies a limit's bounce "
+              "only near stop ERP 1 (this scene uses " +
+                  fmt(s.stop_erp) + "; at 0.2 nothing rebounds); constraint '" + m.constraints[i] +
+                  "' has e = " + fmt(m.restitution(i)));
       break;
     }
 
@@ -378,11 +375,27 @@ sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>&
     v = v_next;
   }
   rec.finish();
-  tr.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return tr;
 }
 
 }  // namespace
+
+std::string settings_error(const WorldSettings& s) {
+  auto bad = [](const char* name, double value, const char* rule) {
+    return std::string("bullet setting ") + name + " must be " + rule + " (got " + fmt(value) + ")";
+  };
+  if (s.solver_iterations < 1) return bad("solver_iterations", s.solver_iterations, ">= 1");
+  if (!(s.stop_erp > 0.0 && s.stop_erp <= 1.0)) return bad("stop_erp", s.stop_erp, "in (0, 1]");
+  if (!(std::isfinite(s.stop_cfm) && s.stop_cfm >= 0.0))
+    return bad("stop_cfm", s.stop_cfm, "finite and >= 0");
+  if (!(std::isfinite(s.limit_erp) && s.limit_erp >= 0.0))
+    return bad("limit_erp", s.limit_erp, "finite and >= 0");
+  if (!(std::isfinite(s.limit_range) && s.limit_range > 0.0))
+    return bad("limit_range", s.limit_range, "finite and > 0");
+  if (!(std::isfinite(s.limit_max_impulse) && s.limit_max_impulse > 0.0))
+    return bad("limit_max_impulse", s.limit_max_impulse, "finite and > 0");
+  return "";
+}
 
 namespace {
 sim::OptionsUsed bullet_options_used() {
@@ -398,10 +411,19 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
   sim::Options opt = options;
   if (auto refused = sim::refuse_invalid_run(model, x0, opt, "bullet", bullet_options_used()))
     return std::move(*refused);
+  if (std::string why = settings_error(s); !why.empty()) {
+    sim::Trajectory tr;
+    tr.method = "bullet";
+    tr.status = sim::RunStatus::kInvalidInput;
+    tr.message = std::move(why);
+    return tr;
+  }
+  const auto wall0 = std::chrono::steady_clock::now();
   const Plan p = plan_of(model, s);  // throws for an inexpressible model
   sim::Trajectory tr = p.scene ? simulate_multibody(model, *p.scene, p.joint_limits, x0, opt, s)
                                : simulate_rb6(model, p.rb6_limits, x0, opt, s);
-  if (!p.warning.empty()) tr.add_warning(p.warning);
+  if (!p.warning.empty()) tr.warn("bullet-scene", 0.0, p.warning);
+  tr.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return tr;
 }
 

@@ -84,25 +84,10 @@ class StateThinner {
 sim::Options run_options(const SimulateArgs& a, const mech::Model& model) {
   sim::Options opt;
   opt.t_end = resolve_horizon(model, a.model, a.t_end_given, a.t_end);
-  if (!(a.dt_out >= 0.0) || !std::isfinite(a.dt_out))
-    throw io::InputError("--dt-out: must be a finite number >= 0 (got " + std::to_string(a.dt_out) +
-                         ")");
+  // dt_out, h and theta are checked by the run (sim::check_run), whoever calls it.
   opt.dt_out = a.dt_out;
-  // The given --h and --theta are checked here to name the flag; the run
-  // checks them again (sim::Integrator::run) whoever calls it.
-  if (a.h) {
-    if (!(*a.h > 0.0) || !std::isfinite(*a.h))
-      throw io::InputError("--h: must be a finite number > 0 (got " + std::to_string(*a.h) + ")");
-    if (*a.h > *opt.t_end)
-      throw io::InputError("--h: must not exceed the horizon " + std::to_string(*opt.t_end) +
-                           " (got " + std::to_string(*a.h) + ")");
-    opt.h = *a.h;
-  }
-  if (a.theta) {
-    if (!(*a.theta >= 0.0 && *a.theta <= 1.0))
-      throw io::InputError("--theta: must lie in [0, 1] (got " + std::to_string(*a.theta) + ")");
-    opt.theta = *a.theta;
-  }
+  if (a.h) opt.h = *a.h;
+  if (a.theta) opt.theta = *a.theta;
   if (a.impact) opt.impact = *a.impact;
   if (a.lcp) opt.lcp_solver = *a.lcp;
   if (a.max_output) opt.max_output_bytes = *a.max_output;
@@ -125,8 +110,8 @@ void print_summary(const SimulateArgs& a, const mech::Model& model, const sim::T
   std::printf("final state %s\n", fmt_vec(tr.final_state).c_str());
   if (model.is_mechanical())
     std::printf("energy %.12g -> %.12g\n", tr.energy_initial, tr.energy_final);
-  std::printf("max violation %.3g, LCP solves %ld, warnings %d, wall time %.3g s\n",
-              tr.max_violation, tr.lcp_solves, tr.warnings, tr.wall_time_s);
+  std::printf("max violation %.3g, LCP solves %ld, warnings %ld, wall time %.3g s\n",
+              tr.max_violation, tr.lcp_solves, tr.warning_count(), tr.wall_time_s);
   if (lin)
     std::printf("linearisation error %.3g %% (mass %.3g %%, forces %.3g %%) over %zu states\n",
                 100.0 * lin->error, 100.0 * lin->mass_error, 100.0 * lin->force_error, lin->states);
@@ -138,10 +123,7 @@ void run_simulate(const SimulateArgs& a) {
   const io::LoadedModel loaded = io::load_model_and_scene(a.model);
   const std::optional<io::Scene>& scene = loaded.scene;
   const mech::Model& model = loaded.model;
-  // Names are checked before anything runs, so a typo fails at once.
   auto integrator = sim::make_integrator(a.method);
-  if (a.impact) (void)impact::make_impact_law(*a.impact);
-  if (a.lcp) (void)lcp::make_solver(*a.lcp);
 
   Eigen::VectorXd x0 = resolve_initial_state(model, a.model, a.x0);
   if (a.project && model.is_mechanical() && !sim::infeasible_start(model, x0).empty()) {
@@ -180,7 +162,11 @@ void run_simulate(const SimulateArgs& a) {
   opt.progress = [&progress](double t) { progress.update(t); };
   const sim::Trajectory tr = integrator->run(model, x0, opt);
   // A refused run integrated nothing: the error line is all there is to say.
-  if (tr.status == sim::RunStatus::kInvalidInput) check_status(tr.status, tr.message);
+  if (tr.status == sim::RunStatus::kInvalidInput) {
+    if (!a.project && model.is_mechanical() && !sim::infeasible_start(model, x0).empty())
+      std::cerr << "lcsim: hint: --project starts from the nearest feasible positions\n";
+    check_status(tr.status, tr.message);
+  }
   if (tr.status == sim::RunStatus::kCompleted) progress.done();
   const bool failed = tr.status != sim::RunStatus::kCompleted;
   if (!failed && csv) csv->commit();
@@ -198,7 +184,7 @@ void run_simulate(const SimulateArgs& a) {
     const std::string w = io::linearisation_warning(*lin, a.linearisation_threshold);
     if (!w.empty()) std::cerr << "lcsim: warning: " << w << "\n";
   }
-  for (const auto& w : tr.warning_messages) std::cerr << "lcsim: warning: " << w << "\n";
+  print_warnings(tr);
   check_status(tr.status, tr.message);
 }
 

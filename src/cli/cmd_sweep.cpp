@@ -51,7 +51,7 @@ std::vector<std::string> split_list(const std::string& s) {
   return out;
 }
 
-std::string warning_text(int count, const std::string& first) {
+std::string warning_text(long count, const std::string& first) {
   if (count == 0) return "0";
   return std::to_string(count) + " (" + first + ")";
 }
@@ -118,10 +118,10 @@ void run_sweep(const SweepArgs& a) {
     draw_plot_of_text(j.dump(2), "lcsim_sweep.json", script, a.plot, model.name, "--plot");
     std::cerr << "work-precision diagram written to " << a.plot << "\n";
   }
+  // A refused reference (bad input) exits 2, a failed one 3: its own status.
   for (const auto& ref : s.references)
-    if (ref.status != "completed")
-      throw NumericalError("sweep: the exact reference run (" + ref.law.label() + ") " +
-                           ref.status);
+    check_status(ref.run.status,
+                 "sweep: the exact reference run (" + ref.law.label() + ") " + ref.status);
 }
 
 void setup(CLI::App& app) {

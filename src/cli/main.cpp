@@ -74,7 +74,9 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version exit 0; a malformed command line is an input
+    // error like any other (exit 2), not CLI11's own codes (104, 105, ...).
+    return app.exit(e) == 0 ? 0 : lcsim::cli::exit_code(Status::kInvalidInput);
   } catch (const lcsim::io::InputError& e) {
     return lcsim::cli::report(Status::kInvalidInput, e.what());
   } catch (const std::invalid_argument& e) {

@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <iostream>
 #include <lcsim/io/io.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -191,6 +192,16 @@ void ProgressLine::draw(double t) {
   std::fflush(stderr);
   drawn_ = true;
   last_ = now;
+}
+
+void print_warnings(const sim::Trajectory& tr) {
+  for (const auto& w : tr.warnings) {
+    std::cerr << "lcsim: warning: " << w.message;
+    if (w.count > 1)
+      std::cerr << " (and " << w.count - 1 << " more like it, the first at t = " << w.first_t
+                << ")";
+    std::cerr << "\n";
+  }
 }
 
 }  // namespace lcsim::cli

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <filesystem>
+#include <lcsim/sim/sim.hpp>
 #include <string>
 
 namespace lcsim::cli {
@@ -61,5 +62,9 @@ class ProgressLine {
   bool tty_ = false, drawn_ = false, finished_ = false;
   double start_ = 0.0, last_ = -1.0;
 };
+
+// One line on stderr per kind of warning of the run:
+//   lcsim: warning: <first message> (and N more like it, the first at t = ...)
+void print_warnings(const sim::Trajectory& tr);
 
 }  // namespace lcsim::cli

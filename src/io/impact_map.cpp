@@ -138,31 +138,30 @@ void check_all_closed(const mech::MechanicalModel& m, const ImpactMapSpec& s,
                       const impact::IndexSet& closed) {
   if (m.dofs() != 2)
     throw InputError(
-        "--map: needs a model with two coordinates (or --closed a,b), the model "
-        "has " +
+        "impact map: needs a model with two coordinates, or two closed constraints "
+        "named as its axes; the model has " +
         std::to_string(m.dofs()));
   if (static_cast<int>(closed.size()) != m.num_constraints())
-    throw InputError("--map: every gap must be zero at q = " + vec_text(s.q) +
-                     " (Figure 3.5 is drawn at x1 = x2 = 0); or name the contacts to close "
-                     "with --closed a,b");
+    throw InputError("impact map: every gap must be zero at q = " + vec_text(s.q) +
+                     " (Figure 3.5 is drawn at x1 = x2 = 0); or name two contacts to close");
 }
 
-// The --closed spelling: exactly the named contacts closed at q.
+// The named-contacts spelling: exactly the named contacts closed at q.
 void check_named_closed(const mech::MechanicalModel& m, const ImpactMapSpec& s,
                         const impact::IndexSet& closed) {
   if (s.closed.size() != 2)
-    throw InputError("--closed: name two constraints (the map's two axes), got " +
+    throw InputError("closed constraints: name two constraints (the map's two axes), got " +
                      std::to_string(s.closed.size()));
   const Eigen::VectorXd gap = m.E * s.q + m.g;
   for (int i : s.closed)
     if (std::find(closed.begin(), closed.end(), i) == closed.end())
-      throw InputError("--closed: constraint '" + m.constraints[i] + "' (" + std::to_string(i) +
-                       ") is open at q = " + vec_text(s.q) + " (gap = " + format_number(gap(i)) +
-                       "); give a q that closes it, or omit --x0 to have q placed there");
+      throw InputError("closed constraints: constraint '" + m.constraints[i] + "' (" +
+                       std::to_string(i) + ") is open at q = " + vec_text(s.q) +
+                       " (gap = " + format_number(gap(i)) + "); give a q that closes it");
   for (int i : closed)
     if (std::find(s.closed.begin(), s.closed.end(), i) == s.closed.end())
-      throw InputError("--closed: constraint '" + m.constraints[i] + "' (" + std::to_string(i) +
-                       ") is also closed at q = " + vec_text(s.q) +
+      throw InputError("closed constraints: constraint '" + m.constraints[i] + "' (" +
+                       std::to_string(i) + ") is also closed at q = " + vec_text(s.q) +
                        " (gap 0) but not named; a map has two axes: name two closed contacts");
 }
 
@@ -170,7 +169,7 @@ void check_named_closed(const mech::MechanicalModel& m, const ImpactMapSpec& s,
 
 ImpactMap impact_map(const mech::MechanicalModel& m, const ImpactMapSpec& s) {
   const int N = m.dofs();
-  const std::string what = s.closed.empty() ? "--map" : "--closed";
+  const std::string what = s.closed.empty() ? "impact map" : "closed constraints";
   if (s.q.size() != N || s.v0.size() != N)
     throw InputError(what + ": q and v need " + std::to_string(N) + " entries each");
   ImpactMap map;

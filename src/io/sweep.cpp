@@ -44,10 +44,6 @@ double max_sample_error(const sim::Trajectory& ts, const sim::Trajectory& exact,
   return worst;
 }
 
-std::string first_of(const sim::Trajectory& t) {
-  return t.warning_messages.empty() ? std::string() : t.warning_messages.front();
-}
-
 // The status word of a run: a time-stepping guard's refusal ("euler:
 // refused: ...", src/sim/time_stepping.cpp) is told apart from a failure.
 std::string status_of(const sim::Trajectory& t) {
@@ -56,32 +52,31 @@ std::string status_of(const sim::Trajectory& t) {
 }
 
 void check_options(const SweepOptions& o) {
-  if (o.methods.empty()) throw InputError("--methods: empty list");
+  if (o.methods.empty()) throw InputError("methods: empty list");
   for (const auto& m : o.methods) {
     try {
       (void)sim::make_integrator(m);
     } catch (const std::invalid_argument& e) {
-      throw InputError(std::string("--methods: ") + e.what());
+      throw InputError(std::string("methods: ") + e.what());
     }
   }
-  if (o.hs.empty()) throw InputError("--h: empty list");
+  if (o.hs.empty()) throw InputError("h: empty list");
   for (double h : o.hs)
     if (!(h > 0.0) || !std::isfinite(h) || h > o.base.t_end.value_or(0.0))
-      throw InputError("--h: every step must be finite, > 0 and <= the horizon (got " +
+      throw InputError("h: every step must be finite, > 0 and <= the horizon (got " +
                        format_number(h) + ")");
-  if (o.repeat < 1)
-    throw InputError("--repeat: must be >= 1 (got " + std::to_string(o.repeat) + ")");
+  if (o.repeat < 1) throw InputError("repeat: must be >= 1 (got " + std::to_string(o.repeat) + ")");
   if (!(o.base.theta >= 0.0 && o.base.theta <= 1.0))
-    throw InputError("--theta: must lie in [0, 1] (got " + format_number(o.base.theta) + ")");
+    throw InputError("theta: must lie in [0, 1] (got " + format_number(o.base.theta) + ")");
   try {
     (void)impact::make_impact_law(o.base.impact);
   } catch (const std::invalid_argument& e) {
-    throw InputError(std::string("--impact: ") + e.what());
+    throw InputError(std::string("impact: ") + e.what());
   }
   try {
     (void)lcp::make_solver(o.base.lcp_solver);
   } catch (const std::invalid_argument& e) {
-    throw InputError(std::string("--lcp: ") + e.what());
+    throw InputError(std::string("lcp solver: ") + e.what());
   }
 }
 
@@ -99,8 +94,8 @@ class References {
     r.law = law;
     r.run = run_reference(model_, x0_, law, options(0.0));
     r.status = status_of(r.run);
-    r.warnings = r.run.warnings;
-    r.first_warning = first_of(r.run);
+    r.warnings = r.run.warning_count();
+    r.first_warning = r.run.first_warning();
     runs_.push_back(std::move(r));
     return runs_.back();
   }
@@ -180,8 +175,8 @@ SweepRow stepping_row(const std::string& method, const sim::Integrator& integ, d
   opt.dt_out = std::max(1.0, std::round(o.base.t_end.value_or(model.t_end) / (2000.0 * h))) * h;
   const sim::Trajectory tr = integ.run(model, x0, sim::keep_used(opt, integ.options_used()));
   r.status = status_of(tr);
-  r.warnings = tr.warnings;
-  r.first_warning = first_of(tr);
+  r.warnings = tr.warning_count();
+  r.first_warning = tr.first_warning();
   r.max_violation = tr.max_violation;
   r.steps = tr.steps;
   r.lcp_solves = tr.lcp_solves;
@@ -230,11 +225,11 @@ ReferenceLaw reference_law(const std::string& method, const std::string& impact,
       e ? "" : " (no restitution in this model: every law is inelastic here)";
   if (method == "event") {
     r.law = impact;
-    r.reason = "the exact run itself (--impact " + impact + ")";
+    r.reason = "the exact run itself (impact law " + impact + ")";
   } else if (method == "moreau-jean") {
     r.law = "moreau-restitution";
     r.reason = "Moreau-Jean's own law: restitution inside its step LCP";
-    if (impact != r.law) r.reason += " (--impact " + impact + " does not apply to it)";
+    if (impact != r.law) r.reason += " (impact law " + impact + " does not apply to it)";
   } else if (method == "euler") {
     r.law = "moreau";
     r.inelastic = e;
@@ -249,7 +244,7 @@ ReferenceLaw reference_law(const std::string& method, const std::string& impact,
         inelastic_note;
   } else {
     r.law = impact;
-    r.reason = "assumed: the --impact law";
+    r.reason = "assumed: the run's impact law";
   }
   return r;
 }

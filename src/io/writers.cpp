@@ -343,8 +343,10 @@ nlohmann::json trajectory_json(const mech::Model& model, const sim::Trajectory& 
   j["max_violation"] = traj.max_violation;
   j["lcp_solves"] = traj.lcp_solves;
   j["steps"] = traj.steps;
-  j["warnings"] = traj.warnings;
-  j["warning_messages"] = traj.warning_messages;
+  j["warnings"] = nlohmann::json::array();
+  for (const auto& w : traj.warnings)
+    j["warnings"].push_back(
+        {{"kind", w.kind}, {"count", w.count}, {"first_t", w.first_t}, {"message", w.message}});
   j["status"] = std::string(run_status_name(traj.status));
   j["message"] = traj.message;
   j["wall_time_s"] = traj.wall_time_s;

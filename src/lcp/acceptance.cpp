@@ -47,8 +47,8 @@ Result finish(const MatrixXd& M, const VectorXd& q, VectorXd z, Status claimed, 
   r.w = M * r.z + q;
   r.residual = r.z.cwiseMin(r.w).cwiseAbs().maxCoeff();
   r.scaled_residual = scaled_residual(M, q, r.z, &r.worst_row);
-  r.min_z = std::min(0.0, r.z.minCoeff());
-  r.min_w = std::min(0.0, r.w.minCoeff());
+  r.min_z = r.z.size() ? std::min(0.0, r.z.minCoeff()) : 0.0;  // k = 0: nothing to violate
+  r.min_w = r.w.size() ? std::min(0.0, r.w.minCoeff()) : 0.0;
   r.status = claimed;
   r.message = std::move(message);
   const bool finite = r.z.allFinite() && r.w.allFinite();
@@ -70,4 +70,9 @@ Result finish(const MatrixXd& M, const VectorXd& q, VectorXd z, Status claimed, 
 }
 
 }  // namespace detail
+
+Result accept(const MatrixXd& M, const VectorXd& q, VectorXd z, const Options& opt) {
+  return detail::finish(M, q, std::move(z), Status::kSolved, opt, "");
+}
+
 }  // namespace lcsim::lcp

@@ -145,7 +145,7 @@ lcs::Lcs Model::as_lcs() const {
         "the model's LCS has " + std::to_string(lcs_state_size()) + " states, more than the " +
         std::to_string(kMaxDenseLcsState) +
         " that dense methods take (event-driven, euler, analyze); simulate models this large "
-        "with --method moreau-jean");
+        "with the moreau-jean method");
   if (mechanical) return to_lcs(*mechanical);
   if (lcs) return *lcs;
   throw std::logic_error("Model::as_lcs: empty model");

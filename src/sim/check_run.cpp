@@ -60,6 +60,7 @@ std::string check_values(const Options& opt, const OptionsUsed& u) {
     return "max_output_bytes must be > 0 (got " + f(opt.max_output_bytes) + ")";
   if (u.h) {
     if (!finite_positive(opt.h)) return "step h must be a finite number > 0 (got " + f(opt.h) + ")";
+    if (opt.h > T) return "step h = " + f(opt.h) + " exceeds t_end = " + f(T);
     if (T / opt.h > 1e9) return "t_end / h = " + f(T / opt.h) + " steps is more than 1e9 (raise h)";
   }
   if (u.theta && !(opt.theta > 0.0 && opt.theta <= 1.0))

@@ -2,7 +2,6 @@
 // augmented state (q, v, 1) of (3.65) for mechanical models): one LCP per
 // step on the fixed grid of time_stepping.cpp's description.
 #include <algorithm>
-#include <chrono>
 #include <lcsim/sim/sim.hpp>
 #include <memory>
 #include <stdexcept>
@@ -49,7 +48,6 @@ EulerFactors euler_factors(const lcs::Lcs& sys, double h) {
 }  // namespace
 
 Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Options& opt) {
-  const auto wall0 = std::chrono::steady_clock::now();
   Trajectory tr;
   tr.method = "euler";
   tr.t_end = *opt.t_end;
@@ -64,8 +62,6 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
   auto finish = [&](const VectorXd& xa) {
     tr.final_state = user(xa);
     tr.energy_final = energy(xa);
-    tr.wall_time_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     return std::move(tr);  // only ever returned from the run: no copy of the samples
   };
   auto fail = [&](const std::string& msg, const VectorXd& xa) {
@@ -105,16 +101,16 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
                                 " >= 3: backward Euler is not consistent here (thesis §7.3, "
                                 "Example 7.3.3: the outputs blow up as h -> 0)";
         if (!opt.force)
-          return fail(
-              "euler: refused: " + msg + "; set Options::force (lcsim --force) to run anyway", x);
-        tr.add_warning("forced despite " + msg);
+          return fail("euler: refused: " + msg + "; set Options::force to run anyway", x);
+        tr.warn("forced", 0.0, "forced despite " + msg);
         break;
       }
     }
   }
   if (mech && model.mechanical->restitution.size() > 0 &&
       model.mechanical->restitution.maxCoeff() > 0.0)
-    tr.add_warning("backward Euler ignores restitution: every impact is inelastic");
+    tr.warn("restitution-ignored", 0.0,
+            "backward Euler ignores restitution: every impact is inelastic");
 
   const StepGrid grid = StepGrid::of(*opt.t_end, opt.h);
   EulerFactors F = euler_factors(sys, grid.h);

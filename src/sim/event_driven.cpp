@@ -17,7 +17,6 @@
 // finding, events) and the entry point; event_driven_detail.hpp lists the
 // other parts.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <lcsim/sim/sim.hpp>
 #include <limits>
@@ -114,7 +113,6 @@ EventDriven::MonitorStart EventDriven::monitor_start(const Phase& phase, const V
 }
 
 Trajectory EventDriven::run(const VectorXd& x0_user) {
-  const auto wall0 = std::chrono::steady_clock::now();
   Trajectory tr;
   tr.method = "event";
   tr.t_end = *opt_.t_end;
@@ -130,7 +128,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
   // Initial mode selection (and jump, if the initial state is not regular).
   EventResult ev = process_event(t, xa);
   tr.lcp_solves += ev.lcp_solves;
-  for (const auto& w : ev.warnings) tr.add_warning(w);
+  for (const auto& w : ev.warnings) tr.warn(w.kind, w.first_t, w.message);
   std::string err;
   Phase phase;
   if (!ev.ok()) {
@@ -358,7 +356,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     }
     ev = process_event(t, x_minus);
     tr.lcp_solves += ev.lcp_solves;
-    for (const auto& w : ev.warnings) tr.add_warning(w);
+    for (const auto& w : ev.warnings) tr.warn(w.kind, w.first_t, w.message);
     if (!ev.ok()) {
       fail(ev.message);
       xa = x_minus;
@@ -409,8 +407,9 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     }
     if (!keep) {
       if (tr.events_not_recorded++ == 0)
-        tr.add_warning("more than " + std::to_string(opt_.max_recorded_events) +
-                       " events: later events and their samples are counted, not recorded");
+        tr.warn("events-not-recorded", t,
+                "more than " + std::to_string(opt_.max_recorded_events) +
+                    " events: later events and their samples are counted, not recorded");
       continue;
     }
     tr.events.push_back(std::move(e));
@@ -418,7 +417,6 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
   }
   tr.final_state = user(xa);
   tr.energy_final = energy(xa);
-  tr.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return tr;
 }
 

@@ -95,7 +95,7 @@ struct EventResult {
   double t_star = 0.0;  // extrapolated accumulation time (accumulation only)
   std::string note;     // how an accumulation's limit was taken (Event::note)
   long lcp_solves = 0;
-  std::vector<std::string> warnings;
+  std::vector<WarningCount> warnings;  // counted into Trajectory::warnings
 };
 
 // Ends a run that cannot make progress: `limit` consecutive events, each

@@ -16,8 +16,8 @@ std::string infeasible_start(const mech::Model& model, const VectorXd& x0) {
     std::ostringstream msg;
     msg.precision(6);
     msg << "constraint '" << m.constraints[r] << "' is violated at t = 0 (gap = " << gap(r)
-        << "): the state is infeasible, E q + g >= 0 must hold (thesis §3.8); `lcsim simulate "
-           "--project` starts from the nearest feasible positions instead";
+        << "): the state is infeasible, E q + g >= 0 must hold (thesis §3.8); "
+           "mech::project_feasible gives the nearest feasible positions";
     return msg.str();
   }
   return "";

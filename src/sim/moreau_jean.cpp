@@ -58,7 +58,6 @@
 //   tolerance falls back to the pivoting solver when |A| <= kPivotFallbackMax,
 //   else the step keeps the PGS iterate and a warning is counted.
 #include <algorithm>
-#include <chrono>
 #include <lcsim/lcp/sparse.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <memory>
@@ -82,7 +81,6 @@ constexpr int kPivotFallbackMax = 2000;
 }  // namespace
 
 Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const Options& opt) {
-  const auto wall0 = std::chrono::steady_clock::now();
   Trajectory tr;
   tr.method = "moreau-jean";
   tr.t_end = *opt.t_end;
@@ -96,8 +94,6 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     tr.final_state.resize(2 * N);
     tr.final_state << q, v;
     tr.energy_final = ops.energy(q, v);
-    tr.wall_time_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     return std::move(tr);  // only ever returned from the run: no copy of the samples
   };
   auto fail = [&](const std::string& msg) {
@@ -252,9 +248,10 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
         solved = r.ok() && all_finite(r.z);
         if (!solved && na > kPivotFallbackMax && r.status == lcp::Status::kIterationLimit &&
             all_finite(r.z)) {
-          tr.add_warning("moreau-jean: PGS stopped at residual " + short_number(r.residual) +
-                         " after " + std::to_string(r.iterations) +
-                         " sweeps at t = " + short_number((j - 1) * grid.h));
+          tr.warn("pgs-not-converged", (j - 1) * grid.h,
+                  "moreau-jean: PGS stopped at residual " + short_number(r.residual) + " after " +
+                      std::to_string(r.iterations) +
+                      " sweeps at t = " + short_number((j - 1) * grid.h));
           solved = true;
         }
         if (solved) z.swap(r.z);

@@ -90,9 +90,10 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
       return out;
     }
     if (!ir.admissible)
-      out.warnings.push_back("impact law '" + impact_->name() + "' at t = " + std::to_string(t) +
-                             " gave a non-admissible jump (negative impulse or E_J v+ < 0)" +
-                             (ir.message.empty() ? "" : ": " + ir.message));
+      count_warning(out.warnings, "impact-not-admissible", t,
+                    "impact law '" + impact_->name() + "' at t = " + std::to_string(t) +
+                        " gave a non-admissible jump (negative impulse or E_J v+ < 0)" +
+                        (ir.message.empty() ? "" : ": " + ir.message));
     xa.segment(N_, N_) = ir.v_after;
     out.impulse += ir.impulse;
     out.jumped = true;

@@ -1,4 +1,5 @@
 // The checked entry points of a run: Integrator::run and sim::simulate.
+#include <chrono>
 #include <cmath>
 #include <lcsim/sim/sim.hpp>
 
@@ -27,7 +28,10 @@ Trajectory Integrator::run(const mech::Model& model, const VectorXd& x0, const O
   Options resolved = opt;
   if (auto refused_run = refuse_invalid_run(model, x0, resolved, name(), options_used()))
     return std::move(*refused_run);
-  return integrate(model, x0, resolved);
+  const auto wall0 = std::chrono::steady_clock::now();
+  Trajectory tr = integrate(model, x0, resolved);
+  tr.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return tr;
 }
 
 Trajectory simulate(const mech::Model& model, const VectorXd& x0, const Options& opt,

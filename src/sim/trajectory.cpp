@@ -30,9 +30,24 @@ void Trajectory::record_sample(Sample s, const Options& opt) {
     samples.push_back(std::move(s));
 }
 
-void Trajectory::add_warning(std::string w) {
-  ++warnings;
-  if (warning_messages.size() < kMaxWarningMessages) warning_messages.push_back(std::move(w));
+void Trajectory::warn(std::string_view kind, double t, std::string message) {
+  count_warning(warnings, kind, t, std::move(message));
+}
+
+long Trajectory::warning_count() const {
+  long n = 0;
+  for (const auto& w : warnings) n += w.count;
+  return n;
+}
+
+long Trajectory::warning_count(std::string_view kind) const {
+  for (const auto& w : warnings)
+    if (w.kind == kind) return w.count;
+  return 0;
+}
+
+std::string Trajectory::first_warning() const {
+  return warnings.empty() ? std::string() : warnings.front().message;
 }
 
 StepGrid StepGrid::of(double t_end, double h) {
@@ -64,7 +79,6 @@ std::string short_number(double x) {
   s << x;
   return s.str();
 }
-
 
 namespace {}  // namespace
 

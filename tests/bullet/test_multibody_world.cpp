@@ -93,7 +93,7 @@ TEST(MultibodyScene, PrismaticChainAgreesWithExactToFirstOrder) {
   EXPECT_GE(r3.c.max_violation, -1.1 * 1.048 * 1e-3);
   EXPECT_GE(r4.c.max_violation, -1.1 * 1.048 * 1e-4);
   EXPECT_LT(r4.c.max_violation, 0.0);  // the stop was hit
-  EXPECT_TRUE(r4.bullet.warning_messages.empty());
+  EXPECT_TRUE(r4.bullet.warnings.empty());
 
   // Bullet's default limit ERP 0.2 does not converge: the Baumgarte push-out
   // ERP * penetration / h is a velocity that does not vanish with h. Measured
@@ -160,9 +160,9 @@ TEST(MultibodyScene, ShippedDoublePendulumRunsAndSaysWhatItDrops) {
     const BulletRun r = compare_at(m, m.initial, h, m.t_end);
     EXPECT_GE(r.c.max_violation, -2e-4);
     bool said = false;
-    for (const auto& w : r.bullet.warning_messages)
-      said |= w.find("restitution is lost") != std::string::npos &&
-              w.find("'shoulder_lower' has e = 0.5") != std::string::npos;
+    for (const auto& w : r.bullet.warnings)
+      said |= w.message.find("restitution is lost") != std::string::npos &&
+              w.message.find("'shoulder_lower' has e = 0.5") != std::string::npos;
     EXPECT_TRUE(said);
   }
 }
@@ -263,8 +263,8 @@ TEST(MultibodyScene, ExplicitSpringsAndDampersAreSaid) {
   sim::Options o;
   o.t_end = 2;
   const auto said = [](const sim::Trajectory& tr, const std::string& what) {
-    for (const auto& w : tr.warning_messages)
-      if (w.find(what) != std::string::npos) return true;
+    for (const auto& w : tr.warnings)
+      if (w.message.find(what) != std::string::npos) return true;
     return false;
   };
   o.h = 0.3;
@@ -308,9 +308,9 @@ TEST(MultibodyScene, InexpressibleModelsThrowWithZeroBasedMessages) {
   EXPECT_EQ(solver_description(hook).rfind("btSequentialImpulseConstraintSolver", 0), 0u);
   const sim::Trajectory tr = simulate_bullet(hook, hook.initial, o);
   ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
-  ASSERT_FALSE(tr.warning_messages.empty());
-  EXPECT_NE(tr.warning_messages[0].find("constraint 'hook' (row 1 of E)"), std::string::npos)
-      << tr.warning_messages[0];
+  ASSERT_FALSE(tr.warnings.empty());
+  EXPECT_NE(tr.first_warning().find("constraint 'hook' (row 1 of E)"), std::string::npos)
+      << tr.first_warning();
   // A scene changed after loading is no longer the URDF's: rb6 (or refused).
   mech::Model changed = io::load_model(kRobots + "two_carts_scene.yaml");
   changed.mechanical->K *= 2.0;

@@ -107,6 +107,33 @@ TEST(BulletWorld, InelasticBallStopsWithoutPenetrating) {
   }
 }
 
+// Settings Bullet cannot use are refused before a world is built, naming the
+// setting and its value (a stop ERP of 0 would never push a limit back; a
+// NaN would reach Bullet's solver).
+TEST(BulletWorld, UnusableSettingsAreInput) {
+  const mech::Model m = load("ball.yaml");
+  sim::Options o;
+  o.t_end = 0.1;
+  o.h = 1e-3;
+  auto refused = [&](bullet::WorldSettings s, const std::string& needle) {
+    EXPECT_NE(bullet::settings_error(s).find(needle), std::string::npos)
+        << bullet::settings_error(s);
+    const sim::Trajectory tr = bullet::simulate_bullet(m, m.initial, o, s);
+    EXPECT_EQ(tr.status, sim::RunStatus::kInvalidInput);
+    EXPECT_NE(tr.message.find(needle), std::string::npos) << tr.message;
+  };
+  EXPECT_EQ(bullet::settings_error({}), "");
+  bullet::WorldSettings s;
+  s.stop_erp = 0.0;
+  refused(s, "stop_erp must be in (0, 1] (got 0)");
+  s = {};
+  s.solver_iterations = 0;
+  refused(s, "solver_iterations must be >= 1 (got 0)");
+  s = {};
+  s.limit_range = std::nan("");
+  refused(s, "limit_range must be finite and > 0 (got nan)");
+}
+
 // The comparison reports a deviation of exactly the size put in.
 TEST(BulletCompare, PerturbedTrajectoryGivesTheDeviationPutIn) {
   const mech::Model m = load("two_carts.yaml");
@@ -165,8 +192,9 @@ TEST(BulletWorld, InfeasibleStartAndUnreproducibleSettingsAreReported) {
 
   tr = bullet_run(ball, ball.initial, 1e-3, 0.0);
   ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
-  ASSERT_EQ(tr.warning_messages.size(), 1u);
-  EXPECT_NE(tr.warning_messages[0].find("restitution is lost or reduced"), std::string::npos);
+  ASSERT_EQ(tr.warning_count(), 1);
+  EXPECT_EQ(tr.warning_count("bullet-restitution-lost"), 1);
+  EXPECT_NE(tr.first_warning().find("restitution is lost or reduced"), std::string::npos);
   // What the warning says: no rebound (the ball ends at rest on the ground).
   EXPECT_LE(std::abs(tr.final_state(1)), 1e-9);
 
@@ -176,11 +204,11 @@ TEST(BulletWorld, InfeasibleStartAndUnreproducibleSettingsAreReported) {
   stiff.t_end = 0.1;
   tr = bullet_run(stiff, stiff.initial, 1e-2, 0.0);
   bool said = false;
-  for (const auto& w : tr.warning_messages) said |= w.find("omega h up to") != std::string::npos;
+  for (const auto& w : tr.warnings) said |= w.message.find("omega h up to") != std::string::npos;
   EXPECT_TRUE(said) << "no warning about explicit springs";
   // The safe side stays quiet: omega h <= 2 with the unit springs at 1e-2.
   tr = bullet_run(load("two_carts.yaml"), load("two_carts.yaml").initial, 1e-2, 0.0);
-  EXPECT_TRUE(tr.warning_messages.empty()) << tr.warning_messages.front();
+  EXPECT_TRUE(tr.warnings.empty()) << tr.first_warning();
 }
 
 // No registration call: linking lcsim::bullet is enough (its INTERFACE

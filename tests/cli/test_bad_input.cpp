@@ -183,7 +183,7 @@ TEST(BadInput, ModelTooLargeForDenseMethods) {
   const fs::path f = d / "chain600.yaml";
   ASSERT_EQ(lcsim(d, "generate chain 600 --stops --out " + quote(f)).exit_code, 0);
   const CliRun a = lcsim(d, "analyze " + quote(f));
-  expect_rejected(d, a, {"1201 states", "more than the 1001", "--method moreau-jean"});
+  expect_rejected(d, a, {"1201 states", "more than the 1001", "the moreau-jean method"});
   const CliRun e = lcsim(d, "simulate " + quote(f) + " --method euler --h 0.1 --t-end 1 --out " +
                                 quote(d / "out" / "traj.csv"));
   expect_rejected(d, e, {"has size 1201", "more than the 1001"}, 2);
@@ -252,17 +252,19 @@ TEST(BadInput, BadStep) {
   const fs::path d = fresh_dir();
   const std::string out = " --out " + quote(d / "out" / "t.csv");
   const std::string sim = "simulate " + quote(kTwoCarts) + " --method euler";
-  expect_rejected(d, lcsim(d, sim + " --h 0" + out), {"--h", "> 0", "0"});
-  expect_rejected(d, lcsim(d, sim + " --h -1e-3" + out), {"--h", "-0.001"});
-  expect_rejected(d, lcsim(d, sim + " --h nan" + out), {"--h", "nan"});
-  expect_rejected(d, lcsim(d, sim + " --h 5" + out), {"--h", "horizon", "5"});  // t_end = 3
-  expect_rejected(d, lcsim(d, sim + " --h 0.5 --t-end 0.1" + out), {"--h", "horizon"});
+  expect_rejected(d, lcsim(d, sim + " --h 0" + out), {"step h", "> 0", "0"});
+  expect_rejected(d, lcsim(d, sim + " --h -1e-3" + out), {"step h", "-0.001"});
+  expect_rejected(d, lcsim(d, sim + " --h nan" + out), {"step h", "nan"});
+  expect_rejected(d, lcsim(d, sim + " --h 5" + out), {"step h = 5", "exceeds t_end = 3"});
+  expect_rejected(d, lcsim(d, sim + " --h 0.5 --t-end 0.1" + out),
+                  {"step h = 0.5", "exceeds t_end = 0.1"});
   const std::string sweep = "sweep " + quote(kTwoCarts) + " --plot " + quote(d / "out" / "p.png");
-  expect_rejected(d, lcsim(d, sweep + " --h 1e-2,0"), {"--h", "0"});
-  expect_rejected(d, lcsim(d, sweep + " --h 1e-2,10"), {"--h", "horizon", "10"});
+  expect_rejected(d, lcsim(d, sweep + " --h 1e-2,0"), {"h: every step", "0"});
+  expect_rejected(d, lcsim(d, sweep + " --h 1e-2,10"), {"h: every step", "horizon", "10"});
   expect_rejected(d, lcsim(d, sweep + " --h 1e-2,x"), {"--h", "'x'"});
-  expect_rejected(d, lcsim(d, "compare " + quote(kTwoCarts) + " --h -1"), {"--h", "-1"});
-  expect_rejected(d, lcsim(d, "compare " + quote(kTwoCarts) + " --h 4"), {"--h", "horizon"});
+  expect_rejected(d, lcsim(d, "compare " + quote(kTwoCarts) + " --h -1"), {"step h", "-1"});
+  expect_rejected(d, lcsim(d, "compare " + quote(kTwoCarts) + " --h 4"),
+                  {"step h = 4", "exceeds t_end = 3"});
 }
 
 TEST(BadInput, UnknownNames) {
@@ -273,7 +275,7 @@ TEST(BadInput, UnknownNames) {
   expect_rejected(d, lcsim(d, sim + " --impact bogus" + out), {"'bogus'", "moreau"});
   expect_rejected(d, lcsim(d, sim + " --lcp simplex" + out), {"'simplex'", "lemke"});
   expect_rejected(d, lcsim(d, "sweep " + quote(kTwoCarts) + " --methods event,rk4"),
-                  {"--methods", "'rk4'"});
+                  {"methods: unknown method", "'rk4'"});
   expect_rejected(d, lcsim(d, "sweep " + quote(kTwoCarts) + " --lcp simplex"), {"'simplex'"});
   expect_rejected(d, lcsim(d, "impacts " + quote(kTwoCarts) + " --rules moreau,bogus"),
                   {"'bogus'", "newton"});

@@ -108,7 +108,7 @@ TEST(SweepCommand, PlotWithARefusedRow) {
 TEST(SweepCommand, UnknownImpactLawExitsTwo) {
   const CliRun r = lcsim("sweep '" + kRobots + "two_carts.yaml' --impact bounce --h 1e-2");
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find("--impact"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("impact: unknown impact law"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("bounce"), std::string::npos) << r.err;
   EXPECT_EQ(r.out, "");
 }

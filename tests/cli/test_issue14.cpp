@@ -182,4 +182,42 @@ TEST(Issue14, SceneWithoutInitialStartsAtQ0AtRest) {
   fs::remove_all(d);
 }
 
+// The command line only parses: the library's checks decide, and their
+// status picks the exit code. An infeasible start refused by the sweep's
+// reference run is input (2), not numerical trouble; a step longer than the
+// horizon and an unusable Bullet setting are input too. A run's warnings
+// come out per kind, counted (backward Euler on the bouncing ball ignores
+// its e = 0.5 once per run: one warning of one kind).
+TEST(Issue14, LibraryChecksDecideTheExitCode) {
+  const fs::path d = fresh_dir("checks");
+  const std::string carts = quote(kRobots + "two_carts.yaml");
+  const CliRun sweep = lcsim(d, "sweep " + carts + " --x0 -0.5,0,0,0 --h 1e-2 --repeat 1");
+  EXPECT_EQ(sweep.exit_code, 2) << sweep.err;
+  EXPECT_NE(sweep.err.find("constraint 'stop' is violated at t = 0"), std::string::npos)
+      << sweep.err;
+  EXPECT_NE(sweep.err.find("mech::project_feasible"), std::string::npos) << sweep.err;
+  const CliRun infeasible = lcsim(d, "simulate " + carts + " --x0 -0.5,0,0,0");
+  EXPECT_EQ(infeasible.exit_code, 2) << infeasible.err;
+  EXPECT_NE(infeasible.err.find("hint: --project"), std::string::npos) << infeasible.err;
+  const CliRun h = lcsim(d, "simulate " + carts + " --method moreau-jean --t-end 0.5 --h 0.6");
+  EXPECT_EQ(h.exit_code, 2) << h.err;
+  EXPECT_NE(h.err.find("step h = 0.6 exceeds t_end = 0.5"), std::string::npos) << h.err;
+  // A value that does not parse is input too (CLI11 alone would exit 104/105).
+  for (const char* bad : {" --h abc", " --t-end", " --no-such-flag"}) {
+    const CliRun r = lcsim(d, "simulate " + carts + bad);
+    EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.err;
+  }
+  const CliRun erp = lcsim(d, "compare " + carts + " --t-end 0.1 --stop-erp 0");
+  EXPECT_EQ(erp.exit_code, 2) << erp.err;
+  EXPECT_NE(erp.err.find("stop_erp must be in (0, 1] (got 0)"), std::string::npos) << erp.err;
+  const CliRun euler =
+      lcsim(d, "simulate " + quote(kRobots + "ball.yaml") + " --method euler --json");
+  ASSERT_EQ(euler.exit_code, 0) << euler.err;
+  const auto w = nlohmann::json::parse(euler.out).at("warnings");
+  ASSERT_EQ(w.size(), 1u) << w.dump();
+  EXPECT_EQ(w[0].at("kind"), "restitution-ignored");
+  EXPECT_EQ(w[0].at("count"), 1);
+  fs::remove_all(d);
+}
+
 }  // namespace

@@ -283,7 +283,7 @@ TEST(Extremes, InfeasibleStartIsRefused) {
   EXPECT_EQ(tr.status, sim::RunStatus::kInvalidInput);
   EXPECT_NE(tr.message.find("floor"), std::string::npos) << tr.message;
   EXPECT_NE(tr.message.find("-0.1"), std::string::npos) << tr.message;
-  EXPECT_NE(tr.message.find("--project"), std::string::npos) << tr.message;
+  EXPECT_NE(tr.message.find("mech::project_feasible"), std::string::npos) << tr.message;
 }
 
 // The documented projection (`lcsim simulate --project`): the nearest

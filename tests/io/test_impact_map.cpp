@@ -104,8 +104,9 @@ TEST(ImpactMap, RefusesWithAMessageNamingTheValue) {
   // q1 = 0.3: the stop is open with gap 0.3.
   spec.q = Eigen::Vector3d(0.3, 0.3, 0);
   spec.closed = {0, 1};
-  EXPECT_TRUE(contains(error_of([&] { impact_map(m, spec); }),
-                       "--closed: constraint 'stop' (0) is open at q = (0.3, 0.3, 0) (gap = 0.3)"));
+  EXPECT_TRUE(contains(
+      error_of([&] { impact_map(m, spec); }),
+      "closed constraints: constraint 'stop' (0) is open at q = (0.3, 0.3, 0) (gap = 0.3)"));
   // q3 = -5 closes 'far' too, which is not named.
   spec.q = Eigen::Vector3d(0, 0, -5);
   EXPECT_TRUE(

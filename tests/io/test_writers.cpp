@@ -121,8 +121,8 @@ sim::Trajectory hand_made() {
   tr.max_violation = -1e-17;
   tr.lcp_solves = 3;
   tr.steps = 2;
-  tr.warnings = 1;
-  tr.warning_messages = {"grazing contact at t = 0.1"};
+  tr.warn("grazing", 0.1, "grazing contact at t = 0.1");
+  tr.warn("grazing", 0.2, "grazing contact at t = 0.2");
   tr.wall_time_s = 0.125;
   return tr;
 }
@@ -275,8 +275,12 @@ TEST(TrajectoryJson, RoundTrip) {
   EXPECT_EQ(j["max_violation"].get<double>(), -1e-17);
   EXPECT_EQ(j["lcp_solves"].get<long>(), 3);
   EXPECT_EQ(j["steps"].get<long>(), 2);
-  EXPECT_EQ(j["warnings"].get<int>(), 1);
-  EXPECT_EQ(j["warning_messages"][0], "grazing contact at t = 0.1");
+  // Two warnings of one kind: one entry, counted, with the first message and time.
+  ASSERT_EQ(j["warnings"].size(), 1u);
+  EXPECT_EQ(j["warnings"][0]["kind"], "grazing");
+  EXPECT_EQ(j["warnings"][0]["count"], 2);
+  EXPECT_EQ(j["warnings"][0]["first_t"], 0.1);
+  EXPECT_EQ(j["warnings"][0]["message"], "grazing contact at t = 0.1");
   EXPECT_EQ(j["status"], "completed");
   EXPECT_EQ(j["message"], "");
   EXPECT_EQ(j["wall_time_s"].get<double>(), 0.125);

@@ -5,9 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <limits>
 #include <lcsim/io/io.hpp>
 #include <lcsim/sim/sim.hpp>
+#include <limits>
 #include <string>
 
 namespace lcsim {
@@ -17,7 +17,9 @@ using Eigen::VectorXd;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-mech::Model carts() { return io::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/two_carts.yaml"); }
+mech::Model carts() {
+  return io::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/two_carts.yaml");
+}
 
 // Options a method accepts: the horizon, and the defaults of the rest.
 sim::Options valid_options() {
@@ -41,6 +43,8 @@ TEST_P(EveryMethod, AValidRunCompletes) {
   const sim::Trajectory tr = integ->run(m, m.initial, valid_options());
   EXPECT_EQ(tr.status, Status::kCompleted) << tr.message;
   EXPECT_DOUBLE_EQ(tr.t_end, 0.5);
+  // The checked entry times the whole call, for every method alike.
+  EXPECT_GT(tr.wall_time_s, 0.0);
 }
 
 TEST_P(EveryMethod, WrongSizeOrNonFiniteInitialState) {
@@ -76,12 +80,16 @@ TEST_P(EveryMethod, StepThetaAndNamesCheckedWhereReadRefusedWhereNot) {
     const sim::Trajectory tr = with([&](sim::Options& o) { o.h = h; });
     expect_refused(tr, u.h ? "step h must be a finite number > 0" : "does not use Options::h");
   }
+  // A step longer than the horizon (0.5) is a typo, not a one-step run.
+  expect_refused(with([](sim::Options& o) { o.h = 0.6; }),
+                 u.h ? "step h = 0.6 exceeds t_end = 0.5" : "does not use Options::h");
   for (double theta : {0.0, -0.5, 1.5, kNaN}) {
     const sim::Trajectory tr = with([&](sim::Options& o) { o.theta = theta; });
     expect_refused(tr, u.theta ? "theta must lie in (0, 1]" : "does not use Options::theta");
   }
   const sim::Trajectory law = with([](sim::Options& o) { o.impact = "no-such-law"; });
-  expect_refused(law, u.impact ? "unknown impact law 'no-such-law'" : "does not use Options::impact");
+  expect_refused(law,
+                 u.impact ? "unknown impact law 'no-such-law'" : "does not use Options::impact");
   const sim::Trajectory lcp = with([](sim::Options& o) { o.lcp_solver = "no-such-solver"; });
   expect_refused(lcp, u.lcp_solver ? "unknown LCP solver 'no-such-solver'"
                                    : "does not use Options::lcp_solver");
@@ -91,7 +99,8 @@ TEST_P(EveryMethod, InfeasibleStartIsInput) {
   const mech::Model m = carts();
   VectorXd x = m.initial;
   x(0) = -0.5;  // E = [1 0], g = 0: cart 1 behind its stop
-  expect_refused(sim::make_integrator(GetParam())->run(m, x, valid_options()), "is violated at t = 0");
+  expect_refused(sim::make_integrator(GetParam())->run(m, x, valid_options()),
+                 "is violated at t = 0");
 }
 
 TEST_P(EveryMethod, OutputLimitRefusedBeforeTheRun) {
@@ -102,7 +111,8 @@ TEST_P(EveryMethod, OutputLimitRefusedBeforeTheRun) {
   expect_refused(sim::make_integrator(GetParam())->run(m, m.initial, o), "max_output_bytes");
   o.max_output_bytes = kNaN;
   o.dt_out = 0.1;
-  expect_refused(sim::make_integrator(GetParam())->run(m, m.initial, o), "max_output_bytes must be > 0");
+  expect_refused(sim::make_integrator(GetParam())->run(m, m.initial, o),
+                 "max_output_bytes must be > 0");
 }
 
 TEST_P(EveryMethod, ModelBuiltInCodeIsChecked) {

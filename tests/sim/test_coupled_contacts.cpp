@@ -328,7 +328,7 @@ TEST(CoupledContacts, DefaultLawKeepsARestingContactAtRest) {
   const auto tr = run(model, Vector4d(0, 0, v(0), v(1)), 1e-3);
   ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
   EXPECT_EQ(tr.impact_law, "moreau-restitution");
-  EXPECT_EQ(tr.warnings, 0) << "an admissible jump needs no warning";
+  EXPECT_EQ(tr.warning_count(), 0) << "an admissible jump needs no warning";
   ASSERT_GE(tr.events.size(), 1u);
   const Vector2d rate = E * tr.events[0].state_after.tail(2);
   EXPECT_NEAR(rate(0), 0.5, 1e-14);
@@ -341,7 +341,7 @@ TEST(CoupledContacts, DefaultLawKeepsARestingContactAtRest) {
   const auto old = sim::simulate_event_driven(model, Vector4d(0, 0, v(0), v(1)), opt);
   ASSERT_EQ(old.status, sim::RunStatus::kCompleted) << old.message;
   EXPECT_EQ(old.impact_law, "moreau");
-  EXPECT_GE(old.warnings, 1) << "the first v+ is not admissible";
+  EXPECT_GE(old.warning_count("impact-not-admissible"), 1) << "the first v+ is not admissible";
   const Vector2d old_rate = E * old.events[0].state_after.tail(2);
   EXPECT_NEAR(old_rate(0), 7.0 / 18, 1e-14);
   EXPECT_NEAR(old_rate(1), 2.5 / 18, 1e-14) << "the resting contact rebounds under Newton's (1+e)";
@@ -413,7 +413,8 @@ TEST(CoupledContacts, EventsPastTheCapAreCountedNotRecorded) {
   ASSERT_EQ(capped.status, sim::RunStatus::kCompleted) << capped.message;
   EXPECT_EQ(capped.events.size(), 3u);
   EXPECT_EQ(capped.events_not_recorded, static_cast<long>(full.events.size()) - 3);
-  EXPECT_EQ(capped.warnings, full.warnings + 1);
+  EXPECT_EQ(capped.warning_count(), full.warning_count() + 1);
+  EXPECT_EQ(capped.warning_count("events-not-recorded"), 1);
   EXPECT_EQ(capped.final_state, full.final_state);
 }
 

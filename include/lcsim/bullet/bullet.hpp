@@ -69,6 +69,12 @@ struct WorldSettings {
   bool multibody_mlcp = false;
 };
 
+// "" when every setting is usable, else one line naming the first bad one
+// and its value (solver_iterations >= 1; stop_erp in (0, 1]; stop_cfm,
+// limit_erp finite >= 0; limit_range, limit_max_impulse finite > 0).
+// simulate_bullet refuses such settings with kInvalidInput.
+std::string settings_error(const WorldSettings& s);
+
 // What runs for `model` with these settings: "btSequentialImpulseConstraintSolver
 // (100 iterations)" for rb6, "btMultiBody from the URDF, ..." for a scene.
 // Throws as check_expressible.

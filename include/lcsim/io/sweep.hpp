@@ -61,7 +61,7 @@ struct ReferenceRun {
   ReferenceLaw law;
   std::string status = "completed";  // or "failed: <message>"
   sim::Trajectory run;               // events only (dt_out = 0)
-  int warnings = 0;
+  long warnings = 0;
   std::string first_warning;  // "" when none
 };
 
@@ -83,9 +83,9 @@ struct SweepRow {
   double error_final = 0.0, error_max = 0.0, max_violation = 0.0, energy_drift = 0.0;
   long steps = 0, lcp_solves = 0;
   double wall_time_s = 0.0;  // median of `repeat` runs without samples; 0 if not completed
-  int warnings = 0;          // the run's
+  long warnings = 0;         // the run's
   std::string first_warning;
-  int reference_warnings = 0;  // the reference run's
+  long reference_warnings = 0;  // the reference run's
   std::string reference_first_warning;
 };
 

@@ -74,6 +74,12 @@ struct Options {
   const VectorXd* warm_start = nullptr;  // initial z (projected onto z >= 0)
 };
 
+// The acceptance test as a result, for solvers outside this layer (Bullet's
+// MLCP solvers): the diagnostics of z for (M, q), and status kSolved iff z is
+// finite and scaled_residual <= opt.tolerance, else kNumericalFailure with a
+// message naming the worst row. Every "solved" of lcsim means this.
+Result accept(const MatrixXd& M, const VectorXd& q, VectorXd z, const Options& opt);
+
 // The pivoting solvers (Lemke, enumeration) pivot on the row-equilibrated LCP
 // (R M, R q), R = diag(2^-e_i) with 2^e_i ~ max_j |M_ij|: exact in floating
 // point and the same solution set (0 <= z ⟂ R w >= 0 iff 0 <= z ⟂ w >= 0), so

@@ -68,15 +68,20 @@ struct Trajectory {
   double max_violation = 0.0;                       // most negative gap over the run (0 if none)
   long lcp_solves = 0;
   long steps = 0;  // time-stepping steps, or continuous phases
-  int warnings = 0;
-  std::vector<std::string> warning_messages;  // first few, for the report
-  double wall_time_s = 0.0;
+  // Warnings counted per kind ("pgs-not-converged", "restitution-ignored",
+  // ...), in order of first appearance, each with its first time and message:
+  // a run that warns a million times stays small and still says what and when.
+  std::vector<WarningCount> warnings;
+  double wall_time_s = 0.0;  // of the whole call, set by the checked entry (Integrator::run)
   // Hands a recorded sample to opt.sample_sink when set (it is then not
   // kept), else appends it to samples.
   void record_sample(Sample s, const Options& opt);
-  // Counts a warning; keeps the text of the first kMaxWarningMessages.
-  void add_warning(std::string w);
-  static constexpr std::size_t kMaxWarningMessages = 10;
+  // Counts a warning of `kind` at time t (see lcsim::count_warning).
+  void warn(std::string_view kind, double t, std::string message);
+  long warning_count() const;                       // over all kinds
+  long warning_count(std::string_view kind) const;  // of one kind (0 if none)
+  // The first message of the first warning, or "" when there is none.
+  std::string first_warning() const;
 };
 
 struct Options {
