@@ -30,7 +30,8 @@ std::uint64_t splitmix64(std::uint64_t& state) {
 std::uint64_t draw_seed(std::uint64_t seed, std::size_t axis, std::size_t quantity,
                         std::size_t draw) {
   std::uint64_t state = seed;
-  for (const std::uint64_t part : {std::uint64_t(axis), std::uint64_t(quantity), std::uint64_t(draw)})
+  for (const std::uint64_t part :
+       {std::uint64_t(axis), std::uint64_t(quantity), std::uint64_t(draw)})
     state = splitmix64(state) ^ part;
   return splitmix64(state);
 }

@@ -106,14 +106,16 @@ Summary Collector::finish() {
   std::lock_guard<std::mutex> lock(mutex_);
   journal_->sync();
   progress(true);
-  std::sort(rows_.begin(), rows_.end(), [](const Row& a, const Row& b) { return a.index < b.index; });
+  std::sort(rows_.begin(), rows_.end(),
+            [](const Row& a, const Row& b) { return a.index < b.index; });
   io::write_file_atomic(opt_.out, table_text(study_, rows_, is_jsonl(opt_.out)));
   Summary sum;
   sum.total = run_count(study_);
   sum.resumed = resumed_;
   sum.computed = computed_;
   for (const Row& r : rows_) sum.failed += !r.completed;
-  sum.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  sum.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   return sum;
 }
 

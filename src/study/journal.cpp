@@ -38,7 +38,8 @@ std::optional<std::string> checked(std::string_view line) {
 }  // namespace
 
 std::string encode_row(const Row& row) {
-  return nlohmann::json{{"i", row.index}, {"w", row.wall_time_s}, {"ok", row.completed}, {"c", row.cells}}
+  return nlohmann::json{
+      {"i", row.index}, {"w", row.wall_time_s}, {"ok", row.completed}, {"c", row.cells}}
       .dump();
 }
 

@@ -30,8 +30,8 @@ class Journal {
   // `resume` (its rows are returned by rows(); a torn or damaged tail is cut
   // off) and is an InputError otherwise; one of another study (fingerprint
   // or run count) is an InputError either way.
-  Journal(const std::filesystem::path& path, const std::string& study_fingerprint,
-          std::size_t runs, bool resume);
+  Journal(const std::filesystem::path& path, const std::string& study_fingerprint, std::size_t runs,
+          bool resume);
   ~Journal();
   Journal(const Journal&) = delete;
   Journal& operator=(const Journal&) = delete;

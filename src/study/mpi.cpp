@@ -54,7 +54,8 @@ void worker(const Study& s) {
   int go = 0;
   MPI_Bcast(&go, 1, MPI_INT, 0, MPI_COMM_WORLD);
   if (!go) return;  // rank 0 could not start (it reports why)
-  for (int r = 0; r < kRequestsAhead; ++r) MPI_Send(nullptr, 0, MPI_CHAR, 0, kRequest, MPI_COMM_WORLD);
+  for (int r = 0; r < kRequestsAhead; ++r)
+    MPI_Send(nullptr, 0, MPI_CHAR, 0, kRequest, MPI_COMM_WORLD);
   int outstanding = kRequestsAhead;
   while (outstanding > 0) {
     std::uint64_t i = 0;

@@ -54,16 +54,35 @@ Setup setup_of(const Study& s, const RunPoint& p) {
     const double v = p.values[i].number;
     if ((q.kind == K::kX0 || q.kind == K::kV0) && u.x0.size() != n) u.x0 = Eigen::VectorXd::Zero(n);
     switch (q.kind) {
-      case K::kModel: break;
-      case K::kMethod: u.method = p.values[i].name; break;
-      case K::kImpact: u.opt.impact = p.values[i].name; break;
-      case K::kH: u.opt.h = v; break;
-      case K::kTheta: u.opt.theta = v; break;
-      case K::kTEnd: u.opt.t_end = v; break;
-      case K::kX0: u.x0(q.row) = v; break;
-      case K::kV0: u.x0(n / 2 + q.row) = v; break;
-      case K::kRestitution: u.model.mechanical->restitution(q.row) = v; break;
-      case K::kScale: scale(*u.model.mechanical, q, v); break;
+      case K::kModel:
+        break;
+      case K::kMethod:
+        u.method = p.values[i].name;
+        break;
+      case K::kImpact:
+        u.opt.impact = p.values[i].name;
+        break;
+      case K::kH:
+        u.opt.h = v;
+        break;
+      case K::kTheta:
+        u.opt.theta = v;
+        break;
+      case K::kTEnd:
+        u.opt.t_end = v;
+        break;
+      case K::kX0:
+        u.x0(q.row) = v;
+        break;
+      case K::kV0:
+        u.x0(n / 2 + q.row) = v;
+        break;
+      case K::kRestitution:
+        u.model.mechanical->restitution(q.row) = v;
+        break;
+      case K::kScale:
+        scale(*u.model.mechanical, q, v);
+        break;
     }
   }
   u.opt.dt_out = 0.0;
@@ -129,11 +148,13 @@ void reference_cells(std::vector<std::string>& c, const Study& s, const Setup& u
   c.push_back(law.label());
   // The exact method of its own law is its own reference.
   const bool itself = u.method == "event" && !law.inelastic;
-  const sim::Trajectory ref = itself ? sim::Trajectory{} : io::run_reference(u.model, u.x0, law, u.opt);
+  const sim::Trajectory ref =
+      itself ? sim::Trajectory{} : io::run_reference(u.model, u.x0, law, u.opt);
   const sim::Trajectory& r = itself ? t : ref;
   c.push_back(status_word(r));
   if (r.status != sim::RunStatus::kCompleted) completed = false;
-  const bool both = t.status == sim::RunStatus::kCompleted && r.status == sim::RunStatus::kCompleted;
+  const bool both =
+      t.status == sim::RunStatus::kCompleted && r.status == sim::RunStatus::kCompleted;
   c.push_back(both ? number((t.final_state - r.final_state).cwiseAbs().maxCoeff()) : "");
 }
 
@@ -168,10 +189,11 @@ std::vector<Column> columns(const Study& s) {
     for (const auto& q : a.quantities) cols.push_back({q.key, q.text() || q.kind == K::kModel});
   cols.insert(cols.end(), {{"status", true}, {"message", true}, {"t_reached", false}});
   for (const auto& [type, name] : kEventColumns) cols.push_back({name, false});
-  for (const char* name : {"events_unrecorded", "energy_change", "max_violation", "steps",
-                           "lcp_solves", "warnings"})
+  for (const char* name :
+       {"events_unrecorded", "energy_change", "max_violation", "steps", "lcp_solves", "warnings"})
     cols.push_back({name, false});
-  cols.insert(cols.end(), {{"reference", true}, {"reference_status", true}, {"error_final", false}});
+  cols.insert(cols.end(),
+              {{"reference", true}, {"reference_status", true}, {"error_final", false}});
   for (const auto& n : state_names(s)) cols.push_back({"final_" + n, false});
   return cols;
 }

@@ -18,9 +18,9 @@ namespace {
 
 namespace y = io::yaml;
 
-const std::vector<std::string> kTopKeys = {"name",   "model", "models", "t_end", "seed",
-                                           "method", "h",     "theta",  "impact", "lcp",
-                                           "reference", "axes"};
+const std::vector<std::string> kTopKeys = {"name",   "model",  "models",    "t_end",
+                                           "seed",   "method", "h",         "theta",
+                                           "impact", "lcp",    "reference", "axes"};
 
 int index_of(const std::vector<std::string>& names, const std::string& name) {
   const auto it = std::find(names.begin(), names.end(), name);
@@ -33,8 +33,9 @@ int named_index(const Study& s, const std::string& key, const std::string& name,
   int found = -2;
   for (const auto& m : s.models) {
     if (!m.is_mechanical())
-      y::fail(s.source, key, "model '" + m.name + "' is an LCS model: it has no named " +
-                                 (constraint ? "constraints" : "coordinates"));
+      y::fail(s.source, key,
+              "model '" + m.name + "' is an LCS model: it has no named " +
+                  (constraint ? "constraints" : "coordinates"));
     const auto& names = constraint ? m.mechanical->constraints : m.mechanical->coordinates;
     const int i = index_of(names, name);
     if (i < 0)
@@ -82,9 +83,9 @@ Quantity parse_quantity(const Study& s, const std::string& key) {
   const std::vector<std::string> p = split_dots(key);
   using K = Quantity::Kind;
   if (p.size() == 1) {
-    const std::vector<std::pair<std::string, K>> plain = {{"model", K::kModel},  {"method", K::kMethod},
-                                                          {"impact", K::kImpact}, {"h", K::kH},
-                                                          {"theta", K::kTheta},  {"t_end", K::kTEnd}};
+    const std::vector<std::pair<std::string, K>> plain = {
+        {"model", K::kModel}, {"method", K::kMethod}, {"impact", K::kImpact},
+        {"h", K::kH},         {"theta", K::kTheta},   {"t_end", K::kTEnd}};
     for (const auto& [name, kind] : plain)
       if (key == name) {
         q.kind = kind;
@@ -128,8 +129,10 @@ std::vector<Value> numbers(const std::vector<double>& v) {
 
 // {linspace|logspace: [a, b, count]} or a distribution {uniform|normal|loguniform: [a, b]}.
 void parse_range(const Study& s, const YAML::Node& n, const std::string& key, Axis& axis) {
-  const y::Keys k = y::mapping(n, s.source, key, {"linspace", "logspace", "uniform", "normal", "loguniform"});
-  if (k.size() != 1) y::fail(s.source, key, "expected one of linspace, logspace, uniform, normal, loguniform");
+  const y::Keys k =
+      y::mapping(n, s.source, key, {"linspace", "logspace", "uniform", "normal", "loguniform"});
+  if (k.size() != 1)
+    y::fail(s.source, key, "expected one of linspace, logspace, uniform, normal, loguniform");
   const auto& [name, spec] = *k.begin();
   const std::string sub = key + "." + name;
   const Eigen::VectorXd v = y::vector(spec, s.source, sub);
@@ -141,10 +144,12 @@ void parse_range(const Study& s, const YAML::Node& n, const std::string& key, Ax
   if (range) {
     const double c = v(2);
     if (!(c >= 1.0) || c != std::floor(c) || c > 1e9)
-      y::fail(s.source, sub, "count must be a whole number >= 1 (got " + io::format_number(c) + ")");
+      y::fail(s.source, sub,
+              "count must be a whole number >= 1 (got " + io::format_number(c) + ")");
     if (name == "logspace" && !(v(0) > 0.0 && v(1) > 0.0))
-      y::fail(s.source, sub, "ends must be > 0 (got " + io::format_number(v(0)) + ", " +
-                                 io::format_number(v(1)) + ")");
+      y::fail(s.source, sub,
+              "ends must be > 0 (got " + io::format_number(v(0)) + ", " + io::format_number(v(1)) +
+                  ")");
     const auto n_values = static_cast<std::size_t>(c);
     axis.values.push_back(numbers(name == "linspace" ? linspace(v(0), v(1), n_values)
                                                      : logspace(v(0), v(1), n_values)));
@@ -296,8 +301,8 @@ void parse_defaults(Study& s, const y::Keys& k) {
   if (k.count("seed")) {
     const double seed = y::number(k.at("seed"), s.source, "seed");
     if (!(seed >= 0.0) || seed != std::floor(seed) || seed >= 9007199254740992.0)
-      y::fail(s.source, "seed", "expected a whole number in [0, 2^53) (got " +
-                                    y::describe(k.at("seed")) + ")");
+      y::fail(s.source, "seed",
+              "expected a whole number in [0, 2^53) (got " + y::describe(k.at("seed")) + ")");
     s.seed = static_cast<std::uint64_t>(seed);
   }
   Quantity q;
@@ -322,7 +327,8 @@ void parse_defaults(Study& s, const y::Keys& k) {
   if (k.count("reference")) {
     s.reference = text_of(s, k, "reference");
     if (s.reference != "event" && s.reference != "none")
-      y::fail(s.source, "reference", "expected event or none (got '" + io::one_line(s.reference, 80) + "')");
+      y::fail(s.source, "reference",
+              "expected event or none (got '" + io::one_line(s.reference, 80) + "')");
   }
 }
 
@@ -332,14 +338,16 @@ Study parse_study(const std::string& yaml_text, const std::string& source) {
   Study s;
   s.source = source;
   const YAML::Node root = y::load(yaml_text, source);
-  if (!root.IsMap()) y::fail(source, "top level", "expected a mapping (got " + y::describe(root) + ")");
+  if (!root.IsMap())
+    y::fail(source, "top level", "expected a mapping (got " + y::describe(root) + ")");
   const y::Keys k = y::mapping(root, source, "", kTopKeys);
   std::string text = yaml_text;
   parse_models(s, k, text);
   parse_defaults(s, k);
   if (k.count("axes")) {
     const YAML::Node& axes = k.at("axes");
-    if (!axes.IsSequence()) y::fail(source, "axes", "expected a list of axes (got " + y::describe(axes) + ")");
+    if (!axes.IsSequence())
+      y::fail(source, "axes", "expected a list of axes (got " + y::describe(axes) + ")");
     for (std::size_t i = 0; i < axes.size(); ++i)
       s.axes.push_back(parse_axis(s, axes[i], "axes[" + std::to_string(i) + "]"));
   }

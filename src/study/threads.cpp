@@ -4,8 +4,8 @@
 #include <atomic>
 #include <cstdlib>
 #include <exception>
-#include <mutex>
 #include <lcsim/study/execute.hpp>
+#include <mutex>
 #include <thread>
 
 #include "study/collector.hpp"
@@ -32,7 +32,8 @@ Summary run_study(const Study& s, const ExecOptions& opt) {
       next = todo.size();
     }
   };
-  const int jobs = std::min<int>(jobs_of(opt), static_cast<int>(std::max<std::size_t>(todo.size(), 1)));
+  const int jobs =
+      std::min<int>(jobs_of(opt), static_cast<int>(std::max<std::size_t>(todo.size(), 1)));
   if (jobs <= 1) {
     work();
   } else {

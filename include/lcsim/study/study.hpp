@@ -64,7 +64,7 @@ struct Study {
   std::vector<mech::Model> models;  // one, or the `models:` list (axis `model`)
   std::vector<std::string> model_paths;
   std::vector<Axis> axes;
-  sim::Options base;        // t_end (unset: the model's), method defaults below
+  sim::Options base;  // t_end (unset: the model's), method defaults below
   std::string method = "event";
   std::uint64_t seed = 0;
   std::string reference = "event";  // "event" (the exact method) or "none"
