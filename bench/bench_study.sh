@@ -30,17 +30,31 @@ YAML
 study event > "$dir/with_reference.yaml"
 study none > "$dir/runs_only.yaml"
 
-seconds() { local t0 t1; t0=$(date +%s.%N); "$@" > /dev/null 2>&1; t1=$(date +%s.%N); echo "$t1 - $t0" | bc -l; }
+# seconds CMD...: prints the wall time (s); the CPU time (user + sys, s, of
+# the command and its children) goes to $dir/cpu. On a shared machine the
+# CPU time tells what the speed-up would be with the cores to ourselves.
+seconds() {
+  /usr/bin/time -f "%e %U %S" -o "$dir/time" "$@" > /dev/null 2>&1
+  read -r wall user sys < "$dir/time"
+  echo "$user + $sys" | bc -l > "$dir/cpu"
+  echo "$wall"
+}
+cpu() { cat "$dir/cpu"; }
 rate() { printf '%.0f' "$(echo "2000 / $1" | bc -l)"; }
+echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) cores"
 
 for s in with_reference runs_only; do
   f=$dir/$s.yaml
   t1=$(seconds "$lcsim" study "$f" --out "$dir/$s-1.csv" --jobs 1)
+  c1=$(cpu)
   t2=$(seconds "$lcsim" study "$f" --out "$dir/$s-2.csv" --jobs 2)
+  c2=$(cpu)
   tm=$(seconds mpirun --allow-run-as-root -np 2 "$lcsim" study "$f" --out "$dir/$s-mpi.csv")
+  cm=$(cpu)
   cmp "$dir/$s-1.csv" "$dir/$s-2.csv" && cmp "$dir/$s-1.csv" "$dir/$s-mpi.csv"
-  printf '%-15s serial %6.2f s (%s runs/s) | 2 threads %6.2f s (%.2fx) | 2 MPI ranks %6.2f s (%.2fx)\n' \
-    "$s" "$t1" "$(rate "$t1")" "$t2" "$(echo "$t1 / $t2" | bc -l)" "$tm" "$(echo "$t1 / $tm" | bc -l)"
+  printf '%-15s serial %6.2f s (%s runs/s, CPU %.2f s) | 2 threads %6.2f s (%.2fx, CPU %.2f s) | 2 MPI ranks %6.2f s (%.2fx, CPU %.2f s)\n' \
+    "$s" "$t1" "$(rate "$t1")" "$c1" "$t2" "$(echo "$t1 / $t2" | bc -l)" "$c2" \
+    "$tm" "$(echo "$t1 / $tm" | bc -l)" "$cm"
 done
 
 # The same 2000 runs, one `lcsim simulate` process each, 2 at a time.
@@ -51,6 +65,9 @@ tail -n +2 "$dir/runs_only-1.csv" |
     > "$dir/commands.txt"
 [ "$(wc -l < "$dir/commands.txt")" -eq 2000 ]
 tx=$(seconds bash -c "xargs -P 2 -L 1 $lcsim simulate --no-progress < $dir/commands.txt")
+cx=$(cpu)
 t2=$(seconds "$lcsim" study "$dir/runs_only.yaml" --out "$dir/again.csv" --jobs 2)
-printf 'xargs -P 2 lcsim simulate: %6.2f s; lcsim study --jobs 2 (no reference): %6.2f s: %.1fx faster\n' \
-  "$tx" "$t2" "$(echo "$tx / $t2" | bc -l)"
+c2=$(cpu)
+printf 'xargs -P 2 lcsim simulate: %6.2f s (CPU %.2f s); lcsim study --jobs 2 (no reference): %6.2f s (CPU %.2f s): %.1fx faster (%.1fx less CPU)\n' \
+  "$tx" "$cx" "$t2" "$c2" "$(echo "$tx / $t2" | bc -l)" "$(echo "$cx / $c2" | bc -l)"
+echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
