@@ -49,6 +49,28 @@ for jobs in 1 2; do
   echo "killed after $done_before runs (--jobs $jobs), resumed: identical"
 done
 
+# Losing an MPI rank (SIGKILL): mpirun ends the job, the journal keeps the
+# finished runs, and a resumed mpirun study writes the same table.
+out=$dir/lost.csv
+mpirun --oversubscribe --allow-run-as-root -np 3 "$lcsim" study "$study" --out "$out" \
+  > /dev/null 2>&1 &
+mpirun_pid=$!
+for _ in $(seq 1 400); do  # until 20 runs are in the journal (at most 20 s)
+  lines=$( (wc -l < "$out.journal") 2>/dev/null || echo 0)
+  [ "$lines" -ge 20 ] && break
+  sleep 0.05
+done
+victim=$(pgrep -P $mpirun_pid lcsim | tail -1)
+kill -KILL "$victim"
+if wait $mpirun_pid; then exit 1; fi
+[ ! -e "$out" ]
+done_before=$(($(wc -l < "$out.journal") - 1))
+[ "$done_before" -lt 80 ]
+mpirun --oversubscribe --allow-run-as-root -np 3 "$lcsim" study "$study" --out "$out" --resume \
+  2>/dev/null
+cmp "$dir/serial.csv" "$out"
+echo "a rank lost after $done_before runs, resumed on 3 ranks: identical"
+
 # A torn last line (a machine that died mid-write) is dropped on resume.
 out=$dir/torn.csv
 head -c -40 "$dir/serial.csv.journal" > "$out.journal"
