@@ -2,8 +2,8 @@
 // appended whole, each line carrying its own check so that a torn last line
 // (a machine that died mid-write) is recognised and dropped.
 //
-//   line 1:  {"journal":"lcsim-study","version":1,"study":<fingerprint>,"runs":N}\t<check>
-//   then:    {"i":index,"w":wall_time_s,"ok":completed,"c":[cells...]}\t<check>
+//   line 1:  {"journal":"lcsim-study","runs":N,"study":<fingerprint>,"version":1}\t<check>
+//   then:    {"c":[cells...],"i":index,"ok":completed,"w":wall_time_s}\t<check>
 //
 // <check> is fingerprint() (FNV-1a 64, 16 hex digits) of the JSON before the
 // tab. Rows are the encoded Row that MPI workers send to rank 0.
