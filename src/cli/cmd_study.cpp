@@ -44,8 +44,7 @@ void setup(CLI::App& app) {
                   "Table: CSV, or JSON lines if it ends in .jsonl; the journal is <out>.journal")
       ->required();
   cmd->add_flag("--resume", a->resume, "Continue the journal: compute only the runs it lacks");
-  cmd->add_option("--jobs", a->jobs, "Threads (default: the number of cores; one per MPI rank)")
-      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--jobs", a->jobs, "Threads (default: the number of cores; one per MPI rank)");
   cmd->callback([a] { run(*a); });
 }
 

@@ -52,32 +52,34 @@ int named_index(const Study& s, const std::string& key, const std::string& name,
 
 std::vector<std::string> split_dots(const std::string& key) { return io::split(key, '.'); }
 
-Quantity parse_scale(const Study& s, const std::string& key, const std::vector<std::string>& p) {
+// where: the key as placed in the file ("axes[1].scale.K"), for messages.
+Quantity parse_scale(const Study& s, const std::string& key, const std::string& where,
+                     const std::vector<std::string>& p) {
   Quantity q;
   q.kind = Quantity::Kind::kScale;
   q.key = key;
   const std::vector<std::string> mats = {"M", "D", "K", "f", "g"};
   if (p.size() < 2 || index_of(mats, p[1]) < 0)
-    y::fail(s.source, key, "expected scale.<M|D|K|f|g>[.<name>...] (got '" + key + "')");
+    y::fail(s.source, where, "expected scale.<M|D|K|f|g>[.<name>...] (got '" + key + "')");
   q.matrix = p[1];
   const bool square = q.matrix == "M" || q.matrix == "D" || q.matrix == "K";
   if (p.size() == 2) return q;
   if (square && p.size() == 4) {
-    q.row = named_index(s, key, p[2], false);
-    q.col = named_index(s, key, p[3], false);
+    q.row = named_index(s, where, p[2], false);
+    q.col = named_index(s, where, p[3], false);
     return q;
   }
   if (!square && p.size() == 3) {
-    q.row = named_index(s, key, p[2], q.matrix == "g");
+    q.row = named_index(s, where, p[2], q.matrix == "g");
     return q;
   }
-  y::fail(s.source, key,
+  y::fail(s.source, where,
           square ? "expected scale." + q.matrix + " or scale." + q.matrix + ".<coord>.<coord>"
                  : "expected scale." + q.matrix + " or scale." + q.matrix + ".<" +
                        (q.matrix == "g" ? "constraint" : "coordinate") + ">");
 }
 
-Quantity parse_quantity(const Study& s, const std::string& key) {
+Quantity parse_quantity(const Study& s, const std::string& key, const std::string& where) {
   Quantity q;
   q.key = key;
   const std::vector<std::string> p = split_dots(key);
@@ -92,13 +94,13 @@ Quantity parse_quantity(const Study& s, const std::string& key) {
         return q;
       }
   } else if (p[0] == "scale") {
-    return parse_scale(s, key, p);
+    return parse_scale(s, key, where, p);
   } else if (p.size() == 2 && (p[0] == "x0" || p[0] == "v0" || p[0] == "restitution")) {
     q.kind = p[0] == "x0" ? K::kX0 : p[0] == "v0" ? K::kV0 : K::kRestitution;
-    q.row = named_index(s, key, p[1], q.kind == K::kRestitution);
+    q.row = named_index(s, where, p[1], q.kind == K::kRestitution);
     return q;
   }
-  y::fail(s.source, key,
+  y::fail(s.source, where,
           "unknown quantity (expected method, impact, h, theta, t_end, x0.<coord>, v0.<coord>, "
           "restitution.<constraint> or scale.<M|D|K|f|g>...)");
 }
@@ -211,7 +213,7 @@ Axis parse_axis(const Study& s, const YAML::Node& n, const std::string& key) {
       has_count = true;
       continue;
     }
-    axis.quantities.push_back(parse_quantity(s, name));
+    axis.quantities.push_back(parse_quantity(s, name, sub));
     if (axis.quantities.back().kind == Quantity::Kind::kModel)
       y::fail(s.source, sub, "the model axis comes from the top-level `models:` list");
     parse_values(s, node, sub, axis);

@@ -9,6 +9,18 @@ trap 'rm -rf "$dir"' EXIT
 study=$src/tests/study/data/slow.yaml
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 
+# Input errors exit 2 with one line naming file, key and value, and write nothing.
+printf 'model: %s/robots/two_carts.yaml\naxes:\n  - x0.nope: [1]\n' "$src" > "$dir/bad.yaml"
+status=0
+msg=$("$lcsim" study "$dir/bad.yaml" --out "$dir/bad.csv" 2>&1) || status=$?
+[ "$status" -eq 2 ]
+[ "$msg" = "lcsim: error: $dir/bad.yaml: axes[0].x0.nope: no coordinate 'nope' in model 'two_carts' (it has x1, x2)" ]
+status=0
+"$lcsim" study "$study" --out "$dir/bad.csv" --jobs -1 2>/dev/null || status=$?
+[ "$status" -eq 2 ]
+[ -z "$(ls "$dir" | grep bad.csv)" ]
+echo "bad study file and --jobs -1: exit 2"
+
 "$lcsim" study "$study" --out "$dir/serial.csv" --jobs 1 2>/dev/null
 "$lcsim" study "$study" --out "$dir/threads.csv" --jobs 2 2>/dev/null
 mpirun --oversubscribe --allow-run-as-root -np 3 "$lcsim" study "$study" --out "$dir/mpi.csv" 2>/dev/null

@@ -187,7 +187,7 @@ TEST(StudyJournal, ResumeReadsWholeLinesAndRefusesAnotherStudy) {
 TEST(StudyFile, MalformedFilesGiveOneLineErrorsNamingFileKeyAndValue) {
   const std::string f = kSource + ": ";
   EXPECT_EQ(error_of("axes:\n  - x0.nope: [1]\n"),
-            f + "x0.nope: no coordinate 'nope' in model 'two_carts' (it has x1, x2)");
+            f + "axes[0].x0.nope: no coordinate 'nope' in model 'two_carts' (it has x1, x2)");
   EXPECT_EQ(error_of("axes:\n  - method: [event, rk4]\n").rfind(f + "axes[0].method[1]: ", 0), 0u);
   EXPECT_EQ(
       error_of("axes:\n  - {h: [1, 2], theta: [0.5]}\n"),

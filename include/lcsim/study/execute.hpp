@@ -18,7 +18,7 @@ struct ExecOptions {
   // Continue the journal: only the runs it lacks are computed. Without it an
   // existing journal is an InputError (nothing is overwritten).
   bool resume = false;
-  int jobs = 0;  // threads; 0 = std::thread::hardware_concurrency()
+  int jobs = 0;  // threads; 0 = std::thread::hardware_concurrency(); < 0 is an InputError
   // Progress lines ("120/2000 runs, 3.1 s, 48 s left"), at most one a second
   // and the last; empty: none.
   std::function<void(const std::string&)> progress;
