@@ -1,24 +1,10 @@
 // Axes: ranges, random draws and the expansion of a run index into its point
 // (study.hpp).
 #include <cmath>
-#include <cstdio>
 #include <lcsim/study/study.hpp>
 #include <limits>
 
-#include "study/detail.hpp"
-
 namespace lcsim::study {
-
-std::string fingerprint(std::string_view text) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  for (const char c : text) {
-    h ^= static_cast<unsigned char>(c);
-    h *= 0x100000001b3ULL;
-  }
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
-}
 
 std::uint64_t splitmix64(std::uint64_t& state) {
   std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);

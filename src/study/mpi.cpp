@@ -4,14 +4,15 @@
 // table. Every rank computes, rank 0 on a second thread: only rank 0's main
 // thread calls MPI (MPI_THREAD_FUNNELED).
 //
-// Messages: a worker sends kRequest twice at the start and a kRow after each
+// Messages: a worker sends kRequestsAhead kRequest at the start and a kRow after each
 // run; rank 0 answers every message with one kIndex (a run index, or kStop
 // when none is left), so a worker always has its next index waiting while it
-// computes. Rank 0 polls (MPI_Iprobe, then a 100 us sleep when idle) rather
-// than blocking in MPI_Recv, which spins a core in OpenMPI.
+// computes. Both sides poll with short sleeps (MPI_Iprobe, MPI_Test) rather
+// than block in MPI_Recv, which spins a core in OpenMPI.
 #include <mpi.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <exception>
 #include <lcsim/io/io.hpp>
@@ -30,7 +31,11 @@ namespace {
 
 constexpr int kRequest = 1, kRow = 2, kIndex = 3;
 constexpr std::uint64_t kStop = ~std::uint64_t{0};
-constexpr int kRequestsAhead = 2;
+constexpr int kRequestsAhead = 3;
+// Rank 0's MPI loop sleeps this long when idle, doubling up to the maximum
+// while nothing comes (a worker holds kRequestsAhead - 1 indices in reserve,
+// so a late answer rarely stalls it).
+constexpr unsigned kMinIdleMicroseconds = 50, kMaxIdleMicroseconds = 1000;
 
 // MPI_Init_thread on construction, MPI_Finalize on destruction (also when an
 // exception leaves run_study_mpi).
@@ -49,6 +54,20 @@ void send_index(std::uint64_t i, int to) {
   MPI_Send(&i, 1, MPI_UINT64_T, to, kIndex, MPI_COMM_WORLD);
 }
 
+// The next index from rank 0. Polled with a short sleep rather than a
+// blocking MPI_Recv, which spins a core in OpenMPI: a worker that waits
+// leaves the core to the ranks that compute.
+std::uint64_t receive_index() {
+  std::uint64_t i = 0;
+  MPI_Request request;
+  MPI_Irecv(&i, 1, MPI_UINT64_T, 0, kIndex, MPI_COMM_WORLD, &request);
+  for (int done = 0;;) {
+    MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+    if (done) return i;
+    ::usleep(20);
+  }
+}
+
 // A worker rank: runs indices until told to stop.
 void worker(const Study& s) {
   int go = 0;
@@ -58,8 +77,7 @@ void worker(const Study& s) {
     MPI_Send(nullptr, 0, MPI_CHAR, 0, kRequest, MPI_COMM_WORLD);
   int outstanding = kRequestsAhead;
   while (outstanding > 0) {
-    std::uint64_t i = 0;
-    MPI_Recv(&i, 1, MPI_UINT64_T, 0, kIndex, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    const std::uint64_t i = receive_index();
     --outstanding;
     if (i == kStop) continue;
     const std::string row = encode_row(run_one(s, static_cast<std::size_t>(i)));
@@ -139,6 +157,7 @@ void serve(const Study& s, Collector& c, int size) {
   long handed = 0, rows = 0, requests = 0;
   const long workers = size - 1;
   std::string buffer;
+  unsigned idle_us = kMinIdleMicroseconds;
   // Every worker message (its requests, one row per index handed out) is
   // received and answered before the loop ends.
   while (!(requests == kRequestsAhead * workers && rows == handed && d.exhausted())) {
@@ -146,9 +165,11 @@ void serve(const Study& s, Collector& c, int size) {
     MPI_Status st;
     MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &st);
     if (!flag) {
-      ::usleep(100);
+      ::usleep(idle_us);
+      idle_us = std::min(2 * idle_us, kMaxIdleMicroseconds);
       continue;
     }
+    idle_us = kMinIdleMicroseconds;
     receive(c, st, buffer, err, d);
     (st.MPI_TAG == kRow ? rows : requests) += 1;
     const auto i = d.next();

@@ -12,6 +12,7 @@
 #include <lcsim/study/study.hpp>
 #include <string>
 
+#include "study/detail.hpp"
 #include "study/journal.hpp"
 
 namespace lcsim::study {
@@ -57,6 +58,13 @@ TEST(StudySeeding, DrawSeedIsTheDocumentedChain) {
   // Top 53 bits times 2^-53, from the same Python computation (exact: a
   // 53-bit integer times a power of two).
   EXPECT_EQ(uniform01(s), 0.0261281589445862);
+}
+
+TEST(StudyJournal, FingerprintIsFnv1a64) {
+  // The published FNV-1a 64 test vectors (Fowler, Noll, Vo).
+  EXPECT_EQ(fingerprint(""), "cbf29ce484222325");
+  EXPECT_EQ(fingerprint("a"), "af63dc4c8601ec8c");
+  EXPECT_EQ(fingerprint("foobar"), "85944171f73967e8");
 }
 
 TEST(StudyAxes, LinspaceAndLogspaceAgainstHandValues) {
