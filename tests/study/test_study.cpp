@@ -153,14 +153,20 @@ TEST(StudyRuns, EventsAndEnergyOfTheThesisRun) {
   // The model's own x0 (thesis §3.7): cart 1 hits the stop at t = 1 with
   // velocity -1, the inelastic impact stops it (M = I: cart 2 keeps its
   // velocity), so exactly 1/2 J is lost and no energy elsewhere (no damping).
-  const Study s = parse("axes:\n  - method: [event]\n");
-  const Row r = run_one(s, 0);
+  // With restitution 1 the impact is elastic (v1: -1 -> +1) and no energy
+  // is lost.
+  const Study s = parse("axes:\n  - restitution.stop: {linspace: [0, 1, 2]}\n");
+  const Row r = run_one(s, 0), elastic = run_one(s, 1);
   ASSERT_EQ(cell(s, r, "status"), "completed") << cell(s, r, "message");
+  EXPECT_EQ(cell(s, r, "restitution.stop"), "0");
   EXPECT_EQ(cell(s, r, "events_impact"), "1");
   // Rounding of the energy (~1 J) over the matrix-exponential phases and the
   // event time found to ~1e-15: 1e-12 is a wide margin.
   EXPECT_NEAR(std::stod(cell(s, r, "energy_change")), -0.5, 1e-12);
   EXPECT_EQ(cell(s, r, "max_violation"), "0");
+  ASSERT_EQ(cell(s, elastic, "status"), "completed") << cell(s, elastic, "message");
+  EXPECT_EQ(cell(s, elastic, "restitution.stop"), "1");
+  EXPECT_NEAR(std::stod(cell(s, elastic, "energy_change")), 0.0, 1e-12);
 }
 
 TEST(StudyJournal, ResumeReadsWholeLinesAndRefusesAnotherStudy) {
