@@ -20,6 +20,7 @@ packages=(
   python3 python3-matplotlib
   clang libclang-rt-14-dev
   libsiconos-kernel-dev libsiconos-numerics-dev python3-siconos
+  libopenmpi-dev openmpi-bin
 )
 missing=()
 for p in "${packages[@]}"; do
