@@ -82,7 +82,8 @@ def main():
     py, cpp, py_min, cpp_min = per_call(a.calls, a.rounds)
     print(f"two carts, exact method, t_end 3 s, {a.rounds} rounds x {a.calls} calls:")
     print(f"  lcsim.simulate (Python)  {py * 1e6:9.2f} µs/call (median; best {py_min * 1e6:.2f})")
-    print(f"  sim::simulate (C++ loop) {cpp * 1e6:9.2f} µs/call (median; best {cpp_min * 1e6:.2f})")
+    print(f"  sim::simulate (C++ loop) {cpp * 1e6:9.2f} µs/call "
+          f"(median; best {cpp_min * 1e6:.2f})")
     print(f"  overhead                 {(py - cpp) * 1e6:9.2f} µs/call (median; best "
           f"{(py_min - cpp_min) * 1e6:.2f}; target <= 10)")
     m = memory(a.samples)

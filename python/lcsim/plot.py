@@ -45,6 +45,7 @@ class TrajectoryError(Exception):
 
 
 def _number(cell, path, row, column):
+    """A CSV cell as a float (blank: NaN); TrajectoryError names the row and column."""
     cell = cell.strip()
     if cell == "":
         return math.nan
@@ -137,6 +138,7 @@ def read_events(path):
 
 
 def _draw_trajectory(header, layout, data, events, title, with_gaps, output):
+    """The stacked panels of `trajectory` from a parsed CSV and (t, type) events."""
     kind, pos, vel, force, gap = layout
     t = data["t"]
     panels = []
@@ -284,6 +286,7 @@ def impact_map(csv_map, output, title="Moreau impact map", arrows=11):
 
 
 def r_tool(r):
+    """The tool a sweep row comes from ("lcsim" unless the row names another)."""
     return r.get("tool", "lcsim")
 
 
@@ -403,7 +406,8 @@ def chain(src, png):
     for r in rows:
         us = float(r["us_per_step"]) if r["us_per_step"] not in ("", "nan") else math.nan
         rss = float(r["peak_rss_kb"]) / 1024 if r["peak_rss_kb"] else math.nan
-        print(f"{r['tool']:8} {r['solver']:20} {int(r['N']):>6} {r['window']:10} {us:>12.4g} {rss:>9.0f}")
+        print(f"{r['tool']:8} {r['solver']:20} {int(r['N']):>6} {r['window']:10} "
+              f"{us:>12.4g} {rss:>9.0f}")
         if r["window"] in ("free", "impacts") and not math.isnan(us):
             series.setdefault((r["tool"], r["solver"], r["window"]), []).append((int(r["N"]), us))
 
