@@ -42,7 +42,13 @@ std::map<std::string, impact::ImpactResult> impacts(const ModelHandle& model,
   in.q = x.head(m.dofs());
   in.v = x.tail(m.dofs());
   in.closed = io::closed_constraints(m, in.q, "x0");
-  if (restitution) in.restitution = *restitution;
+  if (restitution) {  // checked as the model's own would be (mech::check_mechanical)
+    mech::MechanicalModel with = m;
+    with.restitution = *restitution;
+    if (auto p = mech::check_mechanical(with))
+      throw io::InputError("restitution (" + p->field + "): " + p->what);
+    in.restitution = *restitution;
+  }
   const auto solver = lcp::make_solver("pivot");
   std::map<std::string, impact::ImpactResult> out;
   py::gil_scoped_release release;

@@ -59,6 +59,15 @@ def test_bad_matrices_name_the_field():
         lcsim.Model.mechanical(scipy.sparse.csc_matrix(np.diag([1.0, -1.0])))
 
 
+def test_bad_restitution_names_it(robots):
+    """The library's check of a model's restitution (in [0, 1], one per constraint)."""
+    model = lcsim.load(robots / "two_carts_hook.yaml")
+    with pytest.raises(lcsim.InputError, match=r"mechanical\.restitution.*2"):
+        lcsim.impacts(model, [0, 0, -1, 2], restitution=[2.0, 0.0])
+    with pytest.raises(lcsim.InputError, match=r"mechanical\.restitution"):
+        lcsim.impacts(model, [0, 0, -1, 2], restitution=[0.5])
+
+
 def test_bad_lcp():
     with pytest.raises(lcsim.InputError):
         lcsim.solve_lcp(np.eye(2), [1.0, 2.0, 3.0])
