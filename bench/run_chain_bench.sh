@@ -4,7 +4,7 @@
 # and Siconos (MoreauJeanOSI, Lemke and PGS), with the peak memory of each
 # process (/usr/bin/time -v: Debian package `time`). Writes
 # out/chain/results.csv (tool, solver, N, window, us_per_step, peak_rss_kb) and
-# out/chain/chain.png (bench/plot_chain.py), and prints the table and ratios.
+# out/chain/chain.png (python/lcsim/plot.py chain), and prints the table and ratios.
 #
 # Also the whole command line on the generated file (`lcsim generate chain N
 # --stops`, then `lcsim simulate` with Moreau–Jean for 200 steps): file size,
@@ -95,4 +95,4 @@ if [ -x "$BUILD/bench/peer_siconos_chain" ]; then
 else
   echo "run_chain_bench: $BUILD/bench/peer_siconos_chain not built (Siconos missing): skipped" >&2
 fi
-/usr/bin/python3 bench/plot_chain.py "$CSV" "$OUT/chain.png"
+/usr/bin/python3 python/lcsim/plot.py chain "$CSV" "$OUT/chain.png"

@@ -195,7 +195,7 @@ json.dump({"model": scene, "model_file": model, "t_end": 3, "load_average": load
            "exact_source": exact_src, "rows": rows, "ratios": ratios, "event_vs_1e-4": verdict},
           open(f"{out}/{scene}.json", "w"), indent=1)
 PY
-  /usr/bin/python3 bench/plot_work_precision.py "$out/$scene.json" "$out/$scene.png" \
+  /usr/bin/python3 python/lcsim/plot.py work-precision "$out/$scene.json" "$out/$scene.png" \
     --title "$scene (lcsim solid, Siconos dashed)"
   echo "   written: $out/$scene.json, $out/$scene.png" >&2
 done

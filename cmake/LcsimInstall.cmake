@@ -2,7 +2,7 @@
 #   P/include/lcsim/<layer>/*.hpp         #include <lcsim/sim/sim.hpp>
 #   P/lib/liblcsim_<layer>.a              one static library per layer
 #   P/bin/lcsim                           the command-line program
-#   P/share/lcsim/plot_*.py               the plotting scripts (bench/)
+#   P/share/lcsim/plot.py                 the plotting module (python/lcsim/plot.py)
 #   P/share/lcsim/autoregister/*.cpp      registration sources of bullet, ipopt
 #   P/lib/cmake/lcsim/                    find_package(lcsim [COMPONENTS ...])
 #   P/lib/pkgconfig/lcsim*.pc             pkg-config lcsim, lcsim-ipopt, lcsim-bullet
@@ -25,8 +25,7 @@ foreach(c ${LCSIM_COMPONENTS} all)
 endforeach()
 install(DIRECTORY include/lcsim DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(TARGETS lcsim RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
-file(GLOB lcsim_plot_scripts CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/bench/plot_*.py)
-install(PROGRAMS ${lcsim_plot_scripts} DESTINATION ${CMAKE_INSTALL_DATADIR}/lcsim)
+install(PROGRAMS python/lcsim/plot.py DESTINATION ${CMAKE_INSTALL_DATADIR}/lcsim)
 install(FILES src/ipopt/autoregister/register_ipopt.cpp src/bullet/autoregister/register_bullet.cpp
         DESTINATION ${CMAKE_INSTALL_DATADIR}/lcsim/autoregister)
 

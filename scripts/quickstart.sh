@@ -18,6 +18,7 @@ packages=(
   libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-matplotlib
+  pybind11-dev python3-pybind11 python3-numpy python3-scipy python3-pytest python3-hypothesis
   clang libclang-rt-14-dev
   libsiconos-kernel-dev libsiconos-numerics-dev python3-siconos
   libopenmpi-dev openmpi-bin
@@ -35,7 +36,8 @@ if ((${#missing[@]})); then
 fi
 
 jobs=$(nproc 2>/dev/null || echo 2)
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DLCSIM_WERROR=ON
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DLCSIM_WERROR=ON \
+  -DPython3_EXECUTABLE=/usr/bin/python3
 cmake --build build -j"$jobs"
 
 if [ "$what" = demo ]; then
@@ -43,7 +45,7 @@ if [ "$what" = demo ]; then
   mkdir -p out
   ./build/lcsim simulate robots/two_carts.yaml --dt-out 0.01 --out out/two_carts.csv
   ./build/lcsim simulate robots/two_carts.yaml --json > out/two_carts.json
-  /usr/bin/python3 bench/plot_trajectory.py out/two_carts.csv --events out/two_carts.json \
+  /usr/bin/python3 python/lcsim/plot.py trajectory out/two_carts.csv --events out/two_carts.json \
     -o out/two_carts.png --title "Two carts with a stop (thesis §3.7, Figure 3.3)"
   echo "lcsim: wrote out/two_carts.csv, out/two_carts.json and out/two_carts.png"
 else
@@ -75,6 +77,17 @@ else
   g++ -std=c++20 -O1 -o "$pkg/registered_methods_pc" examples/registration/registered_methods.cpp \
     $(PKG_CONFIG_PATH="$pc_dir" pkg-config --cflags --libs lcsim-bullet lcsim-ipopt)
   "$pkg/registered_methods_pc"
+  # The Python package as installed: imported by a fresh interpreter outside
+  # the source tree, from <prefix>/lib/python3/dist-packages, running a tiny
+  # simulation (the two carts' impact at t = 1, thesis §3.7).
+  (cd "$pkg" && PYTHONPATH="$pkg/prefix/lib/python3/dist-packages" /usr/bin/python3 -c '
+import sys, numpy as np, lcsim
+assert lcsim.__file__.startswith(sys.argv[1]), lcsim.__file__
+m = lcsim.Model.mechanical(np.eye(2), np.array([[2.0, -1], [-1, 1]]), np.array([[1.0, 0]]))
+run = lcsim.simulate(m, x0=[0, -1, -1, 0], t_end=0.5)
+assert run.ok and run.events[0].type == "impact", run.message
+print("lcsim: the installed Python package imports and runs:", lcsim.__file__)
+' "$pkg/prefix")
 
   # 3. The suite under AddressSanitizer + UndefinedBehaviorSanitizer
   #    (g++, -O1 with line tables: quicker to build than -O2 -g, and ASan's

@@ -151,10 +151,8 @@ void run_compare(const ImpactsArgs& a, const mech::Model& model) {
   if (!failures.empty()) throw NumericalError(failures);
 }
 
-// bench/plot_impact_map.py (or $LCSIM_PLOT_IMPACT_MAP).
-std::filesystem::path impact_map_script() {
-  return find_plot_script("plot_impact_map.py", "LCSIM_PLOT_IMPACT_MAP");
-}
+// python/lcsim/plot.py impact-map (or $LCSIM_PLOT_IMPACT_MAP).
+PlotScript impact_map_script() { return find_plot_script("impact-map", "LCSIM_PLOT_IMPACT_MAP"); }
 
 void run_map(const ImpactsArgs& a, const mech::Model& model) {
   const mech::MechanicalModel& m = *model.mechanical;

@@ -102,10 +102,10 @@ void run_sweep(const SweepArgs& a) {
   o.base.impact = a.impact;
   o.progress = [](const std::string& line) { std::cerr << "sweep: " << line << "\n"; };
   // The plot's path and script are checked before the runs, not after.
-  std::filesystem::path script;
+  PlotScript script;
   if (!a.plot.empty()) {
     check_writable(a.plot);
-    script = find_plot_script("plot_work_precision.py", "LCSIM_PLOT_WORK_PRECISION");
+    script = find_plot_script("work-precision", "LCSIM_PLOT_WORK_PRECISION");
   }
   const io::SweepResult s = io::run_sweep(model, x0, o);
   const nlohmann::json j = io::sweep_json(s);

@@ -71,34 +71,35 @@ std::string last_line(const fs::path& log) {
 
 void check_writable(const std::string& path) { drop_temp(temp_beside(path)); }
 
-fs::path find_plot_script(const std::string& name, const char* env_var) {
-  if (const char* env = std::getenv(env_var)) return env;
+PlotScript find_plot_script(const std::string& kind, const char* env_var) {
+  if (const char* env = std::getenv(env_var)) return {env, kind};
+  const std::string name = "plot.py";
   std::vector<fs::path> places;
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (!ec)
     places.push_back((exe.parent_path() / ".." / "share" / "lcsim" / name).lexically_normal());
 #ifdef LCSIM_SOURCE_DIR
-  places.push_back(fs::path(LCSIM_SOURCE_DIR) / "bench" / name);
+  places.push_back(fs::path(LCSIM_SOURCE_DIR) / "python" / "lcsim" / name);
 #endif
   std::string looked;
   for (const auto& p : places) {
-    if (fs::is_regular_file(p, ec)) return p;
+    if (fs::is_regular_file(p, ec)) return {p, kind};
     looked += (looked.empty() ? "" : ", ") + p.string();
   }
-  throw std::runtime_error("the plotting script " + name + " is not installed: looked in " +
+  throw std::runtime_error("the plotting module " + name + " is not installed: looked in " +
                            (looked.empty() ? std::string("no place") : looked) + " (set " +
                            env_var + " to its path)");
 }
 
-void draw_plot(const fs::path& script, const fs::path& input, const std::string& out,
+void draw_plot(const PlotScript& script, const fs::path& input, const std::string& out,
                const std::string& title, const std::string& option) {
   const std::string tmp = temp_beside(out);
   const fs::path log =
       fs::temp_directory_path() / ("lcsim_plot_" + std::to_string(::getpid()) + ".log");
   io::track_temporary_file(log.string());
   std::vector<std::string> args{
-      "/usr/bin/python3", script.string(), input.string(), tmp, "--title", title};
+      "/usr/bin/python3", script.path.string(), script.kind, input.string(), tmp, "--title", title};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -119,7 +120,8 @@ void draw_plot(const fs::path& script, const fs::path& input, const std::string&
   if (err != 0)
     why = std::string("cannot run /usr/bin/python3: ") + std::strerror(err);
   else if (!ok)
-    why = "the plot script " + script.string() + " failed: " + last_line(log);
+    why = "the plot script " + script.path.string() + " " + script.kind +
+          " failed: " + last_line(log);
   drop_temp(log.string());
   if (ok && ::rename(tmp.c_str(), out.c_str()) == 0) {
     io::untrack_temporary_file(tmp);
@@ -131,7 +133,7 @@ void draw_plot(const fs::path& script, const fs::path& input, const std::string&
   throw std::runtime_error(option + ": " + why);
 }
 
-void draw_plot_of_text(const std::string& text, const std::string& name, const fs::path& script,
+void draw_plot_of_text(const std::string& text, const std::string& name, const PlotScript& script,
                        const std::string& out, const std::string& title,
                        const std::string& option) {
   const fs::path n(name);

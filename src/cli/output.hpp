@@ -17,27 +17,34 @@ namespace lcsim::cli {
 // a folder. Creates and removes a temporary file to find out.
 void check_writable(const std::string& path);
 
-// The plotting script <name> (a Python file of bench/ shipped with lcsim):
-// the path in the environment variable `env_var` if set, else
-// <dir of the lcsim binary>/../share/lcsim/<name> (installed), else the
-// source tree's bench/<name> (the build-tree binary; LCSIM_SOURCE_DIR is set
-// at build time). std::runtime_error listing where it looked when nowhere.
-std::filesystem::path find_plot_script(const std::string& name, const char* env_var);
+// A figure of the Python package's plotting module, lcsim/plot.py (the one
+// place lcsim's figures are drawn; it needs matplotlib, not the extension
+// module): the file and the figure's subcommand ("impact-map", ...).
+struct PlotScript {
+  std::filesystem::path path;
+  std::string kind;
+};
 
-// Runs `/usr/bin/python3 script input <tmp> --title title` without a shell,
+// The plotting module for figure `kind`: the path in the environment
+// variable `env_var` if set, else <dir of the lcsim binary>/../share/lcsim/plot.py
+// (installed), else the source tree's python/lcsim/plot.py (the build-tree
+// binary; LCSIM_SOURCE_DIR is set at build time). std::runtime_error listing
+// where it looked when nowhere.
+PlotScript find_plot_script(const std::string& kind, const char* env_var);
+
+// Runs `/usr/bin/python3 script kind input <tmp> --title title` without a shell,
 // where <tmp> is a new file beside `out` with the same extension, then renames
 // <tmp> to `out`. The script's own output goes to a log that is dropped on
 // success; on failure <tmp> is removed and std::runtime_error names `option`,
 // the script and the last line it printed (one line).
-void draw_plot(const std::filesystem::path& script, const std::filesystem::path& input,
-               const std::string& out, const std::string& title, const std::string& option);
+void draw_plot(const PlotScript& script, const std::filesystem::path& input, const std::string& out,
+               const std::string& title, const std::string& option);
 
 // draw_plot with its input `text` in a temporary file of the system's
 // temporary folder (`name` with the process id before its extension), which
 // is removed afterwards, and by a signal (io::track_temporary_file).
-void draw_plot_of_text(const std::string& text, const std::string& name,
-                       const std::filesystem::path& script, const std::string& out,
-                       const std::string& title, const std::string& option);
+void draw_plot_of_text(const std::string& text, const std::string& name, const PlotScript& script,
+                       const std::string& out, const std::string& title, const std::string& option);
 
 // Progress of a long run on stderr, fed by sim::Options::progress:
 //   lcsim: t = 12.5 of 100 (12 %), 3.1 s so far, about 22 s left

@@ -339,7 +339,7 @@ TEST(BadInput, FailedPlotLeavesNothing) {
   const CliRun r =
       lcsim(d, "impacts " + quote(kRobots + "two_carts_hook.yaml") +
                    " --map -1:1:3,-1:1:3 --plot " + quote(d / "out" / "map.nosuchfmt"));
-  expect_rejected(d, r, {"--plot", "plot_impact_map.py", "nosuchfmt"}, 1);
+  expect_rejected(d, r, {"--plot", "plot.py impact-map", "nosuchfmt"}, 1);
 }
 
 // The good path of the same machinery: the plot appears whole, and only it.

@@ -1,0 +1,66 @@
+"""lcsim for Python: linear complementarity systems and mechanical models with
+unilateral constraints, simulated exactly (event-driven, thesis Algorithm 3.7.1) or
+by time-stepping, with Moreau's impact law and its variants.
+
+    import lcsim
+    model = lcsim.load("robots/two_carts.yaml")
+    run = lcsim.simulate(model, dt_out=0.01)
+    run.t, run.q, run.v, run.events, run.status
+    run.to_csv("two_carts.csv")          # what `lcsim simulate --out` writes
+
+Everything is computed by the C++ library (lcsim._lcsim); invalid input raises
+lcsim.InputError with the library's message, numerical trouble is a status.
+"""
+
+import json as _json
+
+from . import _lcsim
+from ._lcsim import (
+    Event,
+    ImpactResult,
+    InputError,
+    LcpResult,
+    Model,
+    Trajectory,
+    analyze,
+    impact_law_names,
+    impacts,
+    integrator_names,
+    load,
+    simulate,
+    solve_lcp,
+    solver_names,
+)
+
+__all__ = [
+    "Event", "ImpactResult", "InputError", "LcpResult", "Model", "Trajectory", "analyze",
+    "impact_law_names", "impact_map", "impacts", "integrator_names", "load", "simulate",
+    "solve_lcp", "solver_names", "sweep",
+]
+
+
+def _mechanical_views(run):
+    """q and v: views (no copy) of the state columns of a mechanical run."""
+    n = run.model.dofs
+    return run.x[:, :n], run.x[:, n:]
+
+
+Trajectory.q = property(lambda self: _mechanical_views(self)[0],
+                        doc="Coordinates, shape (n, N): a view of x (mechanical models).")
+Trajectory.v = property(lambda self: _mechanical_views(self)[1],
+                        doc="Velocities, shape (n, N): a view of x (mechanical models).")
+
+
+def sweep(model, methods, hs, x0=None, t_end=None, impact=None, theta=None, repeat=3):
+    """The work-precision sweep of `lcsim sweep`: each method of `methods` at each
+    step of `hs`, against an exact event-driven run. Returns the dict that
+    `lcsim sweep --json` prints (rows, references); lcsim.plot.work_precision draws it."""
+    return _json.loads(_lcsim._sweep_json(model, list(methods), [float(h) for h in hs], x0,
+                                          t_end, impact, theta, repeat))
+
+
+def impact_map(model, v1=(-1.0, 1.0), v2=(-1.0, 1.0), n=41, x0=None, law="moreau"):
+    """The impact map of thesis Figure 3.5 (`lcsim impacts --map`) over pre-impact
+    velocities v1 x v2 (n points each) at q = x0's q (default 0). Returns the CSV text
+    the CLI prints; lcsim.plot.impact_map draws it."""
+    return _lcsim._impact_map_csv(model, tuple(v1), tuple(v2), n, x0, law)

@@ -1,0 +1,153 @@
+// lcsim.Model: a loaded model file or scene, or a model built from matrices.
+#include <cmath>
+#include <lcsim/mech/mech.hpp>
+#include <limits>
+#include <optional>
+#include <string>
+
+#include "bindings.hpp"
+
+namespace lcsim::python {
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+using OptVector = std::optional<VectorXd>;
+
+// A numpy array (dense) or a scipy.sparse matrix as the model's sparse storage.
+mech::SparseMatrix to_sparse(const py::object& a) {
+  const py::object issparse = py::module_::import("scipy.sparse").attr("issparse");
+  if (issparse(a).cast<bool>()) return a.cast<mech::SparseMatrix>();
+  return a.cast<MatrixXd>().sparseView();
+}
+
+// The library's check of a model built in code; InputError with its message.
+ModelHandle checked(mech::Model model, const OptVector& initial, std::optional<double> t_end) {
+  if (initial) model.initial = *initial;
+  if (t_end) model.t_end = *t_end;
+  if (auto p = mech::check_model(model))
+    throw io::InputError("model '" + model.name + "': " + p->field + ": " + p->what);
+  return std::make_shared<io::LoadedModel>(io::LoadedModel{std::move(model), std::nullopt});
+}
+
+ModelHandle make_mechanical(const py::object& M, const py::object& K, const py::object& E,
+                            const py::object& D, const OptVector& f, const OptVector& g,
+                            const OptVector& restitution, std::vector<std::string> names,
+                            std::vector<std::string> constraint_names, const std::string& name,
+                            const OptVector& initial, std::optional<double> t_end) {
+  mech::MechanicalModel mm;
+  mm.M = to_sparse(M);
+  if (!K.is_none()) mm.K = to_sparse(K);
+  if (!E.is_none()) mm.E = to_sparse(E);
+  if (!D.is_none()) mm.D = to_sparse(D);
+  if (f) mm.f = *f;
+  if (g) mm.g = *g;
+  if (restitution) mm.restitution = *restitution;
+  mm.coordinates = std::move(names);
+  mm.constraints = std::move(constraint_names);
+  mech::fill_defaults(mm);
+  mech::Model model = mech::model_of(std::move(mm), name);
+  return checked(std::move(model), initial, t_end);
+}
+
+ModelHandle make_lcs(const MatrixXd& A, const MatrixXd& B, const MatrixXd& C, const MatrixXd& D,
+                     const std::string& name, const OptVector& initial,
+                     std::optional<double> t_end) {
+  mech::Model model;
+  model.name = name;
+  model.lcs = lcs::Lcs{A, B, C, D};
+  return checked(std::move(model), initial, t_end);
+}
+
+ModelHandle load(const std::filesystem::path& path) {
+  return std::make_shared<io::LoadedModel>(io::load_model_and_scene(path));
+}
+
+const mech::MechanicalModel& mechanical(const io::LoadedModel& m) {
+  if (!m.model.is_mechanical())
+    throw io::InputError("model '" + m.model.name + "': not a mechanical model (an `lcs:` model)");
+  return *m.model.mechanical;
+}
+
+}  // namespace
+
+void bind_model(py::module_& m) {
+  py::class_<io::LoadedModel, ModelHandle> c(m, "Model", R"(A model: a mechanical model
+M q'' + D q' + K q = f + E' u, 0 <= E q + g _|_ u >= 0 (with restitution per contact),
+or a general LCS x' = A x + B u, y = C x + D u, 0 <= y _|_ u >= 0. Built by lcsim.load
+(a YAML model or a URDF scene), Model.mechanical or Model.lcs; checked by the library.)");
+  c.def_static("mechanical", &make_mechanical, py::arg("M"), py::arg("K") = py::none(),
+               py::arg("E") = py::none(), py::arg("D") = py::none(), py::arg("f") = py::none(),
+               py::arg("g") = py::none(), py::arg("restitution") = py::none(),
+               py::arg("names") = std::vector<std::string>{},
+               py::arg("constraint_names") = std::vector<std::string>{}, py::arg("name") = "model",
+               py::arg("initial") = py::none(), py::arg("t_end") = py::none(),
+               R"(A mechanical model from matrices (numpy arrays or scipy.sparse matrices).
+Omitted D, K, f, g and restitution are zero; names default to q1.., constraint names to c1...
+`initial` is a default state (q then v), `t_end` a default horizon (s).
+Raises InputError (the library's message) when sizes disagree, M is not symmetric
+positive definite, a restitution lies outside [0, 1], ...)");
+  c.def_static("lcs", &make_lcs, py::arg("A"), py::arg("B"), py::arg("C"), py::arg("D"),
+               py::arg("name") = "lcs", py::arg("initial") = py::none(),
+               py::arg("t_end") = py::none(),
+               "A general LCS x' = A x + B u, y = C x + D u, 0 <= y _|_ u >= 0 (numpy arrays). "
+               "Raises InputError when the library refuses it.");
+  c.def_property_readonly(
+      "name", [](const io::LoadedModel& l) { return l.model.name; }, "The model's name.");
+  c.def_property_readonly(
+      "source", [](const io::LoadedModel& l) { return l.model.source; },
+      "The file it was loaded from ('' if built in code).");
+  c.def_property_readonly(
+      "is_mechanical", [](const io::LoadedModel& l) { return l.model.is_mechanical(); },
+      "True for a mechanical model, False for a general LCS.");
+  c.def_property_readonly(
+      "is_scene", [](const io::LoadedModel& l) { return l.scene.has_value(); },
+      "True when loaded from a URDF scene.");
+  c.def_property_readonly(
+      "state_size", [](const io::LoadedModel& l) { return l.model.state_size(); },
+      "Size of the state: 2N (q then v) for a mechanical model, n for an LCS.");
+  c.def_property_readonly(
+      "num_constraints", [](const io::LoadedModel& l) { return l.model.num_constraints(); },
+      "Number of complementarity pairs (constraints).");
+  c.def_property_readonly(
+      "dofs", [](const io::LoadedModel& l) { return mechanical(l).dofs(); },
+      "Number of coordinates N (mechanical models).");
+  c.def_property_readonly(
+      "initial",
+      [](const io::LoadedModel& l) -> std::optional<VectorXd> {
+        if (l.model.initial.size() == 0) return std::nullopt;
+        return l.model.initial;
+      },
+      "The default initial state, or None.");
+  c.def_property_readonly(
+      "t_end",
+      [](const io::LoadedModel& l) -> std::optional<double> {
+        if (std::isnan(l.model.t_end)) return std::nullopt;
+        return l.model.t_end;
+      },
+      "The default horizon (s), or None.");
+#define LCSIM_MECH_FIELD(field, doc) \
+  c.def_property_readonly(           \
+      #field, [](const io::LoadedModel& l) { return mechanical(l).field; }, doc)
+  LCSIM_MECH_FIELD(M, "Mass matrix (scipy.sparse).");
+  LCSIM_MECH_FIELD(D, "Damping matrix (scipy.sparse).");
+  LCSIM_MECH_FIELD(K, "Stiffness matrix (scipy.sparse).");
+  LCSIM_MECH_FIELD(E, "Constraint rows, E q + g >= 0 (scipy.sparse).");
+  LCSIM_MECH_FIELD(g, "Gaps at q = 0.");
+  LCSIM_MECH_FIELD(f, "Constant generalised force.");
+  LCSIM_MECH_FIELD(restitution, "Newton restitution coefficient per constraint.");
+  LCSIM_MECH_FIELD(coordinates, "Coordinate names.");
+  LCSIM_MECH_FIELD(constraints, "Constraint names.");
+#undef LCSIM_MECH_FIELD
+  c.def("__repr__", [](const io::LoadedModel& l) {
+    return "<lcsim.Model '" + l.model.name + "': " +
+           (l.model.is_mechanical() ? std::to_string(l.model.mechanical->dofs()) + " coordinates"
+                                    : std::to_string(l.model.state_size()) + " states (LCS)") +
+           ", " + std::to_string(l.model.num_constraints()) + " constraints>";
+  });
+  m.def("load", &load, py::arg("path"),
+        "Reads a YAML model file or a URDF scene (io::load_model_and_scene). Raises InputError "
+        "naming the file, the key and the value when it is invalid.");
+}
+
+}  // namespace lcsim::python

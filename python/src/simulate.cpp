@@ -1,0 +1,263 @@
+// lcsim.simulate and lcsim.Trajectory: one run of the library
+// (sim::simulate), its samples streamed into buffers that numpy then owns,
+// so a long trajectory is stored once, never copied.
+#include <cmath>
+#include <cstdint>
+#include <exception>
+#include <lcsim/sim/sim.hpp>
+#include <optional>
+#include <string>
+
+#include "bindings.hpp"
+
+namespace lcsim::python {
+namespace {
+
+using Eigen::VectorXd;
+
+// Samples as they stream from the run (sim::Options::sample_sink), row
+// after row, sized by the model (as the CSV is): a sample without u or y
+// (an event-only record; blank cells in the CSV) gives a row of NaN.
+struct SampleBuffers {
+  std::vector<double> t, x, u, y;
+  std::vector<std::uint8_t> active;  // n x k: 1 where the constraint is in the mode
+  py::ssize_t nx = 0, k = 0;
+  explicit SampleBuffers(const mech::Model& m) : nx(m.state_size()), k(m.num_constraints()) {}
+  void reserve(std::size_t n) {
+    const auto rows = [n](py::ssize_t w) { return n * static_cast<std::size_t>(w); };
+    t.reserve(n);
+    x.reserve(rows(nx));
+    u.reserve(rows(k));
+    y.reserve(rows(k));
+    active.reserve(rows(k));
+  }
+  static void append(std::vector<double>& to, const VectorXd& v, py::ssize_t n) {
+    if (v.size() == n)
+      to.insert(to.end(), v.data(), v.data() + n);
+    else
+      to.insert(to.end(), static_cast<std::size_t>(n), std::nan(""));
+  }
+  void add(const sim::Sample& s) {
+    t.push_back(s.t);
+    append(x, s.x, nx);
+    append(u, s.u, k);
+    append(y, s.y, k);
+    active.resize(t.size() * static_cast<std::size_t>(k), 0);
+    for (int i : s.mode)
+      if (i >= 0 && i < k) active[(t.size() - 1) * static_cast<std::size_t>(k) + i] = 1;
+  }
+};
+
+// A finished run: the library's Trajectory (without samples) and the
+// samples as numpy arrays (t: n, x: n x state, u and y: n x constraints).
+struct Run {
+  ModelHandle model;
+  sim::Trajectory traj;
+  py::array_t<double> t, x, u, y;
+  py::array modes;  // bool, n x k
+
+  // The run as the library gives it, samples included (for the writers).
+  sim::Sample sample(py::ssize_t i) const {
+    sim::Sample s;
+    s.t = t.at(i);
+    auto row = [i](const py::array_t<double>& a) {
+      const py::ssize_t n = a.shape(1);
+      return VectorXd(Eigen::Map<const VectorXd>(a.data() + i * n, n));
+    };
+    // A row of NaN in u or y: the sample recorded none (blank cells).
+    auto recorded = [](VectorXd v) { return v.array().isNaN().all() ? VectorXd() : v; };
+    s.x = row(x), s.u = recorded(row(u)), s.y = recorded(row(y));
+    const py::ssize_t k = modes.shape(1);
+    const auto* on = static_cast<const std::uint8_t*>(modes.data()) + i * k;
+    for (py::ssize_t j = 0; j < k; ++j)
+      if (on[j]) s.mode.push_back(static_cast<int>(j));
+    return s;
+  }
+  sim::Trajectory with_samples() const {
+    sim::Trajectory tr = traj;
+    for (py::ssize_t i = 0; i < t.shape(0); ++i) tr.samples.push_back(sample(i));
+    return tr;
+  }
+  // io::trajectory_json as the CLI's `simulate --json` prints it, with the
+  // scene's linearisation check over the recorded states.
+  std::string json_text() const {
+    nlohmann::json j = io::trajectory_json(model->model, traj);
+    std::optional<io::LinearisationCheck> lin;
+    if (model->scene) {
+      std::vector<VectorXd> states;
+      for (py::ssize_t i = 0; i < t.shape(0); ++i) states.push_back(sample(i).x);
+      lin = io::check_linearisation(*model->scene, states);
+    }
+    j["linearisation_error"] = lin ? nlohmann::json(lin->error) : nlohmann::json(nullptr);
+    j["linearisation_check"] = lin ? io::to_json(*lin) : nlohmann::json(nullptr);
+    return j.dump(2) + "\n";
+  }
+};
+
+std::shared_ptr<Run> simulate(const ModelHandle& model, const std::optional<VectorXd>& x0,
+                              std::optional<double> t_end, const std::string& method,
+                              std::optional<double> h, std::optional<double> theta,
+                              std::optional<std::string> impact, double dt_out,
+                              std::optional<std::string> lcp_solver, bool force,
+                              std::optional<double> max_output, const py::object& progress) {
+  sim::Options opt;
+  opt.t_end = t_end;
+  opt.dt_out = dt_out;
+  if (h) opt.h = *h;
+  if (theta) opt.theta = *theta;
+  if (impact) opt.impact = *impact;
+  if (lcp_solver) opt.lcp_solver = *lcp_solver;
+  if (max_output) opt.max_output_bytes = *max_output;
+  opt.force = force;
+  SampleBuffers buf(model->model);
+  // Room for the output grid's samples (plus a few for events), so that a
+  // run's buffers are allocated once rather than grown: up to 64 MB, beyond
+  // that they grow (the run itself refuses output above max_output_bytes).
+  const double horizon = t_end.value_or(model->model.t_end);
+  const double row_bytes =
+      8.0 * (1 + model->model.state_size() + 2 * model->model.num_constraints());
+  if (dt_out > 0.0 && horizon > 0.0 && horizon / dt_out * row_bytes < 64e6)
+    buf.reserve(static_cast<std::size_t>(horizon / dt_out) + 16);
+  opt.sample_sink = [&buf](const sim::Sample& s) { buf.add(s); };
+  std::exception_ptr progress_error;
+  if (!progress.is_none())
+    opt.progress = [&progress, &progress_error](double t) {
+      if (progress_error) return;
+      py::gil_scoped_acquire gil;
+      try {
+        progress(t);
+      } catch (...) {
+        progress_error = std::current_exception();
+      }
+    };
+  auto run = std::make_shared<Run>();
+  run->model = model;
+  {
+    py::gil_scoped_release release;
+    run->traj = x0 ? sim::simulate(model->model, *x0, opt, method)
+                   : sim::simulate(model->model, opt, method);  // the model's x0
+  }
+  if (progress_error) std::rethrow_exception(progress_error);
+  if (run->traj.status == sim::RunStatus::kInvalidInput) throw io::InputError(run->traj.message);
+  const auto n = static_cast<py::ssize_t>(buf.t.size());
+  run->t = numpy_owning(std::move(buf.t), {n});
+  run->x = numpy_owning(std::move(buf.x), {n, buf.nx});
+  run->u = numpy_owning(std::move(buf.u), {n, buf.k});
+  run->y = numpy_owning(std::move(buf.y), {n, buf.k});
+  run->modes =
+      numpy_owning(std::move(buf.active), {n, buf.k}).attr("view")("bool").cast<py::array>();
+  return run;
+}
+
+void bind_event(py::module_& m) {
+  py::class_<sim::Event> e(m, "Event", "An event of a run: an impact, a contact, a release, ...");
+  e.def_readonly("t", &sim::Event::t, "Time (s).");
+  e.def_property_readonly(
+      "type", [](const sim::Event& ev) { return std::string(sim::to_string(ev.type)); },
+      "'impact', 'release', 'contact', 'accumulation' or 'start'.");
+  e.def_readonly("state_before", &sim::Event::state_before, "State before the event.");
+  e.def_readonly("state_after", &sim::Event::state_after, "State after the event.");
+  e.def_readonly("impulse", &sim::Event::impulse, "Impulse per constraint (zero if no jump).");
+  e.def_readonly("mode", &sim::Event::mode_after, "Active constraints after (0-based).");
+  e.def_readonly("note", &sim::Event::note, "How the event was resolved when not plain.");
+  e.def("__repr__", [](const sim::Event& ev) {
+    return "<lcsim.Event " + std::string(sim::to_string(ev.type)) +
+           " at t = " + std::to_string(ev.t) + ">";
+  });
+}
+
+}  // namespace
+
+void bind_simulate(py::module_& m) {
+  bind_event(m);
+  py::class_<Run, std::shared_ptr<Run>> r(m, "Trajectory", R"(The result of lcsim.simulate.
+Samples as numpy arrays (t, x, u, y; q and v are views of x for mechanical models;
+at a jump two samples share t), events, status and diagnostics. A numerical failure
+is a status ('numerical failure', 'event limit', ...) with a message, not an exception.)");
+  r.def_readonly("t", &Run::t, "Sample times (s), shape (n,).");
+  r.def_readonly("x", &Run::x, "States, shape (n, state size): q then v for mechanical models.");
+  r.def_readonly("u", &Run::u,
+                 "Multipliers (regular part), shape (n, constraints); NaN where not recorded.");
+  r.def_readonly("y", &Run::y, "Gaps / outputs, shape (n, constraints); NaN where not recorded.");
+  r.def_readonly("modes", &Run::modes,
+                 "Modes, shape (n, constraints), bool: True where a constraint is active.");
+  r.def_property_readonly(
+      "events", [](const Run& run) { return run.traj.events; }, "The recorded events.");
+  r.def_property_readonly(
+      "final_state", [](const Run& run) { return run.traj.final_state; }, "State at t_end.");
+  r.def_property_readonly(
+      "status",
+      [](const Run& run) { return std::string(lcsim::to_string(run.traj.status, "completed")); },
+      "'completed', 'numerical failure', 'event limit' or 'interrupted'.");
+  r.def_property_readonly(
+      "ok", [](const Run& run) { return run.traj.status == sim::RunStatus::kCompleted; },
+      "True when the run completed.");
+  r.def_property_readonly(
+      "message", [](const Run& run) { return run.traj.message; }, "Why the run failed, or ''.");
+  r.def_property_readonly(
+      "method", [](const Run& run) { return run.traj.method; }, "The integrator.");
+  r.def_property_readonly(
+      "impact_law", [](const Run& run) { return run.traj.impact_law; }, "The impact law applied.");
+  r.def_property_readonly(
+      "t_end", [](const Run& run) { return run.traj.t_end; }, "The time reached (s).");
+  r.def_property_readonly(
+      "energy_initial", [](const Run& run) { return run.traj.energy_initial; },
+      "Total energy at the start (J, mechanical models).");
+  r.def_property_readonly(
+      "energy_final", [](const Run& run) { return run.traj.energy_final; },
+      "Total energy at the end (J, mechanical models).");
+  r.def_property_readonly(
+      "max_violation", [](const Run& run) { return run.traj.max_violation; },
+      "Most negative gap over the run (0 if none).");
+  r.def_property_readonly(
+      "lcp_solves", [](const Run& run) { return run.traj.lcp_solves; }, "LCPs solved.");
+  r.def_property_readonly(
+      "steps", [](const Run& run) { return run.traj.steps; }, "Steps or continuous phases.");
+  r.def_property_readonly(
+      "warnings", [](const Run& run) { return run.traj.warning_messages; },
+      "The warnings' text (the first few).");
+  r.def_property_readonly(
+      "warning_count", [](const Run& run) { return run.traj.warnings; }, "Warnings counted.");
+  r.def_property_readonly(
+      "events_not_recorded", [](const Run& run) { return run.traj.events_not_recorded; },
+      "Events past the recording cap (counted, not kept).");
+  r.def_property_readonly(
+      "wall_time_s", [](const Run& run) { return run.traj.wall_time_s; }, "Wall time (s).");
+  r.def_property_readonly(
+      "model", [](const Run& run) { return run.model; }, "The model that was run.");
+  r.def(
+      "to_csv",
+      [](const Run& run, std::optional<std::filesystem::path> path) -> std::optional<std::string> {
+        if (!path) return io::trajectory_csv(run.model->model, run.with_samples());
+        io::TrajectoryCsvWriter w(*path, run.model->model);  // what `simulate --out` writes
+        for (py::ssize_t i = 0; i < run.t.shape(0); ++i) w.write(run.sample(i));
+        w.commit();
+        return std::nullopt;
+      },
+      py::arg("path") = py::none(),
+      "The samples as the CLI's `simulate --out` writes them (io layer): to `path` "
+      "(atomically), or returned as text when no path is given.");
+  r.def(
+      "to_json",
+      [](const Run& run, std::optional<std::filesystem::path> path) -> std::optional<std::string> {
+        if (!path) return run.json_text();
+        io::write_file_atomic(*path, run.json_text());
+        return std::nullopt;
+      },
+      py::arg("path") = py::none(),
+      "The run summary as the CLI's `simulate --json` prints it (io::trajectory_json): "
+      "written to `path`, or returned as text.");
+  m.def("simulate", &simulate, py::arg("model"), py::arg("x0") = py::none(),
+        py::arg("t_end") = py::none(), py::arg("method") = "event", py::arg("h") = py::none(),
+        py::arg("theta") = py::none(), py::arg("impact") = py::none(), py::arg("dt_out") = 0.0,
+        py::arg("lcp_solver") = py::none(), py::arg("force") = false,
+        py::arg("max_output") = py::none(), py::arg("progress") = py::none(),
+        R"(Simulates `model` from x0 (default: the model's initial state) to t_end (default:
+the model's) with `method` (lcsim.integrator_names()). Unset options keep the library's
+defaults; an option the method does not read is refused. dt_out is the output grid (0:
+events, start and end only). `progress(t)` is called as the run goes. The GIL is
+released during the run. Raises InputError for invalid input; numerical trouble is
+the returned trajectory's status.)");
+}
+
+}  // namespace lcsim::python

@@ -1,0 +1,194 @@
+// lcsim.impacts, lcsim.impact_map, lcsim.solve_lcp, lcsim.analyze and
+// lcsim.sweep: the library's impact laws, LCP solvers, model analysis and
+// work-precision sweep, called as the CLI calls them.
+#include <lcsim/impact/impact.hpp>
+#include <lcsim/io/impact_map.hpp>
+#include <lcsim/io/sweep.hpp>
+#include <lcsim/lcp/lcp.hpp>
+#include <lcsim/lcs/lcs.hpp>
+#include <lcsim/mech/mech.hpp>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "bindings.hpp"
+
+namespace lcsim::python {
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+const mech::MechanicalModel& mechanical(const ModelHandle& m, const std::string& what) {
+  if (!m->model.is_mechanical())
+    throw io::InputError("model '" + m->model.name + "': " + what +
+                         " need a mechanical model (M, E), not `lcs:`");
+  return *m->model.mechanical;
+}
+
+// Each rule applied to the state x0 = (q, v) (default: the model's initial
+// state), the closed set being the constraints with zero gap at q.
+std::map<std::string, impact::ImpactResult> impacts(const ModelHandle& model,
+                                                    std::optional<VectorXd> x0,
+                                                    std::optional<std::vector<std::string>> rules,
+                                                    std::optional<VectorXd> restitution) {
+  const mech::MechanicalModel& m = mechanical(model, "impact rules");
+  const VectorXd x = x0.value_or(model->model.initial);
+  if (x.size() != model->model.state_size())
+    throw io::InputError("x0: expected " + std::to_string(model->model.state_size()) +
+                         " entries (q then v) (got " + std::to_string(x.size()) + ")");
+  impact::ImpactInput in;
+  in.model = &m;
+  in.q = x.head(m.dofs());
+  in.v = x.tail(m.dofs());
+  in.closed = io::closed_constraints(m, in.q, "x0");
+  if (restitution) {  // checked as the model's own would be (mech::check_mechanical)
+    mech::MechanicalModel with = m;
+    with.restitution = *restitution;
+    if (auto p = mech::check_mechanical(with))
+      throw io::InputError("restitution (" + p->field + "): " + p->what);
+    in.restitution = *restitution;
+  }
+  const auto solver = lcp::make_solver("pivot");
+  std::map<std::string, impact::ImpactResult> out;
+  py::gil_scoped_release release;
+  for (const auto& name : rules.value_or(impact::impact_law_names()))
+    out[name] = impact::make_impact_law(name)->apply(in, *solver);
+  return out;
+}
+
+lcp::Result solve_lcp(const MatrixXd& M, const VectorXd& q, const std::string& solver) {
+  const auto s = lcp::make_solver(solver);
+  lcp::Result r;
+  {
+    py::gil_scoped_release release;
+    r = s->solve(M, q, lcp::Options{});
+  }
+  if (r.status == lcp::Status::kInvalidInput) throw io::InputError("LCP: " + r.message);
+  return r;
+}
+
+py::dict analyze(const ModelHandle& model) {
+  const mech::Model& mm = model->model;
+  py::dict d;
+  d["name"] = mm.name;
+  d["state_size"] = mm.state_size();
+  d["constraints"] = mm.num_constraints();
+  d["notes"] = io::model_notes(mm);
+  if (mm.is_mechanical()) {
+    const mech::MechanicalModel& m = *mm.mechanical;
+    const MatrixXd W = mech::delassus(m);
+    d["dofs"] = m.dofs();
+    d["rank_E"] = mech::constraint_rank(m);
+    d["delassus"] = W;
+    d["delassus_p_matrix"] = W.rows() <= 20 ? py::cast(lcp::is_p_matrix(W)) : py::none();
+  }
+  if (mm.lcs_state_size() <= mech::kMaxDenseLcsState) {
+    const lcs::WellPosednessReport w = lcs::analyze_well_posedness(mm.as_lcs());
+    d["rho"] = w.rho;
+    d["eta"] = w.eta;
+    d["row_p_matrix"] = w.row_p_matrix;
+    d["column_p_matrix"] = w.column_p_matrix;
+    d["locally_well_posed"] = w.locally_well_posed;
+    d["passive"] = w.passive;
+    d["backward_euler_risky"] = w.backward_euler_risky;
+  }
+  return d;
+}
+
+std::string sweep(const ModelHandle& model, std::vector<std::string> methods,
+                  std::vector<double> hs, std::optional<VectorXd> x0, std::optional<double> t_end,
+                  std::optional<std::string> impact, std::optional<double> theta, int repeat) {
+  io::SweepOptions o;
+  o.methods = std::move(methods);
+  o.hs = std::move(hs);
+  o.repeat = repeat;
+  o.base.t_end = t_end;
+  if (!t_end && !std::isnan(model->model.t_end)) o.base.t_end = model->model.t_end;
+  if (impact) o.base.impact = *impact;
+  if (theta) o.base.theta = *theta;
+  io::SweepResult r;
+  {
+    py::gil_scoped_release release;
+    r = io::run_sweep(model->model, x0.value_or(model->model.initial), o);
+  }
+  return io::sweep_json(r).dump(2);
+}
+
+std::string impact_map_csv(const ModelHandle& model, std::pair<double, double> v1,
+                           std::pair<double, double> v2, int n, std::optional<VectorXd> x0,
+                           std::string law) {
+  const mech::MechanicalModel& m = mechanical(model, "impact maps");
+  io::ImpactMapSpec spec;
+  const VectorXd x = x0.value_or(VectorXd::Zero(2 * m.dofs()));
+  if (x.size() != 2 * m.dofs())
+    throw io::InputError("x0: expected " + std::to_string(2 * m.dofs()) + " entries (got " +
+                         std::to_string(x.size()) + ")");
+  spec.q = x.head(m.dofs());
+  spec.v0 = x.tail(m.dofs());
+  spec.axis1 = {v1.first, v1.second, n};
+  spec.axis2 = {v2.first, v2.second, n};
+  spec.law = std::move(law);
+  io::ImpactMap map;
+  {
+    py::gil_scoped_release release;
+    map = io::impact_map(m, spec);
+  }
+  if (!map.failure.empty()) throw std::runtime_error("impact map: " + map.failure);
+  return io::impact_map_csv(m, map);
+}
+
+void bind_results(py::module_& m) {
+  py::class_<impact::ImpactResult> ir(m, "ImpactResult", "The outcome of one impact law.");
+  ir.def_readonly("ok", &impact::ImpactResult::ok, "True when the law computed a result.");
+  ir.def_readonly("message", &impact::ImpactResult::message, "Why it failed, or a note.");
+  ir.def_readonly("v_after", &impact::ImpactResult::v_after, "Post-impact velocity.");
+  ir.def_readonly("impulse", &impact::ImpactResult::impulse, "Impulse per constraint.");
+  ir.def_readonly("mode", &impact::ImpactResult::mode, "Constraints with positive impulse.");
+  ir.def_readonly("energy_before", &impact::ImpactResult::energy_before, "Kinetic energy (J).");
+  ir.def_readonly("energy_after", &impact::ImpactResult::energy_after, "Kinetic energy (J).");
+  ir.def_readonly("worst_rate", &impact::ImpactResult::worst_rate,
+                  "Most negative E_J v+ (0 if none).");
+  ir.def_readonly("admissible", &impact::ImpactResult::admissible,
+                  "False when the result is not an admissible impact.");
+  py::class_<lcp::Result> lr(m, "LcpResult", "The solution of an LCP w = M z + q.");
+  lr.def_property_readonly(
+      "status",
+      [](const lcp::Result& r) { return std::string(lcp::to_string(r.status, "solved")); },
+      "'solved', 'ray termination', 'iteration limit', 'numerical failure'.");
+  lr.def_property_readonly("ok", &lcp::Result::ok, "True when solved.");
+  lr.def_readonly("z", &lcp::Result::z, "The solution z.");
+  lr.def_readonly("w", &lcp::Result::w, "w = M z + q.");
+  lr.def_readonly("residual", &lcp::Result::residual, "||min(z, w)||_inf.");
+  lr.def_readonly("pivots", &lcp::Result::pivots, "Pivots (pivoting solvers).");
+  lr.def_readonly("iterations", &lcp::Result::iterations, "Sweeps (iterative solvers).");
+  lr.def_readonly("message", &lcp::Result::message, "Detail, or ''.");
+}
+
+}  // namespace
+
+void bind_tools(py::module_& m) {
+  bind_results(m);
+  m.def("impacts", &impacts, py::arg("model"), py::arg("x0") = py::none(),
+        py::arg("rules") = py::none(), py::arg("restitution") = py::none(),
+        "Applies each impact rule (default: all, lcsim.impact_law_names()) at the state x0 = "
+        "(q, v) (default: the model's initial state); the closed contacts are those with zero "
+        "gap at q. Returns {rule: ImpactResult}. `restitution`: one coefficient per constraint "
+        "(default: the model's).");
+  m.def("solve_lcp", &solve_lcp, py::arg("M"), py::arg("q"), py::arg("solver") = "lemke",
+        "Solves 0 <= z _|_ w = M z + q >= 0 with a solver of lcsim.solver_names(). Raises "
+        "InputError for a malformed problem; a failure is the result's status.");
+  m.def("analyze", &analyze, py::arg("model"),
+        "What the theory says of a model: sizes, rank of E, the Delassus matrix and its "
+        "P-property, the leading indices and Theorem 3.6.3, passivity, notes (a dict).");
+  m.def("_sweep_json", &sweep, py::arg("model"), py::arg("methods"), py::arg("hs"),
+        py::arg("x0") = py::none(), py::arg("t_end") = py::none(), py::arg("impact") = py::none(),
+        py::arg("theta") = py::none(), py::arg("repeat") = 3,
+        "The work-precision sweep (io::run_sweep) as the JSON text `lcsim sweep --json` prints.");
+  m.def("_impact_map_csv", &impact_map_csv, py::arg("model"), py::arg("v1"), py::arg("v2"),
+        py::arg("n") = 41, py::arg("x0") = py::none(), py::arg("law") = "moreau",
+        "The impact map of thesis Figure 3.5 (io::impact_map) as the CSV `lcsim impacts --map` "
+        "prints.");
+}
+
+}  // namespace lcsim::python

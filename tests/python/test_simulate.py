@@ -1,0 +1,73 @@
+"""lcsim.simulate's options and results beyond the thesis cases: the general LCS
+built from matrices, the time-stepping methods' options, the progress callback, and
+the arrays' consistency with the events and the final state."""
+
+import numpy as np
+import pytest
+
+import lcsim
+
+A = np.array([[0.0, 1, 0], [0, 0, 1], [0, 0, 0]])
+B = np.array([[0.0], [0], [1]])
+C = np.array([[1.0, 0, 0]])
+
+
+def test_lcs_from_matrices_is_the_model_file(robots):
+    """The triple integrator of Example 7.3.3 built by Model.lcs runs exactly as the
+    shipped file (the same CSV text), and jumps to 0 at t = 0 (its consistent state)."""
+    built = lcsim.Model.lcs(A, B, C, np.zeros((1, 1)), name="triple_integrator",
+                            initial=[0, -1, 0], t_end=1.0)
+    loaded = lcsim.load(robots / "triple_integrator.yaml")
+    a = lcsim.simulate(built, dt_out=0.1)
+    b = lcsim.simulate(loaded, dt_out=0.1)
+    assert a.ok and a.to_csv() == b.to_csv()
+    assert not built.is_mechanical and built.state_size == 3
+    np.testing.assert_array_equal(a.events[0].state_after, [0.0, 0.0, 0.0])
+
+
+def test_lcs_sizes_are_checked():
+    with pytest.raises(lcsim.InputError, match=r"lcs\.B"):
+        lcsim.Model.lcs(A, np.ones((2, 1)), C, np.zeros((1, 1)))
+
+
+def test_arrays_agree_with_events_and_final_state(robots):
+    run = lcsim.simulate(lcsim.load(robots / "two_carts.yaml"), dt_out=0.1)
+    n = len(run.t)
+    assert run.x.shape == (n, 4) and run.u.shape == (n, 1) and run.y.shape == (n, 1)
+    assert run.modes.shape == (n, 1) and run.modes.dtype == bool
+    np.testing.assert_array_equal(np.hstack([run.q, run.v]), run.x)
+    np.testing.assert_array_equal(run.x[-1], run.final_state)
+    assert run.t[0] == 0.0 and run.t[-1] == run.t_end == 3.0
+    # The impact: two samples share its time, before and after, as the event says.
+    i = int(np.flatnonzero(run.t == run.events[0].t)[0])
+    np.testing.assert_array_equal(run.x[i], run.events[0].state_before)
+    np.testing.assert_array_equal(run.x[i + 1], run.events[0].state_after)
+    assert not run.modes[i, 0] and run.modes[i + 1, 0]
+    # y is the gap E q + g of each sample (the stop: x1).
+    np.testing.assert_array_equal(run.y[:, 0], run.q[:, 0])
+
+
+def test_time_stepping_options(robots):
+    """Moreau–Jean with h and theta; its energy loss at the impact is bounded by the
+    exact one (½ J) plus the theta-method's numerical dissipation, O(h) over 3 s."""
+    model = lcsim.load(robots / "two_carts.yaml")
+    run = lcsim.simulate(model, method="moreau-jean", h=1e-3, theta=0.5)
+    assert run.ok and run.method == "moreau-jean" and run.steps == 3000
+    exact = lcsim.simulate(model)
+    # theta = 1/2 conserves the energy of the free motion; the impact is
+    # resolved on the step grid, so the loss differs from ½ by O(h |v|) per impact.
+    loss = run.energy_initial - run.energy_final
+    assert loss == pytest.approx(exact.energy_initial - exact.energy_final, abs=1e-2)
+
+
+def test_progress_is_called_and_its_errors_propagate(robots):
+    model = lcsim.load(robots / "two_carts.yaml")
+    seen = []
+    run = lcsim.simulate(model, method="moreau-jean", h=1e-4, progress=seen.append)
+    assert run.ok and seen and seen == sorted(seen) and 0 < seen[-1] <= 3.0
+
+    def fail(t):
+        raise KeyError("stop")
+
+    with pytest.raises(KeyError, match="stop"):
+        lcsim.simulate(model, method="moreau-jean", h=1e-4, progress=fail)
