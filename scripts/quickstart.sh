@@ -79,7 +79,7 @@ else
   "$pkg/registered_methods_pc"
   # The Python package as installed: imported by a fresh interpreter outside
   # the source tree, from <prefix>/lib/python3/dist-packages, running a tiny
-  # simulation (the two carts' impact at t = 1, thesis §3.7).
+  # simulation (two carts whose stop is hit at t = 0: one impact, thesis §3.7).
   (cd "$pkg" && PYTHONPATH="$pkg/prefix/lib/python3/dist-packages" /usr/bin/python3 -c '
 import sys, numpy as np, lcsim
 assert lcsim.__file__.startswith(sys.argv[1]), lcsim.__file__

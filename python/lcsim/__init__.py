@@ -12,7 +12,11 @@ Everything is computed by the C++ library (lcsim._lcsim); invalid input raises
 lcsim.InputError with the library's message, numerical trouble is a status.
 """
 
+import csv as _csv
 import json as _json
+import os as _os
+import tempfile as _tempfile
+from dataclasses import dataclass as _dataclass
 
 from . import _lcsim
 from ._lcsim import (
@@ -35,7 +39,7 @@ from ._lcsim import (
 __all__ = [
     "Event", "ImpactResult", "InputError", "LcpResult", "Model", "Trajectory", "analyze",
     "impact_law_names", "impact_map", "impacts", "integrator_names", "load", "simulate",
-    "solve_lcp", "solver_names", "sweep",
+    "solve_lcp", "solver_names", "study", "StudyTable", "sweep",
 ]
 
 
@@ -64,3 +68,42 @@ def impact_map(model, v1=(-1.0, 1.0), v2=(-1.0, 1.0), n=41, x0=None, law="moreau
     velocities v1 x v2 (n points each) at q = x0's q (default 0). Returns the CSV text
     the CLI prints; lcsim.plot.impact_map draws it."""
     return _lcsim._impact_map_csv(model, tuple(v1), tuple(v2), n, x0, law)
+
+
+@_dataclass
+class StudyTable:
+    """The table of a study: `text` is the file `lcsim study --out` writes (CSV, or
+    JSON lines), `rows` the same rows parsed (dicts of strings for CSV, of values for
+    JSON lines), and the summary: runs in total, resumed from the journal, computed,
+    failed (rows whose status is not "completed") and the wall time."""
+    text: str
+    rows: list
+    total: int
+    resumed: int
+    computed: int
+    failed: int
+    wall_time_s: float
+
+
+def study(path, out=None, resume=False, jobs=0, progress=None):
+    """Runs the study file `path` (docs/study.md) as `lcsim study` does, on `jobs`
+    threads (0: one per core), and returns its StudyTable, the same table whatever
+    the number of threads. With `out` the table is also kept there (CSV, or JSON
+    lines for a name ending in .jsonl) with its journal <out>.journal, and `resume`
+    continues that journal; without it, both live in a temporary folder that is
+    removed. `progress` is called with each progress line. A bad study file raises
+    InputError; failed runs are rows, not exceptions."""
+    def run(target):
+        summary = _lcsim._run_study(_os.fspath(path), _os.fspath(target), resume, jobs, progress)
+        with open(target, encoding="utf-8") as f:
+            text = f.read()
+        if _os.fspath(target).endswith(".jsonl"):
+            rows = [_json.loads(line) for line in text.splitlines() if line]
+        else:
+            rows = list(_csv.DictReader(text.splitlines()))
+        return StudyTable(text=text, rows=rows, **summary)
+
+    if out is not None:
+        return run(out)
+    with _tempfile.TemporaryDirectory(prefix="lcsim_study_") as tmp:
+        return run(_os.path.join(tmp, "table.csv"))

@@ -96,7 +96,7 @@ class Trajectory:
     max_violation: float
     lcp_solves: int
     steps: int
-    warnings: list[str]
+    warnings: list[dict[str, Any]]  # {kind, count, first_t, message} per kind
     warning_count: int
     events_not_recorded: int
     wall_time_s: float
@@ -107,6 +107,7 @@ class Trajectory:
 class ImpactResult:
     """The outcome of one impact law."""
     ok: bool
+    status: str
     message: str
     v_after: np.ndarray
     impulse: np.ndarray
@@ -149,3 +150,17 @@ def sweep(model: Model, methods: Iterable[str], hs: Iterable[float],
 def integrator_names() -> list[str]: ...
 def impact_law_names() -> list[str]: ...
 def solver_names() -> list[str]: ...
+
+class StudyTable:
+    """The table of a study (the text `lcsim study --out` writes), its parsed rows and
+    the run summary."""
+    text: str
+    rows: list[Any]
+    total: int
+    resumed: int
+    computed: int
+    failed: int
+    wall_time_s: float
+
+def study(path: Union[str, Path], out: Optional[Union[str, Path]] = None, resume: bool = False,
+          jobs: int = 0, progress: Optional[Callable[[str], None]] = None) -> StudyTable: ...

@@ -39,5 +39,6 @@ void bind_model(py::module_& m);
 void bind_simulate(py::module_& m);
 void bind_tools(py::module_& m);
 void bind_bench(py::module_& m);
+void bind_study(py::module_& m);
 
 }  // namespace lcsim::python

@@ -38,4 +38,5 @@ PYBIND11_MODULE(_lcsim, m) {
   lcsim::python::bind_simulate(m);
   lcsim::python::bind_tools(m);
   lcsim::python::bind_bench(m);
+  lcsim::python::bind_study(m);
 }

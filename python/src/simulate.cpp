@@ -214,10 +214,19 @@ is a status ('numerical failure', 'event limit', ...) with a message, not an exc
   r.def_property_readonly(
       "steps", [](const Run& run) { return run.traj.steps; }, "Steps or continuous phases.");
   r.def_property_readonly(
-      "warnings", [](const Run& run) { return run.traj.warning_messages; },
-      "The warnings' text (the first few).");
+      "warnings",
+      [](const Run& run) {
+        py::list out;
+        for (const auto& w : run.traj.warnings)
+          out.append(py::dict(py::arg("kind") = w.kind, py::arg("count") = w.count,
+                              py::arg("first_t") = w.first_t, py::arg("message") = w.message));
+        return out;
+      },
+      "The warnings, one dict per kind in order of first appearance: kind, count, "
+      "first_t (time of the first) and message (the first one's).");
   r.def_property_readonly(
-      "warning_count", [](const Run& run) { return run.traj.warnings; }, "Warnings counted.");
+      "warning_count", [](const Run& run) { return run.traj.warning_count(); },
+      "Warnings counted, all kinds.");
   r.def_property_readonly(
       "events_not_recorded", [](const Run& run) { return run.traj.events_not_recorded; },
       "Events past the recording cap (counted, not kept).");

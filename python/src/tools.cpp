@@ -140,7 +140,11 @@ std::string impact_map_csv(const ModelHandle& model, std::pair<double, double> v
 
 void bind_results(py::module_& m) {
   py::class_<impact::ImpactResult> ir(m, "ImpactResult", "The outcome of one impact law.");
-  ir.def_readonly("ok", &impact::ImpactResult::ok, "True when the law computed a result.");
+  ir.def_property_readonly("ok", &impact::ImpactResult::ok, "True when the law computed a result.");
+  ir.def_property_readonly(
+      "status",
+      [](const impact::ImpactResult& r) { return std::string(lcsim::to_string(r.status)); },
+      "'ok', 'invalid input' (the law refused its input) or 'numerical failure'.");
   ir.def_readonly("message", &impact::ImpactResult::message, "Why it failed, or a note.");
   ir.def_readonly("v_after", &impact::ImpactResult::v_after, "Post-impact velocity.");
   ir.def_readonly("impulse", &impact::ImpactResult::impulse, "Impulse per constraint.");

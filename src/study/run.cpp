@@ -133,7 +133,7 @@ void run_cells(std::vector<std::string>& c, const sim::Trajectory& t) {
   c.push_back(energy ? number(t.max_violation) : "");
   c.push_back(std::to_string(t.steps));
   c.push_back(std::to_string(t.lcp_solves));
-  c.push_back(std::to_string(t.warnings));
+  c.push_back(std::to_string(t.warning_count()));
 }
 
 // reference, reference_status, error_final; `completed` false when the

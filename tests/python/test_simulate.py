@@ -71,3 +71,15 @@ def test_progress_is_called_and_its_errors_propagate(robots):
 
     with pytest.raises(KeyError, match="stop"):
         lcsim.simulate(model, method="moreau-jean", h=1e-4, progress=fail)
+
+
+def test_warnings_are_counted_per_kind(robots):
+    """Backward Euler ignores the ball's e = 0.5 and says so once: one warning of
+    kind 'restitution-ignored', at t = 0, as the CLI's JSON reports it."""
+    ball = lcsim.load(robots / "ball.yaml")
+    run = lcsim.simulate(ball, method="euler", h=1e-3, t_end=0.5)
+    assert run.ok, run.message
+    assert run.warning_count == 1
+    (w,) = run.warnings
+    assert w["kind"] == "restitution-ignored" and w["count"] == 1 and w["first_t"] == 0.0
+    assert "ignores restitution" in w["message"]
