@@ -116,6 +116,22 @@ std::string check_output_size(const mech::Model& model, const Options& opt, cons
          ": raise " + knob + ", or max_output_bytes";
 }
 
+// A model with friction and a method that would ignore it: refused, naming
+// the methods that handle friction (those whose OptionsUsed::friction is set).
+std::string refuse_friction(const mech::Model& model, std::string_view method,
+                            const OptionsUsed& used) {
+  if (used.friction || !model.is_mechanical() || !model.mechanical->has_friction()) return "";
+  std::string with;
+  for (const std::string& name : integrators().names())
+    if (auto integ = integrators().make(name); integ && integ->options_used().friction)
+      with += (with.empty() ? "'" : ", '") + name + "'";
+  return "method '" + std::string(method) + "' does not support friction (model '" + model.name +
+         "' has " + std::to_string(model.mechanical->friction.size()) +
+         " frictional contacts in mechanical.friction); " +
+         (with.empty() ? std::string("no simulation method supports it yet (the impact laws do)")
+                       : "use method " + with);
+}
+
 }  // namespace
 
 Options keep_used(const Options& opt, const OptionsUsed& used) {
@@ -142,6 +158,7 @@ std::string check_run(const mech::Model& model, const VectorXd& x0, const Option
   if (used.needs_mechanical && !model.is_mechanical())
     return "method '" + std::string(method) + "' needs a mechanical model ('" + model.name +
            "' is a general LCS; the methods 'event' and 'euler' take one)";
+  if (std::string m = refuse_friction(model, method, used); !m.empty()) return m;
   if (used.dense_lcs && model.lcs_state_size() > mech::kMaxDenseLcsState)
     return "method '" + std::string(method) +
            "' works on the dense LCS (matrix exponentials and LCPs of size n = 2N + 1), and " +

@@ -67,6 +67,7 @@
 #include <utility>
 #include <vector>
 
+#include "sim/mj_friction.hpp"
 #include "sim/step_kernels.hpp"
 #include "sim/time_stepping_detail.hpp"
 
@@ -147,6 +148,12 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
   // other solvers are called on every step.
   const bool warm_pivot = opt.lcp_solver == "pivot";
   lcp::WarmPivot warm;
+  // Friction (issue 17): steps whose active set holds a frictional contact
+  // solve the friction LCP (mj_friction.hpp); the others are the
+  // frictionless step below, unchanged.
+  std::unique_ptr<MjFriction> friction;
+  if (m.has_friction()) friction = std::make_unique<MjFriction>(m);
+  VectorXd lambda_T = VectorXd::Zero(m.has_friction() ? k : 0);
   IndexSet A, A_prev, mode, u_set;
   std::vector<int> pos(k, -1);               // position of constraint i in A, or -1
   VectorXd lambda_prev = VectorXd::Zero(k);  // last step's impulses (warm start)
@@ -195,13 +202,29 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
         }
     }
     for (int i : u_set) u(i) = 0.0;
+    if (friction) lambda_T.setZero();
     u_set.clear();
     mode.clear();
     z.resize(static_cast<Eigen::Index>(A.size()));  // warm start: last step's impulses
     for (size_t a = 0; a < A.size(); ++a) z(static_cast<Eigen::Index>(a)) = lambda_prev(A[a]);
     for (int i : A_prev) lambda_prev(i) = 0.0;  // set again below for this step's A
     A_prev = A;
-    if (!A.empty()) {
+    if (friction && friction->any_in(A)) {
+      const int na = static_cast<int>(A.size());
+      cols.resize(na);
+      for (int a = 0; a < na; ++a)
+        if (!f.column(A[a], cols[a]))
+          return fail("moreau-jean: iteration matrix too ill-conditioned at h = " +
+                      short_number(h));
+      if (!friction->step(f, A, cols, Ev, e, *solver, v_next, z, lambda_T, tr.lcp_solves, failed))
+        return fail(lcp_failure("moreau-jean", (j - 1) * grid.h, failed));
+      for (int a = 0; a < na; ++a) {
+        lambda_prev(A[a]) = z(a);
+        if (z(a) > 0.0) mode.push_back(A[a]);
+        u(A[a]) = z(a) / h;
+        u_set.push_back(A[a]);
+      }
+    } else if (!A.empty()) {
       const int na = static_cast<int>(A.size());
       cols.resize(na);
       for (int a = 0; a < na; ++a)

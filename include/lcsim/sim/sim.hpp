@@ -164,6 +164,9 @@ struct OptionsUsed {
   // method and backward Euler: mech::kMaxDenseLcsState).
   bool needs_mechanical = false;
   bool dense_lcs = false;
+  // The method handles mechanical.friction (planar Coulomb, issue 17); a
+  // method without it refuses a model with friction (check_run).
+  bool friction = false;
 };
 
 class Integrator {
