@@ -263,9 +263,11 @@ ImpactResult lcp_law(const ImpactInput& in, const lcp::Solver& solver, RuleFn fr
 
 const Rule kRules[] = {
     {"moreau",
-     +[](const ImpactInput& in, const lcp::Solver& s) { return lcp_law(in, s, &moreau_newton); }},
+     +[](const ImpactInput& in, const lcp::Solver& s) { return lcp_law(in, s, &moreau_newton); },
+     true},
     {"newton",
-     +[](const ImpactInput& in, const lcp::Solver& s) { return lcp_law(in, s, &moreau_newton); }},
+     +[](const ImpactInput& in, const lcp::Solver& s) { return lcp_law(in, s, &moreau_newton); },
+     true},
     {"moreau-restitution",
      +[](const ImpactInput& in, const lcp::Solver& s) {
        return lcp_law(in, s, &moreau_restitution);

@@ -95,6 +95,13 @@ TEST(FrictionImpact, FrictionlessLawsRefuseAModelWithFriction) {
   }
 }
 
+TEST(FrictionImpact, TheLcpLawsSayTheyHandleFrictionTheOthersDoNot) {
+  for (const char* law : {"moreau", "newton", "moreau-restitution"})
+    EXPECT_TRUE(make_impact_law(law)->handles_friction()) << law;
+  for (const char* law : {"sequential", "flip"})
+    EXPECT_FALSE(make_impact_law(law)->handles_friction()) << law;
+}
+
 TEST(FrictionImpact, ZeroMuIsTheFrictionlessImpact) {
   // mu = 0: the tangential impulse is 0 and v+ is Moreau's with Newton
   // restitution on one contact: v+ = v + (1 + e) M^{-1} E' lambda.
