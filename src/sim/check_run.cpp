@@ -107,7 +107,9 @@ std::string check_output_size(const mech::Model& model, const Options& opt, cons
     knob = "dt_out (or h)";
   } else
     return "";
-  const double numbers = 1.0 + model.state_size() + 2.0 * model.num_constraints();
+  const double numbers =
+      1.0 + model.state_size() + 2.0 * model.num_constraints() +
+      (model.is_mechanical() ? static_cast<double>(model.mechanical->friction.size()) : 0.0);
   const double bytes = samples * numbers * 25.0;
   if (bytes <= opt.max_output_bytes) return "";
   return "the recorded output would be about " + short_number(bytes) + " bytes (" +
@@ -126,8 +128,8 @@ std::string refuse_friction(const mech::Model& model, std::string_view method,
     if (auto integ = integrators().make(name); integ && integ->options_used().friction)
       with += (with.empty() ? "'" : ", '") + name + "'";
   return "method '" + std::string(method) + "' does not support friction (model '" + model.name +
-         "' has " + std::to_string(model.mechanical->friction.size()) +
-         " frictional contacts in mechanical.friction); " +
+         "' has " + std::to_string(model.mechanical->friction.size()) + " frictional contact" +
+         (model.mechanical->friction.size() == 1 ? "" : "s") + " in mechanical.friction); " +
          (with.empty() ? std::string("no simulation method supports it yet (the impact laws do)")
                        : "use method " + with);
 }

@@ -120,6 +120,15 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     return fail("moreau-jean: last step: " + F_last.message());
   const VectorXd e = m.restitution.size() == k ? m.restitution : VectorXd::Zero(k);
 
+  // Friction (issue 17): steps whose active set holds a frictional contact
+  // solve the friction LCP (mj_friction.hpp); the others are the
+  // frictionless step below, unchanged.
+  std::unique_ptr<MjFriction> friction;
+  if (m.has_friction()) friction = std::make_unique<MjFriction>(m);
+  VectorXd lambda_T = VectorXd::Zero(m.has_friction() ? k : 0);
+  // Mean friction force over the step (N), per entry of m.friction: the
+  // samples' u_t.
+  VectorXd u_t = VectorXd::Zero(static_cast<Eigen::Index>(m.friction.size()));
   OutputSampler sampler(opt.dt_out);
   auto record = [&](double t, const VectorXd& y, const VectorXd& uu, const IndexSet& mode) {
     if (!opt.record_samples) return;
@@ -130,6 +139,7 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     s.u = uu;
     s.y = y;
     s.mode = mode;
+    if (friction) s.u_t = u_t;
     tr.record_sample(std::move(s), opt);
   };
   VectorXd y(k);
@@ -148,12 +158,6 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
   // other solvers are called on every step.
   const bool warm_pivot = opt.lcp_solver == "pivot";
   lcp::WarmPivot warm;
-  // Friction (issue 17): steps whose active set holds a frictional contact
-  // solve the friction LCP (mj_friction.hpp); the others are the
-  // frictionless step below, unchanged.
-  std::unique_ptr<MjFriction> friction;
-  if (m.has_friction()) friction = std::make_unique<MjFriction>(m);
-  VectorXd lambda_T = VectorXd::Zero(m.has_friction() ? k : 0);
   IndexSet A, A_prev, mode, u_set;
   std::vector<int> pos(k, -1);               // position of constraint i in A, or -1
   VectorXd lambda_prev = VectorXd::Zero(k);  // last step's impulses (warm start)
@@ -202,7 +206,10 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
         }
     }
     for (int i : u_set) u(i) = 0.0;
-    if (friction) lambda_T.setZero();
+    if (friction) {
+      lambda_T.setZero();
+      u_t.setZero();
+    }
     u_set.clear();
     mode.clear();
     z.resize(static_cast<Eigen::Index>(A.size()));  // warm start: last step's impulses
@@ -218,6 +225,8 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
                       short_number(h));
       if (!friction->step(f, A, cols, Ev, e, *solver, v_next, z, lambda_T, tr.lcp_solves, failed))
         return fail(lcp_failure("moreau-jean", (j - 1) * grid.h, failed));
+      for (size_t fi = 0; fi < m.friction.size(); ++fi)
+        u_t(static_cast<Eigen::Index>(fi)) = lambda_T(m.friction[fi].contact) / h;
       for (int a = 0; a < na; ++a) {
         lambda_prev(A[a]) = z(a);
         if (z(a) > 0.0) mode.push_back(A[a]);

@@ -30,6 +30,9 @@ struct Sample {
   VectorXd u;  // multipliers (regular part)
   VectorXd y;  // gaps / outputs
   IndexSet mode;
+  // Tangential multipliers (mean friction force over the step, N), one per
+  // entry of mechanical.friction in its order; empty for frictionless models.
+  VectorXd u_t;
 };
 
 struct Event {
