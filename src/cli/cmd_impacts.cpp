@@ -78,11 +78,21 @@ Eigen::VectorXd restitution(const ImpactsArgs& a, const mech::MechanicalModel& m
   return e;
 }
 
-std::vector<std::string> rule_list(const std::string& text) {
-  if (text == "all") return impact::impact_law_names();
-  std::vector<std::string> out = io::split(text, ',');
+// With friction, "all" is the laws that handle it and naming another is an
+// input error (ImpactLaw::handles_friction).
+std::vector<std::string> rule_list(const std::string& text, bool friction) {
+  std::vector<std::string> out;
+  if (text == "all") {
+    for (const auto& n : impact::impact_law_names())
+      if (!friction || impact::make_impact_law(n)->handles_friction()) out.push_back(n);
+    return out;
+  }
+  out = io::split(text, ',');
   if (out.empty()) throw io::InputError("--rules: empty list (give all or a,b,...)");
-  for (const auto& n : out) (void)impact::make_impact_law(n);  // invalid_argument -> exit 2
+  for (const auto& n : out)  // invalid_argument -> exit 2
+    if (friction && !impact::make_impact_law(n)->handles_friction())
+      throw io::InputError("--rules: impact law '" + n +
+                           "' does not handle friction, and the model has friction");
   return out;
 }
 
@@ -90,7 +100,7 @@ void run_compare(const ImpactsArgs& a, const mech::Model& model) {
   const mech::MechanicalModel& m = *model.mechanical;
   const int N = m.dofs();
   const Eigen::VectorXd x0 = initial_state(a, model);
-  const std::vector<std::string> rules = rule_list(a.rules);
+  const std::vector<std::string> rules = rule_list(a.rules, m.has_friction());
   impact::ImpactInput in;
   in.model = &m;
   in.q = x0.head(N);
@@ -128,6 +138,18 @@ void run_compare(const ImpactsArgs& a, const mech::Model& model) {
                   {"worst_violation", r.worst_rate},
                   {"admissible", r.admissible},
                   {"message", r.message}};
+      if (m.has_friction()) {  // frictionless output unchanged
+        nlohmann::json outcome = nlohmann::json::object();
+        for (const auto& fc : m.friction)
+          outcome[m.constraints[fc.contact]] =
+              r.outcome.empty() ? "none" : impact::to_string(r.outcome[fc.contact]);
+        js[name]["friction_impulse"] =
+            io::to_json(r.friction_impulse.size() ? r.friction_impulse
+                                                  : Eigen::VectorXd::Zero(m.num_constraints()));
+        js[name]["friction_outcome"] = outcome;
+        js[name]["painleve"] = r.painleve;
+        js[name]["energy_gain"] = r.energy_gain;
+      }
     }
     j["rules"] = js;
     std::cout << j.dump(2) << "\n";
@@ -145,6 +167,11 @@ void run_compare(const ImpactsArgs& a, const mech::Model& model) {
                   fmt_vec(r.v_after).c_str(), fmt_vec(r.impulse).c_str(),
                   mode_text(m, r.mode, ",").c_str(), r.energy_before, r.energy_after, r.worst_rate,
                   note.c_str());
+      if (m.has_friction() && r.friction_impulse.size())  // frictionless output unchanged
+        for (const auto& fc : m.friction)
+          std::printf("%-19s friction at %s: P_T = %.6g, %s\n", "",
+                      m.constraints[fc.contact].c_str(), r.friction_impulse(fc.contact),
+                      impact::to_string(r.outcome[fc.contact]));
     }
   }
   std::cout.flush();

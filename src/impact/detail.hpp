@@ -21,8 +21,11 @@ struct Setup {
 // Validates the input and fills `out` with the no-impact defaults (v_after = v,
 // zero impulse, energy_before = energy_after). Returns nullopt when there is
 // nothing more to do: out.ok() says whether the input was valid (an empty J is a
-// valid input with no impact).
-std::optional<Setup> prepare(const ImpactInput& in, ImpactResult& out);
+// valid input with no impact). A model with friction is refused (kInvalidInput,
+// message says so) unless the caller handles friction (moreau_friction): a
+// law must not ignore it silently.
+std::optional<Setup> prepare(const ImpactInput& in, ImpactResult& out,
+                             bool handles_friction = false);
 
 // Fills impulse (per constraint, from the impulse on J), mode (impulse_J(i) >
 // mode_threshold), v_after, energy_after, worst_rate and admissible

@@ -13,7 +13,7 @@ namespace lcsim::impact {
 
 namespace detail {
 
-std::optional<Setup> prepare(const ImpactInput& in, ImpactResult& out) {
+std::optional<Setup> prepare(const ImpactInput& in, ImpactResult& out, bool handles_friction) {
   out = ImpactResult{};
   if (in.model == nullptr) {
     out.message = "impact input has no model";
@@ -21,6 +21,14 @@ std::optional<Setup> prepare(const ImpactInput& in, ImpactResult& out) {
     return std::nullopt;
   }
   const mech::MechanicalModel& m = *in.model;
+  if (m.has_friction() && !handles_friction) {
+    out.message = "this impact law does not handle friction (the model has " +
+                  std::to_string(m.friction.size()) +
+                  " frictional contacts); the laws 'moreau', 'newton' and "
+                  "'moreau-restitution' do";
+    out.status = Status::kInvalidInput;
+    return std::nullopt;
+  }
   const int N = m.dofs(), k = m.num_constraints();
   if (in.v.size() != N) {
     out.message = "pre-impact velocity has " + std::to_string(in.v.size()) +
@@ -245,14 +253,31 @@ using RuleFn = ImpactResult (*)(const ImpactInput&, const lcp::Solver&);
 struct Rule {
   const char* name;
   RuleFn fn;
+  bool friction = false;  // handles mechanical.friction
 };
 
 // "moreau" and "newton" are one formula (§8.2.2 with the given restitution;
 // e = 0 is Moreau's inelastic rule): two names, one implementation.
+// On a model with friction the three LCP laws are the one friction LCP
+// (moreau_friction: Newton's restitution inside it); the others refuse
+// friction (detail::prepare).
+ImpactResult lcp_law(const ImpactInput& in, const lcp::Solver& solver, RuleFn frictionless) {
+  if (in.model != nullptr && in.model->has_friction()) return moreau_friction(in, solver);
+  return frictionless(in, solver);
+}
+
 const Rule kRules[] = {
-    {"moreau", &moreau_newton},
-    {"newton", &moreau_newton},
-    {"moreau-restitution", &moreau_restitution},
+    {"moreau",
+     +[](const ImpactInput& in, const lcp::Solver& s) { return lcp_law(in, s, &moreau_newton); },
+     true},
+    {"newton",
+     +[](const ImpactInput& in, const lcp::Solver& s) { return lcp_law(in, s, &moreau_newton); },
+     true},
+    {"moreau-restitution",
+     +[](const ImpactInput& in, const lcp::Solver& s) {
+       return lcp_law(in, s, &moreau_restitution);
+     },
+     true},
     {"sequential", +[](const ImpactInput& in, const lcp::Solver&) { return sequential(in); }},
     {"flip", +[](const ImpactInput& in, const lcp::Solver&) { return flip_rule(in); }},
 };
@@ -261,8 +286,13 @@ class NamedLaw : public ImpactLaw {
  public:
   explicit NamedLaw(const Rule& r) : rule_(r) {}
   std::string name() const override { return rule_.name; }
+  bool handles_friction() const override { return rule_.friction; }
   ImpactResult apply(const ImpactInput& in, const lcp::Solver& solver) const override {
-    return rule_.fn(in, solver);
+    ImpactResult r = rule_.fn(in, solver);
+    if (!r.ok() && in.model != nullptr && in.model->has_friction() &&
+        r.message.rfind("this impact law", 0) == 0)
+      r.message = "impact law '" + std::string(rule_.name) + "'" + r.message.substr(15);
+    return r;
   }
 
  private:

@@ -80,6 +80,12 @@ std::string model_yaml(const mech::Model& model, const std::string& header) {
     out << "  constraints: " << names(m.constraints) << "\n";
   }
   if (!m.f.isZero(0.0)) out << "  f: " << list(m.f) << "\n";
+  if (m.has_friction()) {
+    out << "  friction:\n";
+    for (const mech::FrictionalContact& c : m.friction)
+      out << "    - {contact: " << c.contact << ", tangent: " << list(c.tangent)
+          << ", mu: " << format_number(c.mu) << "}\n";
+  }
   out << "  coordinates: " << names(m.coordinates) << "\n";
   if (model.initial.size() > 0) out << "initial: " << list(model.initial) << "\n";
   if (std::isfinite(model.t_end)) out << "t_end: " << format_number(model.t_end) << "\n";

@@ -182,10 +182,50 @@ std::vector<std::string> names(const YAML::Node& n, Eigen::Index size, const std
   return out;
 }
 
+// `friction: [{contact: <0-based row of E or its name>, tangent: [N numbers],
+// mu: <number>}]` (docs/model-format.md). Names resolve against the model's
+// constraint names, so this runs after fill_defaults; the sizes, ranges and
+// duplicates are mech::check_mechanical's.
+std::vector<mech::FrictionalContact> parse_friction(const YAML::Node& n,
+                                                    const mech::MechanicalModel& m,
+                                                    const std::string& source) {
+  const std::string key = "mechanical.friction";
+  if (!n.IsSequence())
+    fail(source, key, "expected a list of {contact, tangent, mu} (got " + describe(n) + ")");
+  std::vector<mech::FrictionalContact> out;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const std::string ikey = key + "[" + std::to_string(i) + "]";
+    const Keys keys = mapping(n[i], source, ikey, {"contact", "tangent", "mu"});
+    for (const char* k : {"contact", "tangent", "mu"})
+      if (!keys.count(k)) fail(source, ikey + "." + k, "missing");
+    mech::FrictionalContact c;
+    const YAML::Node& cn = keys.at("contact");
+    if (!cn.IsScalar() || cn.Scalar().empty())
+      fail(source, ikey + ".contact",
+           "expected a 0-based row of E or a constraint name (got " + describe(cn) + ")");
+    const std::string& text = cn.Scalar();
+    const bool is_index = text.find_first_not_of("0123456789") == std::string::npos;
+    if (is_index) {
+      c.contact = static_cast<int>(
+          count(cn, source, ikey + ".contact", static_cast<double>(m.num_constraints())));
+    } else {
+      const auto it = std::find(m.constraints.begin(), m.constraints.end(), text);
+      if (it == m.constraints.end())
+        fail(source, ikey + ".contact",
+             "no constraint named '" + text + "' (the constraints: " + join(m.constraints) + ")");
+      c.contact = static_cast<int>(it - m.constraints.begin());
+    }
+    c.tangent = vector(keys.at("tangent"), source, ikey + ".tangent");
+    c.mu = number(keys.at("mu"), source, ikey + ".mu");
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
 mech::MechanicalModel parse_mechanical(const YAML::Node& node, const std::string& source) {
-  const Keys keys =
-      mapping(node, source, "mechanical",
-              {"M", "D", "K", "E", "g", "f", "restitution", "coordinates", "constraints"});
+  const Keys keys = mapping(
+      node, source, "mechanical",
+      {"M", "D", "K", "E", "g", "f", "restitution", "coordinates", "constraints", "friction"});
   const auto has = [&](const char* k) { return keys.count(k) > 0; };
   mech::MechanicalModel m;
   if (!has("M")) fail(source, "mechanical.M", "missing (the mass matrix is required)");
@@ -232,6 +272,7 @@ mech::MechanicalModel parse_mechanical(const YAML::Node& node, const std::string
   // fill_defaults leaves the zero-row E alone and sizes g and restitution to
   // k, so a model without constraints (E omitted or []) is complete as well.
   mech::fill_defaults(m);
+  if (has("friction")) m.friction = parse_friction(keys.at("friction"), m, source);
   // What the file's structure did not already refuse: M symmetric positive
   // definite, restitution in [0, 1], finite entries, no all-zero row of E.
   if (auto p = mech::check_mechanical(m)) fail(source, p->field, p->what);

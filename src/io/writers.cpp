@@ -206,6 +206,8 @@ std::vector<std::string> csv_header(const mech::Model& model) {
     for (const auto& c : m.coordinates) header.push_back("v_" + c);
     for (const auto& c : m.constraints) header.push_back("u_" + c);
     for (const auto& c : m.constraints) header.push_back("y_" + c);
+    // Friction only: models without it keep their columns byte for byte.
+    for (const auto& f : m.friction) header.push_back("ut_" + m.constraints[f.contact]);
   } else {
     for (int i = 1; i <= n; ++i) header.push_back(prefixed("x", std::to_string(i)));
     for (int i = 1; i <= k; ++i) header.push_back(prefixed("u", std::to_string(i)));
@@ -235,8 +237,13 @@ void append_csv_vector(std::string& out, const VectorXd& v, int size, const char
   }
 }
 
-// Row `r` of the CSV: t, x, u, y, mode.
-void append_csv_row(std::string& out, const sim::Sample& s, int n, int k, std::size_t r) {
+int friction_count(const mech::Model& model) {
+  return model.is_mechanical() ? static_cast<int>(model.mechanical->friction.size()) : 0;
+}
+
+// Row `r` of the CSV: t, x, u, y, the tangential multipliers (nf of them,
+// models with friction only), mode.
+void append_csv_row(std::string& out, const sim::Sample& s, int n, int k, int nf, std::size_t r) {
   if (s.x.size() != n)
     throw std::logic_error("trajectory_csv: sample " + std::to_string(r) + " has a state of size " +
                            std::to_string(s.x.size()) + ", expected " + std::to_string(n));
@@ -244,6 +251,7 @@ void append_csv_row(std::string& out, const sim::Sample& s, int n, int k, std::s
   append_csv_vector(out, s.x, n, "x", r);
   append_csv_vector(out, s.u, k, "u", r);
   append_csv_vector(out, s.y, k, "y", r);
+  if (nf > 0) append_csv_vector(out, s.u_t, nf, "u_t", r);
   out += ',';
   for (std::size_t j = 0; j < s.mode.size(); ++j)
     out += prefixed(j ? ";" : "", std::to_string(s.mode[j]));
@@ -262,9 +270,9 @@ void write_file_atomic(const std::filesystem::path& path, const std::string& con
 std::string trajectory_csv(const mech::Model& model, const sim::Trajectory& traj) {
   std::string out;
   append_csv_header(out, model);
-  const int n = model.state_size(), k = model.num_constraints();
+  const int n = model.state_size(), k = model.num_constraints(), nf = friction_count(model);
   for (std::size_t r = 0; r < traj.samples.size(); ++r)
-    append_csv_row(out, traj.samples[r], n, k, r);
+    append_csv_row(out, traj.samples[r], n, k, nf, r);
   return out;
 }
 
@@ -272,7 +280,10 @@ std::string trajectory_csv(const mech::Model& model, const sim::Trajectory& traj
 
 TrajectoryCsvWriter::TrajectoryCsvWriter(const std::filesystem::path& path,
                                          const mech::Model& model)
-    : path_(path.string()), n_(model.state_size()), k_(model.num_constraints()) {
+    : path_(path.string()),
+      n_(model.state_size()),
+      k_(model.num_constraints()),
+      nf_(friction_count(model)) {
   TemporaryFile t = temporary_beside(path);
   fd_ = t.fd;
   temporary_ = std::move(t.name);
@@ -289,7 +300,7 @@ TrajectoryCsvWriter::~TrajectoryCsvWriter() {
 void TrajectoryCsvWriter::write(const sim::Sample& s) noexcept {
   if (fd_ < 0 || error_ != 0 || !logic_error_.empty()) return;
   try {
-    append_csv_row(buffer_, s, n_, k_, rows_++);
+    append_csv_row(buffer_, s, n_, k_, nf_, rows_++);
   } catch (const std::exception& e) {
     logic_error_ = e.what();
     return;

@@ -8,6 +8,7 @@
 #include <lcsim/mech/mech.hpp>
 #include <limits>
 #include <string>
+#include <vector>
 
 namespace lcsim::mech {
 
@@ -51,6 +52,39 @@ std::optional<std::string> non_finite_vector(const VectorXd& v) {
 // the message; above it by a sparse LDL' factorisation (O(nnz) for banded M),
 // cheap enough for every run to repeat (Integrator::run checks the model).
 constexpr Eigen::Index kDenseMassCheckMax = 64;
+
+// Frictional contacts: a row of E each, at most one per row, a finite
+// tangent row of length N, a finite mu >= 0.
+std::optional<ModelProblem> check_friction(const MechanicalModel& m) {
+  const Eigen::Index N = m.M.rows(), k = m.E.rows();
+  std::vector<int> owner(static_cast<size_t>(k), -1);
+  for (size_t f = 0; f < m.friction.size(); ++f) {
+    const FrictionalContact& c = m.friction[f];
+    const std::string at = "mechanical.friction[" + std::to_string(f) + "]";
+    if (c.contact < 0 || c.contact >= k)
+      return ModelProblem{at + ".contact", "contact " + std::to_string(c.contact) +
+                                               " out of range (k = " + std::to_string(k) +
+                                               " constraints, 0-based)"};
+    if (owner[static_cast<size_t>(c.contact)] >= 0)
+      return ModelProblem{at + ".contact",
+                          "contact " + std::to_string(c.contact) + " ('" +
+                              m.constraints[static_cast<size_t>(c.contact)] +
+                              "') already has friction (mechanical.friction[" +
+                              std::to_string(owner[static_cast<size_t>(c.contact)]) + "])"};
+    owner[static_cast<size_t>(c.contact)] = static_cast<int>(f);
+    if (c.tangent.size() != N)
+      return ModelProblem{at + ".tangent", "expected " + std::to_string(N) + " entries (N = " +
+                                               std::to_string(N) + " coordinates, from M) (got " +
+                                               std::to_string(c.tangent.size()) + ")"};
+    if (auto bad = non_finite_vector(c.tangent))
+      return ModelProblem{at + ".tangent" + *bad, "not finite"};
+    if (!(c.tangent.cwiseAbs().maxCoeff() > 0.0))
+      return ModelProblem{at + ".tangent", "all zero (it measures no sliding)"};
+    if (!std::isfinite(c.mu)) return ModelProblem{at + ".mu", "not finite (got " + num(c.mu) + ")"};
+    if (c.mu < 0.0) return ModelProblem{at + ".mu", "must be >= 0 (got " + num(c.mu) + ")"};
+  }
+  return std::nullopt;
+}
 
 }  // namespace
 
@@ -155,7 +189,7 @@ std::optional<ModelProblem> check_mechanical(const MechanicalModel& m) {
                             "constraint '" + m.constraints[i] +
                                 "' has an all-zero row (it constrains no coordinate)"};
   }
-  return std::nullopt;
+  return check_friction(m);
 }
 
 std::optional<ModelProblem> check_lcs(const lcs::Lcs& s) {

@@ -108,13 +108,31 @@ std::string check_output_size(const mech::Model& model, const Options& opt, cons
     knob = "dt_out (or h)";
   } else
     return "";
-  const double numbers = 1.0 + model.state_size() + 2.0 * model.num_constraints();
+  const double numbers =
+      1.0 + model.state_size() + 2.0 * model.num_constraints() +
+      (model.is_mechanical() ? static_cast<double>(model.mechanical->friction.size()) : 0.0);
   const double bytes = samples * numbers * 25.0;
   if (bytes <= opt.max_output_bytes) return "";
   return "the recorded output would be about " + short_number(bytes) + " bytes (" +
          short_number(samples) + " samples of " + short_number(numbers) +
          " numbers), more than max_output_bytes = " + short_number(opt.max_output_bytes) +
          ": raise " + knob + ", or max_output_bytes";
+}
+
+// A model with friction and a method that would ignore it: refused, naming
+// the methods that handle friction (those whose OptionsUsed::friction is set).
+std::string refuse_friction(const mech::Model& model, std::string_view method,
+                            const OptionsUsed& used) {
+  if (used.friction || !model.is_mechanical() || !model.mechanical->has_friction()) return "";
+  std::string with;
+  for (const std::string& name : integrators().names())
+    if (auto integ = integrators().make(name); integ && integ->options_used().friction)
+      with += (with.empty() ? "'" : ", '") + name + "'";
+  return "method '" + std::string(method) + "' does not support friction (model '" + model.name +
+         "' has " + std::to_string(model.mechanical->friction.size()) + " frictional contact" +
+         (model.mechanical->friction.size() == 1 ? "" : "s") + " in mechanical.friction); " +
+         (with.empty() ? std::string("no simulation method supports it yet (the impact laws do)")
+                       : "use method " + with);
 }
 
 }  // namespace
@@ -143,6 +161,7 @@ std::string check_run(const mech::Model& model, const VectorXd& x0, const Option
   if (used.needs_mechanical && !model.is_mechanical())
     return "method '" + std::string(method) + "' needs a mechanical model ('" + model.name +
            "' is a general LCS; the methods 'event' and 'euler' take one)";
+  if (std::string m = refuse_friction(model, method, used); !m.empty()) return m;
   if (used.dense_lcs && model.lcs_state_size() > mech::kMaxDenseLcsState)
     return "method '" + std::string(method) +
            "' works on the dense LCS (matrix exponentials and LCPs of size n = 2N + 1), and " +

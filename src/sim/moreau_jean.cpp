@@ -66,6 +66,7 @@
 #include <utility>
 #include <vector>
 
+#include "sim/mj_friction.hpp"
 #include "sim/step_kernels.hpp"
 #include "sim/time_stepping_detail.hpp"
 
@@ -115,6 +116,15 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     return fail("moreau-jean: last step: " + F_last.message());
   const VectorXd e = m.restitution.size() == k ? m.restitution : VectorXd::Zero(k);
 
+  // Friction (issue 17): steps whose active set holds a frictional contact
+  // solve the friction LCP (mj_friction.hpp); the others are the
+  // frictionless step below, unchanged.
+  std::unique_ptr<MjFriction> friction;
+  if (m.has_friction()) friction = std::make_unique<MjFriction>(m);
+  VectorXd lambda_T = VectorXd::Zero(m.has_friction() ? k : 0);
+  // Mean friction force over the step (N), per entry of m.friction: the
+  // samples' u_t.
+  VectorXd u_t = VectorXd::Zero(static_cast<Eigen::Index>(m.friction.size()));
   OutputSampler sampler(opt.dt_out);
   auto record = [&](double t, const VectorXd& y, const VectorXd& uu, const IndexSet& mode) {
     if (!opt.record_samples) return;
@@ -125,6 +135,7 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     s.u = uu;
     s.y = y;
     s.mode = mode;
+    if (friction) s.u_t = u_t;
     tr.record_sample(std::move(s), opt);
   };
   VectorXd y(k);
@@ -191,13 +202,34 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
         }
     }
     for (int i : u_set) u(i) = 0.0;
+    if (friction) {
+      lambda_T.setZero();
+      u_t.setZero();
+    }
     u_set.clear();
     mode.clear();
     z.resize(static_cast<Eigen::Index>(A.size()));  // warm start: last step's impulses
     for (size_t a = 0; a < A.size(); ++a) z(static_cast<Eigen::Index>(a)) = lambda_prev(A[a]);
     for (int i : A_prev) lambda_prev(i) = 0.0;  // set again below for this step's A
     A_prev = A;
-    if (!A.empty()) {
+    if (friction && friction->any_in(A)) {
+      const int na = static_cast<int>(A.size());
+      cols.resize(na);
+      for (int a = 0; a < na; ++a)
+        if (!f.column(A[a], cols[a]))
+          return fail("moreau-jean: iteration matrix too ill-conditioned at h = " +
+                      short_number(h));
+      if (!friction->step(f, A, cols, Ev, e, *solver, v_next, z, lambda_T, tr.lcp_solves, failed))
+        return fail(lcp_failure("moreau-jean", (j - 1) * grid.h, failed));
+      for (size_t fi = 0; fi < m.friction.size(); ++fi)
+        u_t(static_cast<Eigen::Index>(fi)) = lambda_T(m.friction[fi].contact) / h;
+      for (int a = 0; a < na; ++a) {
+        lambda_prev(A[a]) = z(a);
+        if (z(a) > 0.0) mode.push_back(A[a]);
+        u(A[a]) = z(a) / h;
+        u_set.push_back(A[a]);
+      }
+    } else if (!A.empty()) {
       const int na = static_cast<int>(A.size());
       cols.resize(na);
       for (int a = 0; a < na; ++a)

@@ -19,6 +19,16 @@ using Eigen::MatrixXd;
 using Eigen::VectorXd;
 using IndexSet = std::vector<int>;
 
+// What an impact did at a frictional contact (ImpactResult::outcome).
+enum class ContactOutcome {
+  kNone,          // frictionless, or not closed
+  kNoImpulse,     // closed frictional contact that received no normal impulse
+  kStick,         // tangential velocity zero after the impact, |P_T| <= mu P_N
+  kSlipPositive,  // slides along +t after the impact, P_T = -mu P_N
+  kSlipNegative,  // slides along -t after the impact, P_T = +mu P_N
+};
+const char* to_string(ContactOutcome o);  // "none", "no-impulse", "stick", "slip+", "slip-"
+
 struct ImpactResult {
   Status status = Status::kNumericalFailure;  // kOk when computed; message says why not
   bool ok() const { return status == Status::kOk; }
@@ -38,6 +48,18 @@ struct ImpactResult {
   // Sequential: v before the first pairwise impact, then after each one (only
   // filled when ImpactInput::record_iterates is set).
   std::vector<VectorXd> iterates;
+  // Friction (models with mechanical.friction; both empty otherwise):
+  // tangential impulse P_T per constraint (k, N s, along the contact's
+  // tangent row; 0 without friction) and the outcome per constraint (k).
+  VectorXd friction_impulse;
+  std::vector<ContactOutcome> outcome;
+  // Painlevé-type case: some closed frictional contact has W_NN - mu |W_NT|
+  // <= 0; the impact LCP then may have no solution or several, so no
+  // result is computed (ok = false, message names the contact).
+  bool painleve = false;
+  // Kinetic energy rose through the impact (beyond rounding): with e > 0 and
+  // W_NT != 0 Newton's law can do that (Kane's paradox); message says so.
+  bool energy_gain = false;
 };
 
 struct ImpactInput {
@@ -55,6 +77,9 @@ class ImpactLaw {
   virtual ~ImpactLaw() = default;
   virtual std::string name() const = 0;
   virtual ImpactResult apply(const ImpactInput& in, const lcp::Solver& solver) const = 0;
+  // Whether apply handles mechanical.friction; a law that does not refuses a
+  // model with friction (ok = false, message says so).
+  virtual bool handles_friction() const { return false; }
 };
 // The laws by name: those below, and "moreau-qp" in programs that link the
 // component lcsim::ipopt (include/lcsim/ipopt/moreau_qp.hpp).
@@ -72,6 +97,47 @@ std::vector<std::string> impact_law_names();
 // per-contact Newton restitution applied to the inelastic impulse (§8.2.2):
 // v+ = v + sum_i (1 + e_i) M^{-1} E_i' lambda_i. e = 0 is Moreau's rule.
 ImpactResult moreau_newton(const ImpactInput& in, const lcp::Solver& solver);
+// "moreau", "newton" and "moreau-restitution" on a model with friction: the
+// planar Coulomb impact as one LCP (thesis §2.5.3, Lemma 2.5.1; Glocker's
+// planar formulation, Siconos's fc2d_tolcp) with unknowns per frictional
+// closed contact (lambda_N, lambda_R, xi): the normal impulse, the split
+// lambda_R = lambda_T + mu lambda_N >= 0 of the tangential impulse, and the
+// reserve xi >= 0 (the negative part of the post-impact sliding velocity);
+// a frictionless contact keeps lambda_N alone:
+//   0 <= u_N+ + e u_N-           ⟂ lambda_N >= 0
+//   0 <= u_T+ + xi               ⟂ lambda_R >= 0
+//   0 <= 2 mu lambda_N - lambda_R ⟂ xi >= 0
+// with u+ = u- + W (lambda_N, lambda_T), W = G M^{-1} G', G = [E_J; T_F].
+// Newton's restitution acts on approaching contacts (u_N- < 0) only. Refuses
+// Painlevé-type cases (ImpactResult::painleve) and flags a gain of energy
+// (ImpactResult::energy_gain; impossible for e = 0).
+ImpactResult moreau_friction(const ImpactInput& in, const lcp::Solver& solver);
+
+// The friction LCP above from its data, for the impact law and the
+// time-stepping methods: Wg = G M^{-1} G' (n_N + n_F square, normal rows
+// first), rate_N (n_N, restitution included), rate_T (n_F), normal_of[f] the
+// normal row (0..n_N) of frictional contact f, mu (n_F). Unknowns
+// z = (lambda_N, lambda_R, xi), size n_N + 2 n_F.
+struct FrictionLcp {
+  MatrixXd M;
+  VectorXd q;
+};
+FrictionLcp friction_lcp(const MatrixXd& Wg, const VectorXd& rate_N, const VectorXd& rate_T,
+                         const std::vector<int>& normal_of, const VectorXd& mu);
+// Solves a friction_lcp: lcp::solve_scaled with `solver` and its fallbacks
+// (accepted at 1e-12, then 1e-10); where that fails, Lemke's and (size <= 12)
+// the enumeration's own z with its entries below rounding (64 eps |z|_inf)
+// set to zero, accepted by the same row-scaled test at 1e-10: at a closed
+// contact with no normal impulse the row 2 mu lambda_N - lambda_R is formed
+// of zeros, and a lambda_R of 1e-33 left by a pivot makes its row-scaled
+// residual 1 although the solution is exact to rounding. `solves` counts the
+// LCP solves, `tried` lists the solvers.
+lcp::Result solve_friction_lcp(const FrictionLcp& p, const lcp::Solver& solver, int* solves,
+                               std::string* tried);
+// The impulses (lambda_N, lambda_T) of a solution z of friction_lcp.
+void friction_impulses(const VectorXd& z, int n_normal, const std::vector<int>& normal_of,
+                       const VectorXd& mu, VectorXd& lambda_N, VectorXd& lambda_T);
+
 // "moreau-restitution": the Moreau–Jean law, restitution inside the LCP:
 // 0 <= E_J v+ + e∘E_J v ⟂ lambda >= 0, v+ = v + M^{-1} E_J' lambda.
 ImpactResult moreau_restitution(const ImpactInput& in, const lcp::Solver& solver);

@@ -89,7 +89,7 @@ class TrajectoryCsvWriter {
   void flush() noexcept;
   static constexpr std::size_t kBufferBytes = 1 << 20;
   std::string path_, temporary_, buffer_, logic_error_;
-  int n_ = 0, k_ = 0, fd_ = -1, error_ = 0;
+  int n_ = 0, k_ = 0, nf_ = 0, fd_ = -1, error_ = 0;  // nf_: frictional contacts
   std::size_t rows_ = 0;
 };
 

@@ -26,6 +26,16 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 // LCS theory, matrix exponentials, small Delassus matrices) take M.toDense()
 // where they need it; the time-stepping layer chooses dense or sparse
 // factorisations by size (sim::Options::sparse_dofs_threshold).
+// A planar Coulomb frictional contact (issue 17; thesis §2.5.3, Lemma 2.5.1):
+// the normal row E_c pairs with a tangent row t (relative sliding velocity
+// u_T = t' v, m/s) and a coefficient mu >= 0 (dimensionless). The friction
+// impulse P_T along t obeys |P_T| <= mu P_N and opposes sliding.
+struct FrictionalContact {
+  int contact = 0;   // 0-based row of E
+  VectorXd tangent;  // length N
+  double mu = 0.0;   // >= 0
+};
+
 struct MechanicalModel {
   SparseMatrix M;                        // mass matrix, symmetric positive definite (N x N)
   SparseMatrix D;                        // damping (N x N), zero if omitted
@@ -36,6 +46,9 @@ struct MechanicalModel {
   VectorXd restitution;                  // per-constraint Newton coefficient in [0, 1] (k)
   std::vector<std::string> coordinates;  // names (N); "q1".. if omitted
   std::vector<std::string> constraints;  // names (k); "c1".. if omitted
+  // Frictional contacts, at most one per row of E (empty: frictionless model).
+  std::vector<FrictionalContact> friction;
+  bool has_friction() const { return !friction.empty(); }
   int dofs() const { return static_cast<int>(M.rows()); }
   int num_constraints() const { return static_cast<int>(E.rows()); }
 };
@@ -110,8 +123,10 @@ struct ModelProblem {
 // loaders put the file name in front): sizes that agree, finite entries, M
 // symmetric (1e-12 relative) and positive definite (its smallest eigenvalue,
 // or LDL' pivot above 64 coordinates, above N eps of the largest),
-// restitution in [0, 1], no all-zero row of E, an initial state of the right
-// size and a finite t_end > 0 when set. nullopt when usable.
+// restitution in [0, 1], no all-zero row of E, frictional contacts naming
+// distinct rows of E with a finite tangent row of length N and a finite
+// mu >= 0, an initial state of the right size and a finite t_end > 0 when
+// set. nullopt when usable.
 std::optional<ModelProblem> check_model(const Model& model);
 std::optional<ModelProblem> check_mechanical(const MechanicalModel& m);
 std::optional<ModelProblem> check_lcs(const lcs::Lcs& s);

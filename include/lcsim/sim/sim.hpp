@@ -30,6 +30,9 @@ struct Sample {
   VectorXd u;  // multipliers (regular part)
   VectorXd y;  // gaps / outputs
   IndexSet mode;
+  // Tangential multipliers (mean friction force over the step, N), one per
+  // entry of mechanical.friction in its order; empty for frictionless models.
+  VectorXd u_t;
 };
 
 struct Event {
@@ -169,6 +172,9 @@ struct OptionsUsed {
   // method and backward Euler: mech::kMaxDenseLcsState).
   bool needs_mechanical = false;
   bool dense_lcs = false;
+  // The method handles mechanical.friction (planar Coulomb, issue 17); a
+  // method without it refuses a model with friction (check_run).
+  bool friction = false;
 };
 
 class Integrator {

@@ -1,0 +1,265 @@
+// The planar Coulomb impact as one LCP (issue 17): thesis §2.5.3 (Lemma 2.5.1,
+// the relay characteristic as complementarity) applied to the tangential
+// impulse of each frictional contact, Moreau's LCP (3.69)-(3.70) on the
+// normals, Newton's restitution on the approaching normals.
+#include <algorithm>
+#include <cmath>
+#include <lcsim/impact/impact.hpp>
+#include <limits>
+#include <sstream>
+
+#include "impact/detail.hpp"
+
+namespace lcsim::impact {
+
+const char* to_string(ContactOutcome o) {
+  switch (o) {
+    case ContactOutcome::kNone:
+      return "none";
+    case ContactOutcome::kNoImpulse:
+      return "no-impulse";
+    case ContactOutcome::kStick:
+      return "stick";
+    case ContactOutcome::kSlipPositive:
+      return "slip+";
+    case ContactOutcome::kSlipNegative:
+      return "slip-";
+  }
+  return "?";
+}
+
+FrictionLcp friction_lcp(const MatrixXd& Wg, const VectorXd& rate_N, const VectorXd& rate_T,
+                         const std::vector<int>& normal_of, const VectorXd& mu) {
+  const Eigen::Index nn = rate_N.size(), nf = rate_T.size(), n = nn + 2 * nf;
+  // (lambda_N, lambda_T) = P z with lambda_T = lambda_R - mu∘lambda_N[F].
+  MatrixXd P = MatrixXd::Zero(nn + nf, n);
+  P.topLeftCorner(nn, nn).setIdentity();
+  P.block(nn, nn, nf, nf).setIdentity();
+  for (Eigen::Index f = 0; f < nf; ++f) P(nn + f, normal_of[static_cast<size_t>(f)]) = -mu(f);
+  FrictionLcp out;
+  out.M = MatrixXd::Zero(n, n);
+  out.q = VectorXd::Zero(n);
+  // Rows 0..nn: u_N+ (with restitution); nn..nn+nf: u_T+ + xi;
+  // nn+nf..n: 2 mu lambda_N - lambda_R (the friction cone's two edges,
+  // mu lambda_N + lambda_T >= 0 and mu lambda_N - lambda_T >= 0, as
+  // lambda_R >= 0 and this row).
+  out.M.topRows(nn + nf) = Wg * P;
+  out.M.block(nn, nn + nf, nf, nf).setIdentity();
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    out.M(nn + nf + f, normal_of[static_cast<size_t>(f)]) = 2.0 * mu(f);
+    out.M(nn + nf + f, nn + f) = -1.0;
+  }
+  out.q.head(nn) = rate_N;
+  out.q.segment(nn, nf) = rate_T;
+  return out;
+}
+
+void friction_impulses(const VectorXd& z, int n_normal, const std::vector<int>& normal_of,
+                       const VectorXd& mu, VectorXd& lambda_N, VectorXd& lambda_T) {
+  const Eigen::Index nf = mu.size();
+  lambda_N = z.head(n_normal);
+  lambda_T.resize(nf);
+  for (Eigen::Index f = 0; f < nf; ++f)
+    lambda_T(f) = z(n_normal + f) - mu(f) * lambda_N(normal_of[static_cast<size_t>(f)]);
+}
+
+lcp::Result solve_friction_lcp(const FrictionLcp& p, const lcp::Solver& solver, int* solves,
+                               std::string* tried) {
+  lcp::Options opt;
+  lcp::Result res;
+  for (const double tol : {1e-12, 1e-10}) {
+    opt.tolerance = tol;
+    res = lcp::solve_scaled(solver, p.M, p.q, opt, solves, tried);
+    if (res.ok()) return res;
+  }
+  for (const char* name : {"lemke", "enum"}) {
+    if (std::string(name) == "enum" && p.q.size() > 12) continue;
+    lcp::Result r = lcp::make_solver(name)->solve(p.M, p.q, opt);
+    if (solves) ++*solves;
+    if (tried) *tried += std::string(", ") + name + " (zeros below rounding)";
+    if (r.z.size() != p.q.size() || !r.z.allFinite()) continue;
+    const double zmax = r.z.cwiseAbs().maxCoeff();
+    for (Eigen::Index i = 0; i < r.z.size(); ++i)
+      if (std::abs(r.z(i)) <= 64 * std::numeric_limits<double>::epsilon() * zmax) r.z(i) = 0.0;
+    lcp::Result chk = lcp::evaluate(p.M, p.q, r.z);
+    chk.scaled_residual = lcp::scaled_residual(p.M, p.q, r.z, &chk.worst_row);
+    if (chk.scaled_residual <= opt.tolerance) {
+      chk.status = lcp::Status::kSolved;
+      chk.pivots = r.pivots;
+      return chk;
+    }
+  }
+  return res;
+}
+
+namespace {
+
+// The closed frictional contacts: their normal row in J, index in
+// model.friction, tangent rows and mu.
+struct ClosedFriction {
+  std::vector<int> normal_of;  // position in J
+  std::vector<int> index;      // into model.friction
+  MatrixXd T;                  // tangent rows (n_F x N)
+  VectorXd mu;
+};
+
+ClosedFriction closed_friction(const mech::MechanicalModel& m, const IndexSet& closed) {
+  ClosedFriction c;
+  for (size_t f = 0; f < m.friction.size(); ++f) {
+    const auto it = std::lower_bound(closed.begin(), closed.end(), m.friction[f].contact);
+    if (it == closed.end() || *it != m.friction[f].contact) continue;
+    c.normal_of.push_back(static_cast<int>(it - closed.begin()));
+    c.index.push_back(static_cast<int>(f));
+  }
+  const Eigen::Index nf = static_cast<Eigen::Index>(c.index.size());
+  c.T.resize(nf, m.dofs());
+  c.mu.resize(nf);
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(c.index[f])];
+    c.T.row(f) = fc.tangent.transpose();
+    c.mu(f) = fc.mu;
+  }
+  return c;
+}
+
+// Painlevé-type cases. With the frictional contacts sliding in directions
+// sigma (lambda_T = -sigma mu lambda_N), the normal impulses solve the LCP
+// with matrix W_NN - W_NT diag(sigma mu) S (S picks the frictional rows);
+// when it is not a P-matrix that LCP may have no solution or several. One
+// contact: its coefficient W_NN - mu |W_NT| <= 0. Several: every sign
+// pattern, up to kMaxPatternContacts frictional and kMaxPatternNormals
+// closed contacts (2^n_F P-matrix tests of 2^n_N minors); beyond, the
+// single-contact test alone. The message, or "" when there is none.
+constexpr Eigen::Index kMaxPatternContacts = 8, kMaxPatternNormals = 12;
+
+std::string painleve(const mech::MechanicalModel& m, const IndexSet& closed,
+                     const ClosedFriction& c, const MatrixXd& W, const MatrixXd& WNT) {
+  std::ostringstream msg;
+  msg.precision(6);
+  const std::string tail =
+      "; the friction impact LCP may have no solution or several (not resolved)";
+  for (size_t f = 0; f < c.index.size(); ++f) {
+    const int j = c.normal_of[f];
+    const double wnn = W(j, j), wnt = WNT(j, static_cast<Eigen::Index>(f));
+    const double mu = c.mu(static_cast<Eigen::Index>(f));
+    const double coef = wnn - mu * std::abs(wnt);
+    // Relative to the terms that form it: below that it is zero to rounding.
+    if (coef > 1e-12 * (wnn + mu * std::abs(wnt))) continue;
+    const int row = closed[static_cast<size_t>(j)];
+    msg << "Painlevé-type case at contact " << row << " ('" << m.constraints[row]
+        << "'): W_NN - mu |W_NT| = " << wnn << " - " << mu << " * " << std::abs(wnt) << " = "
+        << coef << " <= 0, so sliding " << (wnt > 0 ? "along +t" : "along -t")
+        << " presses the contact shut" << tail;
+    return msg.str();
+  }
+  const Eigen::Index nf = c.mu.size();
+  if (nf < 1 || (nf == 1 && W.rows() == 1) || nf > kMaxPatternContacts ||
+      W.rows() > kMaxPatternNormals)
+    return "";
+  for (long pattern = 0; pattern < (1L << nf); ++pattern) {
+    MatrixXd Ns = W;
+    for (Eigen::Index f = 0; f < nf; ++f) {
+      const double sigma = (pattern >> f) & 1 ? -1.0 : 1.0;
+      Ns.col(c.normal_of[static_cast<size_t>(f)]) -= sigma * c.mu(f) * WNT.col(f);
+    }
+    if (lcp::is_p_matrix(Ns)) continue;
+    msg << "Painlevé-type case at contacts";
+    for (size_t f = 0; f < c.index.size(); ++f)
+      msg << " " << closed[static_cast<size_t>(c.normal_of[f])]
+          << (((pattern >> f) & 1) ? " (slip-)" : " (slip+)");
+    msg << ": with these slips the normal matrix W_NN - W_NT diag(sigma mu) is not a P-matrix"
+        << tail;
+    return msg.str();
+  }
+  return "";
+}
+
+void set_outcomes(const mech::MechanicalModel& m, const ImpactInput& in, const ClosedFriction& c,
+                  const VectorXd& lambda_N, const VectorXd& lambda_T, double tiny,
+                  ImpactResult& out) {
+  for (size_t f = 0; f < c.index.size(); ++f) {
+    const Eigen::Index fi = static_cast<Eigen::Index>(f);
+    const int row = m.friction[static_cast<size_t>(c.index[f])].contact;
+    out.friction_impulse(row) = lambda_T(fi);
+    if (!(lambda_N(c.normal_of[f]) > tiny)) {
+      out.outcome[static_cast<size_t>(row)] = ContactOutcome::kNoImpulse;
+      continue;
+    }
+    const double ut = c.T.row(fi).dot(out.v_after);
+    // Zero to rounding: the terms of t'v+ and t'v-, as the rates in finish.
+    const double scale = c.T.row(fi).cwiseAbs().dot(in.v.cwiseAbs() + out.v_after.cwiseAbs());
+    out.outcome[static_cast<size_t>(row)] =
+        std::abs(ut) <= 1e-9 * scale + kAbsTol
+            ? ContactOutcome::kStick
+            : (ut > 0 ? ContactOutcome::kSlipPositive : ContactOutcome::kSlipNegative);
+  }
+}
+
+}  // namespace
+
+ImpactResult moreau_friction(const ImpactInput& in, const lcp::Solver& solver) {
+  ImpactResult out;
+  const auto s = detail::prepare(in, out, /*handles_friction=*/true);
+  if (in.model != nullptr && out.v_after.size() == in.model->dofs()) {
+    out.friction_impulse = VectorXd::Zero(in.model->num_constraints());
+    out.outcome.assign(static_cast<size_t>(in.model->num_constraints()), ContactOutcome::kNone);
+  }
+  if (!s) return out;
+  const mech::MechanicalModel& m = *in.model;
+  const ClosedFriction c = closed_friction(m, in.closed);
+  const Eigen::Index nj = s->W.rows(), nf = c.mu.size();
+  MatrixXd MinvTt = c.T.transpose();
+  s->L.triangularView<Eigen::Lower>().solveInPlace(MinvTt);
+  s->L.transpose().triangularView<Eigen::Upper>().solveInPlace(MinvTt);
+  MatrixXd Wg(nj + nf, nj + nf);
+  Wg.topLeftCorner(nj, nj) = s->W;
+  Wg.topRightCorner(nj, nf) = s->EJ * MinvTt;
+  Wg.bottomLeftCorner(nf, nj) = Wg.topRightCorner(nj, nf).transpose();
+  Wg.bottomRightCorner(nf, nf) = c.T * MinvTt;
+  if (std::string p = painleve(m, in.closed, c, s->W, Wg.topRightCorner(nj, nf)); !p.empty()) {
+    out.painleve = true;
+    out.message = p;
+    return out;
+  }
+  // Newton's restitution on approaching contacts: u_N+ >= -e u_N- there; a
+  // closed contact already separating (u_N- >= 0) only needs u_N+ >= 0.
+  const VectorXd rate_N = s->a + s->e_J.cwiseProduct(s->a.cwiseMin(0.0));
+  const FrictionLcp lcp = friction_lcp(Wg, rate_N, c.T * in.v, c.normal_of, c.mu);
+  std::string tried;
+  const lcp::Result res = solve_friction_lcp(lcp, solver, &out.lcp_solves, &tried);
+  out.lcp_status = res.status;
+  if (!res.ok()) {
+    out.message = "friction impact LCP failed (" + tried +
+                  "): " + std::string(lcp::to_string(res.status, "solved")) +
+                  (res.message.empty() ? "" : " (" + res.message + ")");
+    return out;
+  }
+  const VectorXd* z = &res.z;
+  VectorXd lambda_N, lambda_T;
+  friction_impulses(*z, static_cast<int>(nj), c.normal_of, c.mu, lambda_N, lambda_T);
+  const VectorXd v_after = in.v + s->MinvEt * lambda_N + MinvTt * lambda_T;
+  // Mode threshold as moreau_newton's: rounding of the largest approach rate
+  // through the diagonal of W.
+  double tiny = 0.0;
+  for (Eigen::Index i = 0; i < nj; ++i)
+    if (s->W(i, i) > 0.0) tiny = std::max(tiny, std::abs(s->a(i)) / s->W(i, i));
+  tiny *= kRelTol;
+  detail::finish(in, *s, lambda_N, v_after, tiny, out);
+  set_outcomes(m, in, c, lambda_N, lambda_T, tiny, out);
+  out.status = Status::kOk;
+  // T+ - T- = lambda' u+ - ½ dv' M dv (dv = v+ - v-); lambda_T u_T+ <= 0 and
+  // lambda_N u_N+ = 0 for e = 0, so only restitution can make it positive.
+  // Beyond rounding: 1e-12 relative (a few hundred eps of the kinetic energy).
+  if (out.energy_after > out.energy_before * (1.0 + 1e-12) + 1e-300) {
+    out.energy_gain = true;
+    std::ostringstream msg;
+    msg.precision(6);
+    msg << "kinetic energy rose through the impact, " << out.energy_before << " -> "
+        << out.energy_after << " J: Newton restitution with coupled normal and tangential "
+        << "directions (W_NT != 0) can create energy (Kane's paradox)";
+    out.message = msg.str();
+  }
+  return out;
+}
+
+}  // namespace lcsim::impact

@@ -1,0 +1,191 @@
+// Friction in the simulation methods (issue 17): Moreau–Jean against closed
+// forms (a block sliding to a stop on a floor and on an incline, a
+// mass–spring on a rough floor), and every other method refusing a model
+// with friction instead of ignoring it.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <lcsim/impact/impact.hpp>
+#include <lcsim/io/io.hpp>
+#include <lcsim/sim/sim.hpp>
+#include <string>
+#include <tuple>
+
+namespace lcsim {
+namespace {
+
+using Eigen::VectorXd;
+
+constexpr double kG = 9.81;
+
+// A block of mass m on a plane inclined by alpha, coordinates (s, n) along
+// and normal to the plane: f = m g (-sin alpha, -cos alpha), contact n >= 0,
+// tangent along s, coefficient mu; a spring of stiffness k pulls s to 0.
+mech::Model block(double m, double alpha, double mu, double k = 0.0) {
+  mech::MechanicalModel mm;
+  mm.M = (m * Eigen::MatrixXd::Identity(2, 2)).sparseView();
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(2, 2);
+  K(0, 0) = k;
+  mm.K = K.sparseView();
+  mm.E = Eigen::RowVector2d(0, 1).sparseView();
+  mm.f = Eigen::Vector2d(-m * kG * std::sin(alpha), -m * kG * std::cos(alpha));
+  mech::fill_defaults(mm);
+  mm.friction.push_back({0, Eigen::Vector2d(1, 0), mu});
+  return mech::model_of(mm, "block");
+}
+
+sim::Trajectory run_mj(const mech::Model& model, const VectorXd& x0, double t_end, double h) {
+  sim::Options o;
+  o.t_end = t_end;
+  o.h = h;
+  return sim::make_integrator("moreau-jean")->run(model, x0, o);
+}
+
+// Zero to rounding: a stuck velocity is v_free + W^{-1} t lambda_T, a
+// cancellation of terms of the size of the initial speed, exact to a few eps
+// of it; 1e-12 of it is far below the last sliding velocity before a stick
+// (a fraction of the decrement mu g h per step, 1e-4 and more here).
+bool stuck(double v) { return std::abs(v) <= 1e-12 * 2.0; }
+
+// The first sample time at which the sliding velocity is zero.
+double stick_time(const sim::Trajectory& tr) {
+  for (const sim::Sample& s : tr.samples)
+    if (stuck(s.x(2))) return s.t;
+  return NAN;
+}
+
+TEST(FrictionMoreauJean, BlockOnFloorSticksAtVOverMuG) {
+  // v0 = 2 m/s, mu = 0.4: t* = v0 / (mu g) = 0.5097 s. Each step takes
+  // mu g h off the velocity (normal impulse m g h, friction mu m g h) until
+  // the step where less is left: there it sticks (exactly 0). So
+  // t_stick = ceil(t* / h) h and |t_stick - t*| <= h: C = 1.
+  const double v0 = 2.0, mu = 0.4, t_star = v0 / (mu * kG);
+  for (const double h : {1e-2, 1e-3, 1e-4}) {
+    const sim::Trajectory tr =
+        run_mj(block(3.0, 0.0, mu), (VectorXd(4) << 0, 0, v0, 0).finished(), 1.0, h);
+    ASSERT_EQ(tr.status, Status::kCompleted) << tr.message;
+    const double ts = stick_time(tr);
+    EXPECT_LE(std::abs(ts - t_star), h) << "h = " << h;
+    // It stays stuck and on the floor: no velocity, and the position is the
+    // one reached (distance v0 t* / 2 to O(h)).
+    EXPECT_TRUE(stuck(tr.final_state(2))) << tr.final_state(2);
+    EXPECT_NEAR(tr.final_state(0), v0 * t_star / 2, 2 * v0 * h);
+    // Resting contact: a step whose normal rate came out +1e-17 leaves the
+    // contact out of the next active set (predicted gap > 0), which then falls
+    // for one step, by g h^2 / 2 at theta = 1/2 (the penetration bound of
+    // src/sim/moreau_jean.cpp, frictionless alike): at most 2 g h^2 here.
+    EXPECT_LE(std::abs(tr.final_state(1)), 2 * kG * h * h);
+  }
+}
+
+TEST(FrictionMoreauJean, BlockOnInclineSticksAndStaysWhenMuAboveTanAlpha) {
+  // alpha = 0.3 rad, mu = 0.5 > tan(0.3) = 0.309: sliding down at v0 = -1.5
+  // m/s decelerates at g (mu cos alpha - sin alpha) and sticks at
+  // t* = |v0| / (g (mu cos alpha - sin alpha)) = 0.8395 s, to within h as on
+  // the floor; then it stays (velocity exactly 0 at every later sample).
+  const double alpha = 0.3, mu = 0.5, v0 = -1.5;
+  const double t_star = -v0 / (kG * (mu * std::cos(alpha) - std::sin(alpha)));
+  const double h = 1e-3;
+  const sim::Trajectory tr =
+      run_mj(block(1.0, alpha, mu), (VectorXd(4) << 0, 0, v0, 0).finished(), 2.0, h);
+  ASSERT_EQ(tr.status, Status::kCompleted) << tr.message;
+  const double ts = stick_time(tr);
+  EXPECT_LE(std::abs(ts - t_star), h);
+  for (const sim::Sample& s : tr.samples)
+    if (s.t >= ts) {
+      EXPECT_TRUE(stuck(s.x(2))) << "t = " << s.t << ": " << s.x(2);
+    }
+  // mu < tan alpha: never sticks.
+  const sim::Trajectory slide =
+      run_mj(block(1.0, alpha, 0.25), (VectorXd(4) << 0, 0, v0, 0).finished(), 2.0, h);
+  ASSERT_EQ(slide.status, Status::kCompleted) << slide.message;
+  EXPECT_TRUE(std::isnan(stick_time(slide)));
+}
+
+TEST(FrictionMoreauJean, MassSpringOnRoughFloorStopsAfterNHalfCycles) {
+  // m = 1, k = 4 (omega = 2), mu = 0.1: x_s = mu m g / k = 0.24525 m. From
+  // x0 = 1 at rest: each half-cycle the amplitude about the far side's
+  // offset shrinks by 2 x_s; N = ceil((x0 - x_s) / (2 x_s)) = 2 half-cycles,
+  // final position (-1)^N (x0 - 2 N x_s) = 0.019 m, at rest from
+  // T = N pi / omega = pi s. First order in h: the final position to a few
+  // h times the speed scale x0 omega (C = 4 leaves room for the stick step).
+  const double m = 1, k = 4, mu = 0.1, x0 = 1.0, omega = 2.0;
+  const double xs = mu * m * kG / k;
+  const int N = static_cast<int>(std::ceil((x0 - xs) / (2 * xs)));
+  ASSERT_EQ(N, 2);
+  const double x_final = (N % 2 ? -1.0 : 1.0) * (x0 - 2 * N * xs);
+  const double h = 1e-4;
+  const sim::Trajectory tr =
+      run_mj(block(m, 0.0, mu, k), (VectorXd(4) << x0, 0, 0, 0).finished(), 5.0, h);
+  ASSERT_EQ(tr.status, Status::kCompleted) << tr.message;
+  EXPECT_NEAR(tr.final_state(0), x_final, 4 * h * x0 * omega);
+  EXPECT_TRUE(stuck(tr.final_state(2))) << tr.final_state(2);
+  // At rest from T = N pi / omega on (to within a few steps).
+  double t_rest = NAN;
+  for (const sim::Sample& s : tr.samples)
+    if (!stuck(s.x(2)))
+      t_rest = NAN;
+    else if (std::isnan(t_rest))
+      t_rest = s.t;
+  EXPECT_NEAR(t_rest, N * M_PI / omega, 4 * h);
+}
+
+mech::Model shipped(const std::string& name) {
+  return io::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/" + name);
+}
+
+// robots/*friction*.yaml against the closed forms in their headers, at the
+// tolerances of the tests above (stick within h, positions within 2 v0 h).
+TEST(FrictionShippedModels, MatchTheirClosedForms) {
+  const double h = 1e-3;
+  for (const auto& [file, t_star, x_star] :
+       {std::tuple{"block_on_floor_friction.yaml", 0.509684, 0.509684},
+        std::tuple{"incline_friction.yaml", 0.839456, -0.629592}}) {
+    SCOPED_TRACE(file);
+    const mech::Model m = shipped(file);
+    const sim::Trajectory tr = run_mj(m, m.initial, m.t_end, h);
+    ASSERT_EQ(tr.status, Status::kCompleted) << tr.message;
+    // 1e-6: the closed forms in the files are rounded to 6 digits.
+    EXPECT_LE(std::abs(stick_time(tr) - t_star), h + 1e-6);
+    EXPECT_NEAR(tr.final_state(0), x_star, 2 * std::abs(m.initial(2)) * h + 1e-6);
+    EXPECT_TRUE(stuck(tr.final_state(2))) << tr.final_state(2);
+  }
+  const mech::Model ms = shipped("mass_spring_friction.yaml");
+  const sim::Trajectory tr = run_mj(ms, ms.initial, ms.t_end, 1e-4);
+  ASSERT_EQ(tr.status, Status::kCompleted) << tr.message;
+  EXPECT_NEAR(tr.final_state(0), 0.019, 4 * 1e-4 * 2.0);  // as in the test above
+  // The disk: its initial state is the impact; v+ = (-1/3, 1.5, 2/3) exactly
+  // (a 3 x 3 LCP and a diagonal M: 1e-12 is a few hundred ulps).
+  const mech::Model d = shipped("spinning_disk_friction.yaml");
+  impact::ImpactInput in;
+  in.model = &*d.mechanical;
+  in.q = d.initial.head(3);
+  in.v = d.initial.tail(3);
+  in.closed = {0};
+  const impact::ImpactResult r =
+      impact::make_impact_law("moreau")->apply(in, *lcp::make_solver("pivot"));
+  ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_NEAR((r.v_after - Eigen::Vector3d(-1.0 / 3, 1.5, 2.0 / 3)).cwiseAbs().maxCoeff(), 0.0,
+              1e-12);
+  EXPECT_NEAR(r.friction_impulse(0), -8.0 / 3, 1e-12);
+  EXPECT_EQ(r.outcome[0], impact::ContactOutcome::kStick);
+}
+
+TEST(FrictionRefusal, MethodsWithoutFrictionRefuseIt) {
+  const mech::Model model = block(1.0, 0.0, 0.3);
+  const VectorXd x0 = (VectorXd(4) << 0, 0, 1, 0).finished();
+  sim::Options o;
+  o.t_end = 0.1;
+  for (const std::string& name : sim::integrators().names()) {
+    const auto integ = sim::make_integrator(name);
+    if (integ->options_used().friction) continue;
+    const sim::Trajectory tr = integ->run(model, x0, o);
+    EXPECT_EQ(tr.status, Status::kInvalidInput) << name;
+    EXPECT_EQ(tr.message, "method '" + name +
+                              "' does not support friction (model 'block' has 1 frictional "
+                              "contact in mechanical.friction); use method 'moreau-jean'");
+  }
+}
+
+}  // namespace
+}  // namespace lcsim
