@@ -77,6 +77,7 @@ class Trajectory:
     t: np.ndarray
     x: np.ndarray
     u: np.ndarray
+    u_t: np.ndarray  # tangential multipliers, (n, frictional contacts)
     y: np.ndarray
     modes: np.ndarray
     @property

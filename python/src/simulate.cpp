@@ -19,10 +19,13 @@ using Eigen::VectorXd;
 // after row, sized by the model (as the CSV is): a sample without u or y
 // (an event-only record; blank cells in the CSV) gives a row of NaN.
 struct SampleBuffers {
-  std::vector<double> t, x, u, y;
-  std::vector<std::uint8_t> active;  // n x k: 1 where the constraint is in the mode
-  py::ssize_t nx = 0, k = 0;
-  explicit SampleBuffers(const mech::Model& m) : nx(m.state_size()), k(m.num_constraints()) {}
+  std::vector<double> t, x, u, y, u_t;  // u_t: n x frictional contacts
+  std::vector<std::uint8_t> active;     // n x k: 1 where the constraint is in the mode
+  py::ssize_t nx = 0, k = 0, nf = 0;
+  explicit SampleBuffers(const mech::Model& m)
+      : nx(m.state_size()),
+        k(m.num_constraints()),
+        nf(m.is_mechanical() ? static_cast<py::ssize_t>(m.mechanical->friction.size()) : 0) {}
   void reserve(std::size_t n) {
     const auto rows = [n](py::ssize_t w) { return n * static_cast<std::size_t>(w); };
     t.reserve(n);
@@ -42,6 +45,7 @@ struct SampleBuffers {
     append(x, s.x, nx);
     append(u, s.u, k);
     append(y, s.y, k);
+    if (nf > 0) append(u_t, s.u_t, nf);
     active.resize(t.size() * static_cast<std::size_t>(k), 0);
     for (int i : s.mode)
       if (i >= 0 && i < k) active[(t.size() - 1) * static_cast<std::size_t>(k) + i] = 1;
@@ -54,7 +58,8 @@ struct Run {
   ModelHandle model;
   sim::Trajectory traj;
   py::array_t<double> t, x, u, y;
-  py::array modes;  // bool, n x k
+  py::array_t<double> u_t;  // tangential multipliers, n x frictional contacts
+  py::array modes;          // bool, n x k
 
   // The run as the library gives it, samples included (for the writers).
   sim::Sample sample(py::ssize_t i) const {
@@ -67,6 +72,7 @@ struct Run {
     // A row of NaN in u or y: the sample recorded none (blank cells).
     auto recorded = [](VectorXd v) { return v.array().isNaN().all() ? VectorXd() : v; };
     s.x = row(x), s.u = recorded(row(u)), s.y = recorded(row(y));
+    if (u_t.shape(1) > 0) s.u_t = recorded(row(u_t));
     const py::ssize_t k = modes.shape(1);
     const auto* on = static_cast<const std::uint8_t*>(modes.data()) + i * k;
     for (py::ssize_t j = 0; j < k; ++j)
@@ -144,6 +150,7 @@ std::shared_ptr<Run> simulate(const ModelHandle& model, const std::optional<Vect
   run->x = numpy_owning(std::move(buf.x), {n, buf.nx});
   run->u = numpy_owning(std::move(buf.u), {n, buf.k});
   run->y = numpy_owning(std::move(buf.y), {n, buf.k});
+  run->u_t = numpy_owning(std::move(buf.u_t), {n, buf.nf});
   run->modes =
       numpy_owning(std::move(buf.active), {n, buf.k}).attr("view")("bool").cast<py::array>();
   return run;
@@ -175,6 +182,9 @@ Samples as numpy arrays (t, x, u, y; q and v are views of x for mechanical model
 at a jump two samples share t), events, status and diagnostics. A numerical failure
 is a status ('numerical failure', 'event limit', ...) with a message, not an exception.)");
   r.def_readonly("t", &Run::t, "Sample times (s), shape (n,).");
+  r.def_readonly("u_t", &Run::u_t,
+                 "Tangential multipliers of the frictional contacts (model order), shape "
+                 "(n, contacts); NaN where a sample records none.");
   r.def_readonly("x", &Run::x, "States, shape (n, state size): q then v for mechanical models.");
   r.def_readonly("u", &Run::u,
                  "Multipliers (regular part), shape (n, constraints); NaN where not recorded.");
