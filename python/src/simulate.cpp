@@ -90,9 +90,9 @@ struct Run {
     nlohmann::json j = io::trajectory_json(model->model, traj);
     std::optional<io::LinearisationCheck> lin;
     if (model->scene) {
-      std::vector<VectorXd> states;
-      for (py::ssize_t i = 0; i < t.shape(0); ++i) states.push_back(sample(i).x);
-      lin = io::check_linearisation(*model->scene, states);
+      io::LinearisationStates visited;  // as `lcsim simulate` thins them
+      for (py::ssize_t i = 0; i < t.shape(0); ++i) visited.add(sample(i).x);
+      lin = io::check_linearisation(*model->scene, visited.states());
     }
     j["linearisation_error"] = lin ? nlohmann::json(lin->error) : nlohmann::json(nullptr);
     j["linearisation_check"] = lin ? io::to_json(*lin) : nlohmann::json(nullptr);

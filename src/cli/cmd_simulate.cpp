@@ -55,32 +55,6 @@ std::string fmt_set(const std::vector<int>& s) {
   return r + "}";
 }
 
-// States of a run, thinned as they stream by so that at most
-// 2 * kLinearisationStates are kept, evenly spaced, plus the last: what
-// io::check_linearisation evaluates (it subsamples to kLinearisationStates).
-class StateThinner {
- public:
-  void add(const Eigen::VectorXd& x) {
-    if (seen_++ % stride_ == 0) kept_.push_back(x);
-    last_ = x;
-    if (kept_.size() < 2 * io::kLinearisationStates) return;
-    std::vector<Eigen::VectorXd> half;
-    for (std::size_t i = 0; i < kept_.size(); i += 2) half.push_back(std::move(kept_[i]));
-    kept_ = std::move(half);
-    stride_ *= 2;
-  }
-  std::vector<Eigen::VectorXd> states() const {
-    std::vector<Eigen::VectorXd> s = kept_;
-    if (seen_ > 0 && (seen_ - 1) % stride_ != 0) s.push_back(last_);
-    return s;
-  }
-
- private:
-  std::vector<Eigen::VectorXd> kept_;
-  Eigen::VectorXd last_;
-  long seen_ = 0, stride_ = 1;
-};
-
 sim::Options run_options(const SimulateArgs& a, const mech::Model& model) {
   sim::Options opt;
   opt.t_end = resolve_horizon(model, a.model, a.t_end_given, a.t_end);
@@ -149,7 +123,7 @@ void run_simulate(const SimulateArgs& a) {
   // An unwritable --out fails now, not after the run.
   std::optional<io::TrajectoryCsvWriter> csv;
   if (!a.out.empty()) csv.emplace(a.out, model);
-  StateThinner visited;
+  io::LinearisationStates visited;
   if (opt.record_samples)
     opt.sample_sink = [&csv, &visited, &scene](const sim::Sample& s) {
       if (csv) csv->write(s);

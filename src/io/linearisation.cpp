@@ -175,4 +175,20 @@ nlohmann::json to_json(const std::vector<LinearRange>& ranges) {
   return a;
 }
 
+void LinearisationStates::add(const VectorXd& x) {
+  if (seen_++ % stride_ == 0) kept_.push_back(x);
+  last_ = x;
+  if (kept_.size() < 2 * kLinearisationStates) return;
+  std::vector<VectorXd> half;
+  for (std::size_t i = 0; i < kept_.size(); i += 2) half.push_back(std::move(kept_[i]));
+  kept_ = std::move(half);
+  stride_ *= 2;
+}
+
+std::vector<VectorXd> LinearisationStates::states() const {
+  std::vector<VectorXd> s = kept_;
+  if (seen_ > 0 && (seen_ - 1) % stride_ != 0) s.push_back(last_);
+  return s;
+}
+
 }  // namespace lcsim::io

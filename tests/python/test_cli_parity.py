@@ -61,3 +61,16 @@ def test_cli_and_python_agree(name, robots, lcsim_binary, tmp_path):
     if method:
         assert run.ok and "ut_" in run.to_csv().splitlines()[0], run.message
     assert len(summary["events"]) == len(run.events)
+
+
+def test_long_scene_run_reports_the_same_linearisation_check(robots, lcsim_binary, tmp_path):
+    """Past 2 x 200 samples both thin the visited states the same way
+    (io::LinearisationStates) before the scene's linearisation check: 1001 samples."""
+    path = robots / "two_carts_scene.yaml"
+    cli = subprocess.run([str(lcsim_binary), "simulate", str(path), "--t-end", "1",
+                          "--dt-out", "0.001", "--out", str(tmp_path / "cli.csv"), "--json",
+                          "--no-progress"], capture_output=True, text=True)
+    assert cli.returncode == 0, cli.stderr
+    run = lcsim.simulate(lcsim.load(path), t_end=1.0, dt_out=0.001)
+    assert len(run.t) > 1000
+    assert without_wall_time(run.to_json()) == without_wall_time(cli.stdout)

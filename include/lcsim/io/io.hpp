@@ -256,6 +256,22 @@ constexpr double kLinearisationThreshold = 0.01;   // default warning threshold 
 // kept. std::invalid_argument for a wrong size.
 LinearisationCheck check_linearisation(const Scene& scene, const std::vector<VectorXd>& states);
 
+// The states of a run as they stream by (sim::Options::sample_sink), thinned
+// so that at most 2 * kLinearisationStates are kept, evenly spaced, plus the
+// last: what check_linearisation evaluates, in bounded memory however long
+// the run. The command line and the Python module check a scene's run with
+// it, so both report the same check.
+class LinearisationStates {
+ public:
+  void add(const VectorXd& x);
+  std::vector<VectorXd> states() const;
+
+ private:
+  std::vector<VectorXd> kept_;
+  VectorXd last_;
+  long seen_ = 0, stride_ = 1;
+};
+
 // "" when check.error <= threshold, else the warning line. InputError
 // ("--linearisation-threshold: ...") unless threshold is finite and > 0.
 std::string linearisation_warning(const LinearisationCheck& check, double threshold);
