@@ -212,13 +212,13 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     for (size_t a = 0; a < A.size(); ++a) z(static_cast<Eigen::Index>(a)) = lambda_prev(A[a]);
     for (int i : A_prev) lambda_prev(i) = 0.0;  // set again below for this step's A
     A_prev = A;
+    // The columns W^{-1} E_a' of the active set, for either LCP below.
+    const int na = static_cast<int>(A.size());
+    cols.resize(na);
+    for (int a = 0; a < na; ++a)
+      if (!f.column(A[a], cols[a]))
+        return fail("moreau-jean: iteration matrix too ill-conditioned at h = " + short_number(h));
     if (friction && friction->any_in(A)) {
-      const int na = static_cast<int>(A.size());
-      cols.resize(na);
-      for (int a = 0; a < na; ++a)
-        if (!f.column(A[a], cols[a]))
-          return fail("moreau-jean: iteration matrix too ill-conditioned at h = " +
-                      short_number(h));
       if (!friction->step(f, A, cols, Ev, e, *solver, v_next, z, lambda_T, tr.lcp_solves, failed))
         return fail(lcp_failure("moreau-jean", (j - 1) * grid.h, failed));
       for (size_t fi = 0; fi < m.friction.size(); ++fi)
@@ -230,12 +230,6 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
         u_set.push_back(A[a]);
       }
     } else if (!A.empty()) {
-      const int na = static_cast<int>(A.size());
-      cols.resize(na);
-      for (int a = 0; a < na; ++a)
-        if (!f.column(A[a], cols[a]))
-          return fail("moreau-jean: iteration matrix too ill-conditioned at h = " +
-                      short_number(h));
       ops.E_times(v_next, Evf);  // v_next is still v_free here
       b.resize(na);
       for (int a = 0; a < na; ++a) b(a) = Evf(A[a]) + e(A[a]) * Ev(A[a]);

@@ -6,17 +6,12 @@
 #include <lcsim/io/io.hpp>
 #include <string>
 
+#include "support/model_error.hpp"
+
 namespace lcsim::io {
 namespace {
 
-std::string error_of(const std::string& yaml) {
-  try {
-    parse_model(yaml, "bad.yaml");
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(accepted)";
-}
+std::string error_of(const std::string& yaml) { return test_support::model_error(yaml); }
 
 // Two coordinates, two constraints named floor and wall.
 std::string model(const std::string& friction) {

@@ -9,6 +9,7 @@
 #include <string>
 #include <unsupported/Eigen/MatrixFunctions>
 
+#include "support/model_error.hpp"
 #include "support/same_model.hpp"
 
 namespace lcsim::io {
@@ -19,15 +20,7 @@ using Eigen::VectorXd;
 
 const std::string kRobots = std::string(LCSIM_SOURCE_DIR) + "/robots/";
 
-// The message of the InputError parse_model throws, or "(accepted)".
-std::string error_of(const std::string& yaml) {
-  try {
-    parse_model(yaml, "bad.yaml");
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(accepted)";
-}
+std::string error_of(const std::string& yaml) { return test_support::model_error(yaml); }
 
 bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
