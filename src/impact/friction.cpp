@@ -101,6 +101,7 @@ struct ClosedFriction {
   std::vector<int> index;      // into model.friction
   MatrixXd T;                  // tangent rows (n_F x N)
   VectorXd mu;
+  VectorXd velocity;  // the surfaces' velocities (sliding = T v - velocity)
 };
 
 ClosedFriction closed_friction(const mech::MechanicalModel& m, const IndexSet& closed) {
@@ -114,10 +115,12 @@ ClosedFriction closed_friction(const mech::MechanicalModel& m, const IndexSet& c
   const Eigen::Index nf = static_cast<Eigen::Index>(c.index.size());
   c.T.resize(nf, m.dofs());
   c.mu.resize(nf);
+  c.velocity.resize(nf);
   for (Eigen::Index f = 0; f < nf; ++f) {
     const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(c.index[f])];
     c.T.row(f) = fc.tangent.transpose();
     c.mu(f) = fc.mu;
+    c.velocity(f) = fc.velocity;
   }
   return c;
 }
@@ -185,9 +188,10 @@ void set_outcomes(const mech::MechanicalModel& m, const ImpactInput& in, const C
       out.outcome[static_cast<size_t>(row)] = ContactOutcome::kNoImpulse;
       continue;
     }
-    const double ut = c.T.row(fi).dot(out.v_after);
+    const double ut = c.T.row(fi).dot(out.v_after) - c.velocity(fi);
     // Zero to rounding: the terms of t'v+ and t'v-, as the rates in finish.
-    const double scale = c.T.row(fi).cwiseAbs().dot(in.v.cwiseAbs() + out.v_after.cwiseAbs());
+    const double scale = c.T.row(fi).cwiseAbs().dot(in.v.cwiseAbs() + out.v_after.cwiseAbs()) +
+                         std::abs(c.velocity(fi));
     out.outcome[static_cast<size_t>(row)] =
         std::abs(ut) <= 1e-9 * scale + kAbsTol
             ? ContactOutcome::kStick
@@ -224,7 +228,7 @@ ImpactResult moreau_friction(const ImpactInput& in, const lcp::Solver& solver) {
   // Newton's restitution on approaching contacts: u_N+ >= -e u_N- there; a
   // closed contact already separating (u_N- >= 0) only needs u_N+ >= 0.
   const VectorXd rate_N = s->a + s->e_J.cwiseProduct(s->a.cwiseMin(0.0));
-  const FrictionLcp lcp = friction_lcp(Wg, rate_N, c.T * in.v, c.normal_of, c.mu);
+  const FrictionLcp lcp = friction_lcp(Wg, rate_N, c.T * in.v - c.velocity, c.normal_of, c.mu);
   std::string tried;
   const lcp::Result res = solve_friction_lcp(lcp, solver, &out.lcp_solves, &tried);
   out.lcp_status = res.status;
@@ -247,10 +251,13 @@ ImpactResult moreau_friction(const ImpactInput& in, const lcp::Solver& solver) {
   detail::finish(in, *s, lambda_N, v_after, tiny, out);
   set_outcomes(m, in, c, lambda_N, lambda_T, tiny, out);
   out.status = Status::kOk;
-  // T+ - T- = lambda' u+ - ½ dv' M dv (dv = v+ - v-); lambda_T u_T+ <= 0 and
-  // lambda_N u_N+ = 0 for e = 0, so only restitution can make it positive.
+  // T+ - T- = lambda' u+ - ½ dv' M dv (dv = v+ - v-), with u_T+ = T v+ the
+  // tangential rates; lambda_T (u_T+ - velocity) <= 0 and lambda_N u_N+ = 0
+  // for e = 0, so beyond the work of moving surfaces on the body
+  // (lambda_T' velocity, a belt) only restitution can make it positive.
   // Beyond rounding: 1e-12 relative (a few hundred eps of the kinetic energy).
-  if (out.energy_after > out.energy_before * (1.0 + 1e-12) + 1e-300) {
+  const double surface_work = c.velocity.dot(lambda_T);
+  if (out.energy_after - surface_work > out.energy_before * (1.0 + 1e-12) + 1e-300) {
     out.energy_gain = true;
     std::ostringstream msg;
     msg.precision(6);

@@ -84,7 +84,9 @@ std::string model_yaml(const mech::Model& model, const std::string& header) {
     out << "  friction:\n";
     for (const mech::FrictionalContact& c : m.friction)
       out << "    - {contact: " << c.contact << ", tangent: " << list(c.tangent)
-          << ", mu: " << format_number(c.mu) << "}\n";
+          << ", mu: " << format_number(c.mu)
+          << (c.velocity != 0.0 ? ", velocity: " + format_number(c.velocity) : std::string())
+          << "}\n";
   }
   out << "  coordinates: " << names(m.coordinates) << "\n";
   if (model.initial.size() > 0) out << "initial: " << list(model.initial) << "\n";

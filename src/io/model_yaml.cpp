@@ -183,9 +183,9 @@ std::vector<std::string> names(const YAML::Node& n, Eigen::Index size, const std
 }
 
 // `friction: [{contact: <0-based row of E or its name>, tangent: [N numbers],
-// mu: <number>}]` (docs/model-format.md). Names resolve against the model's
-// constraint names, so this runs after fill_defaults; the sizes, ranges and
-// duplicates are mech::check_mechanical's.
+// mu: <number>, velocity: <number, optional>}]` (docs/model-format.md). Names resolve against the
+// model's constraint names, so this runs after fill_defaults; the sizes, ranges and duplicates are
+// mech::check_mechanical's.
 std::vector<mech::FrictionalContact> parse_friction(const YAML::Node& n,
                                                     const mech::MechanicalModel& m,
                                                     const std::string& source) {
@@ -195,7 +195,7 @@ std::vector<mech::FrictionalContact> parse_friction(const YAML::Node& n,
   std::vector<mech::FrictionalContact> out;
   for (std::size_t i = 0; i < n.size(); ++i) {
     const std::string ikey = key + "[" + std::to_string(i) + "]";
-    const Keys keys = mapping(n[i], source, ikey, {"contact", "tangent", "mu"});
+    const Keys keys = mapping(n[i], source, ikey, {"contact", "tangent", "mu", "velocity"});
     for (const char* k : {"contact", "tangent", "mu"})
       if (!keys.count(k)) fail(source, ikey + "." + k, "missing");
     mech::FrictionalContact c;
@@ -217,6 +217,8 @@ std::vector<mech::FrictionalContact> parse_friction(const YAML::Node& n,
     }
     c.tangent = vector(keys.at("tangent"), source, ikey + ".tangent");
     c.mu = number(keys.at("mu"), source, ikey + ".mu");
+    if (keys.count("velocity"))
+      c.velocity = number(keys.at("velocity"), source, ikey + ".velocity");
     out.push_back(std::move(c));
   }
   return out;

@@ -82,6 +82,8 @@ std::optional<ModelProblem> check_friction(const MechanicalModel& m) {
       return ModelProblem{at + ".tangent", "all zero (it measures no sliding)"};
     if (!std::isfinite(c.mu)) return ModelProblem{at + ".mu", "not finite (got " + num(c.mu) + ")"};
     if (c.mu < 0.0) return ModelProblem{at + ".mu", "must be >= 0 (got " + num(c.mu) + ")"};
+    if (!std::isfinite(c.velocity))
+      return ModelProblem{at + ".velocity", "not finite (got " + num(c.velocity) + ")"};
   }
   return std::nullopt;
 }

@@ -41,7 +41,7 @@ bool MjFriction::step(MjIteration& f, const IndexSet& A, const std::vector<const
   const Eigen::Index nf = static_cast<Eigen::Index>(fric.size()), ng = na + nf;
   // G = [E_A; T_F] and W^{-1} G' dense (N x ng).
   MatrixXd G(ng, N), WGt(N, ng);
-  VectorXd mu(nf);
+  VectorXd mu(nf), belt(nf);
   for (Eigen::Index a = 0; a < na; ++a) {
     G.row(a) = Er_.row(A[a]);
     WGt.col(a) = *cols[a];
@@ -51,12 +51,14 @@ bool MjFriction::step(MjIteration& f, const IndexSet& A, const std::vector<const
     G.row(na + j) = c.tangent.transpose();
     WGt.col(na + j) = tc[static_cast<size_t>(fric[j])];
     mu(j) = c.mu;
+    belt(j) = c.velocity;
   }
   const MatrixXd Wg = G * WGt;
   const VectorXd rates = G * v_next;  // v_next = v_free here
   VectorXd rate_N = rates.head(na);
   for (Eigen::Index a = 0; a < na; ++a) rate_N(a) += e(A[a]) * Ev(A[a]);
-  const impact::FrictionLcp p = impact::friction_lcp(Wg, rate_N, rates.tail(nf), normal_of, mu);
+  const impact::FrictionLcp p =
+      impact::friction_lcp(Wg, rate_N, rates.tail(nf) - belt, normal_of, mu);
   int attempts = 0;
   lcp::Result r = impact::solve_friction_lcp(p, solver, &attempts, nullptr);
   solves += attempts;

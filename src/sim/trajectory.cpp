@@ -19,6 +19,24 @@ std::string_view to_string(EventType t) {
       return "accumulation";
     case EventType::kStart:
       return "start";
+    case EventType::kStick:
+      return "stick";
+    case EventType::kSlip:
+      return "slip";
+  }
+  return "unknown";
+}
+
+std::string_view to_string(FrictionMode m) {
+  switch (m) {
+    case FrictionMode::kOpen:
+      return "open";
+    case FrictionMode::kStick:
+      return "stick";
+    case FrictionMode::kSlipPositive:
+      return "slip+";
+    case FrictionMode::kSlipNegative:
+      return "slip-";
   }
   return "unknown";
 }

@@ -34,6 +34,11 @@ struct FrictionalContact {
   int contact = 0;   // 0-based row of E
   VectorXd tangent;  // length N
   double mu = 0.0;   // >= 0
+  // Velocity of the surface along the tangent (m/s; a belt), finite: the
+  // contact slides at tangent'v - velocity. 0 for a fixed surface.
+  double velocity = 0.0;
+  // The sliding velocity at generalised velocity v.
+  double sliding(const VectorXd& v) const { return tangent.dot(v) - velocity; }
 };
 
 struct MechanicalModel {

@@ -21,8 +21,18 @@ namespace lcsim::sim {
 using Eigen::VectorXd;
 using IndexSet = std::vector<int>;
 
-enum class EventType { kImpact, kRelease, kContact, kAccumulation, kStart };
+// kStick: a frictional contact's sliding velocity reached zero and it
+// sticks; kSlip: a frictional contact starts to slide (its stick force
+// reached the edge of the friction cone, or it reverses).
+enum class EventType { kImpact, kRelease, kContact, kAccumulation, kStart, kStick, kSlip };
 std::string_view to_string(EventType t);
+
+// What a closed frictional contact does in a sample (Sample::friction_mode):
+// kOpen when its normal constraint is not closed; kStick, tangential
+// velocity zero (relative to its surface) and |u_T| <= mu u_N; kSlipPositive
+// / kSlipNegative, sliding along +t / -t with u_T = -/+ mu u_N.
+enum class FrictionMode : signed char { kOpen, kStick, kSlipPositive, kSlipNegative };
+std::string_view to_string(FrictionMode m);  // "open", "stick", "slip+", "slip-"
 
 struct Sample {
   double t = 0.0;
@@ -33,6 +43,9 @@ struct Sample {
   // Tangential multipliers (mean friction force over the step, N), one per
   // entry of mechanical.friction in its order; empty for frictionless models.
   VectorXd u_t;
+  // The mode of each entry of mechanical.friction, in its order; empty for
+  // frictionless models and for methods that do not determine it.
+  std::vector<FrictionMode> friction_mode;
 };
 
 struct Event {
