@@ -217,7 +217,8 @@ struct FrictionBlockOf {
 // (so the physical coefficient is mu |s| / c), M = m I, D = K = 0 and
 // f = (0, -m g) in (t, n) order with g > 0; the state x0 (the model's
 // initial when empty) must start on the floor (gap 0, normal velocity 0).
-// Restitution is irrelevant (the block never leaves the floor). A model of
+// Restitution is irrelevant (the block never leaves the floor). t_end is
+// the model's, or FrictionBlock's default 1 s when it has none. A model of
 // any other shape gets kInvalidInput and a message naming the first field
 // that differs (0-based indices) and why.
 FrictionBlockOf friction_block_of(const mech::Model& model, const Eigen::VectorXd& x0 = {});
