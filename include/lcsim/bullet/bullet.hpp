@@ -173,3 +173,120 @@ Eigen::MatrixXd multibody_mass_matrix(const urdf::ModelInterface& model,
                                       const std::map<std::string, double>& q0);
 
 }  // namespace lcsim::bullet
+
+// ---- A block sliding on a rough floor in Bullet (friction_box.cpp) ----
+//
+// Issue 17's "Bullet side by side": a btBoxShape on a btStaticPlaneShape with
+// Coulomb friction, stepped by btDiscreteDynamicsWorld and
+// btSequentialImpulseConstraintSolver at a fixed step, against the closed form
+// of a block on a floor (robots/block_on_floor_friction.yaml): from v0 it
+// decelerates at mu g and sticks at t* = |v0| / (mu g) after sliding
+// d = v0^2 / (2 mu g). docs/friction-bullet.md has the measured table.
+
+#include <lcsim/core/status.hpp>
+#include <limits>
+
+namespace lcsim::bullet {
+
+// The block's parameters (SI units).
+struct FrictionBlock {
+  double mass = 1.0;           // kg, > 0
+  double mu = 0.4;             // Coulomb coefficient, in [0, 10] (Bullet clamps at 10)
+  double gravity = 9.81;       // m/s^2, > 0, pressing the block onto the floor
+  double x0 = 0.0;             // m, position along the floor
+  double v0 = 2.0;             // m/s, velocity along the floor
+  double t_end = 1.0;          // s, horizon of a run
+  int tangent_coordinate = 0;  // which model coordinate runs along the floor
+  int normal_coordinate = 1;   // which one is normal to it
+  // The closed form: |v0| / (mu g) and v0^2 / (2 mu g) (infinite for mu = 0).
+  double stop_time() const;
+  double slide_distance() const;
+};
+// "" when usable, else one line naming the first bad field and its value.
+std::string friction_block_error(const FrictionBlock& b);
+
+// A model read as a block on a floor, or why it is not one.
+struct FrictionBlockOf {
+  Status status = Status::kOk;  // kInvalidInput with `message` when not a block on a floor
+  std::string message;
+  FrictionBlock block;
+};
+// Reads the block from a mechanical model with two coordinates (q_t along
+// the floor, q_n normal to it), one row of E, c e_n with c > 0 (the floor
+// c q_n + g >= 0), one frictional contact on it with tangent s e_t, s != 0
+// (so the physical coefficient is mu |s| / c), M = m I, D = K = 0 and
+// f = (0, -m g) in (t, n) order with g > 0; the state x0 (the model's
+// initial when empty) must start on the floor (gap 0, normal velocity 0).
+// Restitution is irrelevant (the block never leaves the floor). t_end is
+// the model's, or FrictionBlock's default 1 s when it has none. A model of
+// any other shape gets kInvalidInput and a message naming the first field
+// that differs (0-based indices) and why.
+FrictionBlockOf friction_block_of(const mech::Model& model, const Eigen::VectorXd& x0 = {});
+
+// Every Bullet setting of the scene that is not pinned in friction_box.cpp.
+struct FrictionBoxSettings {
+  double h = 1e-3;  // fixed step (s), > 0, at most 1e8 steps over t_end
+  // btSequentialImpulseConstraintSolver sweeps per step (Bullet's default
+  // 10): 4 contact points x (normal + 2 friction rows) converge well within 100.
+  int solver_iterations = 100;
+  // Box half extents (m); the block's footprint does not enter the closed form.
+  double half_width = 0.1;    // along the floor (x) and across it (z)
+  double half_height = 0.05;  // normal to the floor (y)
+  // |v| at or below this (m/s) counts as stuck (slide_stop).
+  double stop_velocity = 1e-9;
+  // btDefaultCollisionConfiguration::setPlaneConvexMultipointIterations(n, n):
+  // every step, besides the deepest corner, the box-plane algorithm collides
+  // n copies of the box tilted towards directions 360/n degrees apart (while
+  // the manifold holds fewer than n points: always, for n > 4). 8 finds the
+  // 4 corners of the bottom face at every step (measured in
+  // docs/friction-bullet.md; 3 or 4 leave the box on 1 to 4 points). 0: not
+  // called (Bullet's default, one point per step).
+  int multipoint_iterations = 8;
+  // The box rotates freely (a btBoxShape rigid body); false: angular factor
+  // 0, the box only translates, as the model's two coordinates do.
+  bool free_rotation = true;
+};
+// "" when usable, else one line naming the first bad setting and its value.
+std::string friction_box_settings_error(const FrictionBoxSettings& s, double t_end);
+
+// The state after each step (and at t = 0): forces are the step's impulses
+// divided by its length, as Bullet's solver applied them to the box.
+struct FrictionBoxSample {
+  double t = 0.0;
+  double x = 0.0;               // box centre along the floor (m), = q_t of the model
+  double v = 0.0;               // its velocity along the floor (m/s)
+  double gap = 0.0;             // lowest corner's height above the floor (m)
+  double normal_force = 0.0;    // sum of the contact points' normal impulses / h (N)
+  double friction_force = 0.0;  // sum of their friction impulses along x / h (N)
+  int contact_points = 0;       // points in the box-plane manifold
+  double tilt = 0.0;            // rotation angle of the box (rad)
+};
+
+// Where a sliding run sticks: the first sample from which |v| <= v_tol to the
+// end of the run, its time and the distance |x - x(0)| slid until then; NaN
+// time and distance when it still slides at the end.
+struct SlideStop {
+  double time = std::numeric_limits<double>::quiet_NaN();
+  double distance = std::numeric_limits<double>::quiet_NaN();
+};
+// t, x, v: one entry per sample, equal sizes >= 1, t increasing; throws
+// std::invalid_argument naming the size or v_tol (finite >= 0) otherwise.
+SlideStop slide_stop(const std::vector<double>& t, const std::vector<double>& x,
+                     const std::vector<double>& v, double v_tol);
+
+struct FrictionBoxRun {
+  Status status = Status::kOk;  // kInvalidInput (nothing ran) or kNumericalFailure, with message
+  std::string message;
+  FrictionBlock block;
+  std::vector<FrictionBoxSample> samples;
+  SlideStop stop;  // of the samples, with settings.stop_velocity
+};
+// The block run in Bullet for block.t_end (the last step shortened to land
+// on it). Bad block or settings: kInvalidInput, nothing run; a non-finite
+// state: kNumericalFailure.
+FrictionBoxRun simulate_friction_box(const FrictionBlock& block, const FrictionBoxSettings& s = {});
+// The same from a model (friction_block_of; its message when not a block on
+// a floor).
+FrictionBoxRun simulate_friction_box(const mech::Model& model, const FrictionBoxSettings& s = {});
+
+}  // namespace lcsim::bullet
