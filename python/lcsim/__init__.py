@@ -36,8 +36,11 @@ from ._lcsim import (
     solver_names,
 )
 
+# Trajectory.friction_modes holds indices into this tuple (-1: not determined).
+FRICTION_MODES = ("open", "stick", "slip+", "slip-")
+
 __all__ = [
-    "Event", "ImpactResult", "InputError", "LcpResult", "Model", "Trajectory", "analyze",
+    "FRICTION_MODES", "Event", "ImpactResult", "InputError", "LcpResult", "Model", "Trajectory", "analyze",
     "impact_law_names", "impact_map", "impacts", "integrator_names", "load", "simulate",
     "solve_lcp", "solver_names", "study", "StudyTable", "sweep",
 ]

@@ -10,6 +10,8 @@ ArrayLike = npt.ArrayLike
 MatrixLike = Union[npt.ArrayLike, scipy.sparse.spmatrix]
 Path = Union[str, PathLike[str]]
 
+FRICTION_MODES: tuple[str, str, str, str]  # ("open", "stick", "slip+", "slip-")
+
 class InputError(ValueError):
     """Invalid input: the library's message names the file or field, the element and the value."""
 
@@ -21,7 +23,8 @@ class Model:
                    g: Optional[ArrayLike] = None, restitution: Optional[ArrayLike] = None,
                    names: Sequence[str] = ..., constraint_names: Sequence[str] = ...,
                    name: str = "model", initial: Optional[ArrayLike] = None,
-                   t_end: Optional[float] = None) -> Model: ...
+                   t_end: Optional[float] = None,
+                   friction: Optional[Sequence[dict[str, Any]]] = None) -> Model: ...
     @staticmethod
     def lcs(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, name: str = "lcs",
             initial: Optional[ArrayLike] = None, t_end: Optional[float] = None) -> Model: ...
@@ -71,6 +74,8 @@ class Event:
     impulse: np.ndarray
     mode: list[int]
     note: str
+    friction_impulse: np.ndarray  # per frictional contact (empty without friction)
+    friction_modes: list[str]  # 'open', 'stick', 'slip+' or 'slip-' after the event
 
 class Trajectory:
     """The result of simulate: samples as numpy arrays, events, status, diagnostics."""
@@ -78,6 +83,7 @@ class Trajectory:
     x: np.ndarray
     u: np.ndarray
     u_t: np.ndarray  # tangential multipliers, (n, frictional contacts)
+    friction_modes: np.ndarray  # int8 (n, frictional contacts): FRICTION_MODES index, -1 none
     y: np.ndarray
     modes: np.ndarray
     @property

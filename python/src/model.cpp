@@ -1,4 +1,5 @@
 // lcsim.Model: a loaded model file or scene, or a model built from matrices.
+#include <algorithm>
 #include <cmath>
 #include <lcsim/mech/mech.hpp>
 #include <limits>
@@ -30,11 +31,46 @@ ModelHandle checked(mech::Model model, const OptVector& initial, std::optional<d
   return std::make_shared<io::LoadedModel>(io::LoadedModel{std::move(model), std::nullopt});
 }
 
+// One entry of Model.mechanical's `friction`: {contact: index or name,
+// tangent, mu, velocity (optional)}; sizes, ranges and mu are checked by
+// mech::check_model with the other fields.
+mech::FrictionalContact frictional_contact(const py::handle& entry, std::size_t i,
+                                           const mech::MechanicalModel& mm) {
+  const std::string at = "friction[" + std::to_string(i) + "]";
+  if (!py::isinstance<py::dict>(entry))
+    throw io::InputError(at + ": expected a dict {contact, tangent, mu[, velocity]}");
+  const auto d = py::reinterpret_borrow<py::dict>(entry);
+  for (const char* key : {"contact", "tangent", "mu"})
+    if (!d.contains(key)) throw io::InputError(at + "." + key + ": missing");
+  for (const auto& item : d) {
+    const std::string key = py::str(item.first);
+    if (key != "contact" && key != "tangent" && key != "mu" && key != "velocity")
+      throw io::InputError(at + "." + key +
+                           ": unknown key (expected contact, tangent, mu, velocity)");
+  }
+  mech::FrictionalContact c;
+  const py::object contact = d["contact"];
+  if (py::isinstance<py::str>(contact)) {
+    const std::string name = contact.cast<std::string>();
+    const auto it = std::find(mm.constraints.begin(), mm.constraints.end(), name);
+    if (it == mm.constraints.end())
+      throw io::InputError(at + ".contact: no constraint named '" + name + "'");
+    c.contact = static_cast<int>(it - mm.constraints.begin());
+  } else {
+    c.contact = contact.cast<int>();
+  }
+  c.tangent = d["tangent"].cast<VectorXd>();
+  c.mu = d["mu"].cast<double>();
+  if (d.contains("velocity")) c.velocity = d["velocity"].cast<double>();
+  return c;
+}
+
 ModelHandle make_mechanical(const py::object& M, const py::object& K, const py::object& E,
                             const py::object& D, const OptVector& f, const OptVector& g,
                             const OptVector& restitution, std::vector<std::string> names,
                             std::vector<std::string> constraint_names, const std::string& name,
-                            const OptVector& initial, std::optional<double> t_end) {
+                            const OptVector& initial, std::optional<double> t_end,
+                            const py::object& friction) {
   mech::MechanicalModel mm;
   mm.M = to_sparse(M);
   if (!K.is_none()) mm.K = to_sparse(K);
@@ -46,6 +82,11 @@ ModelHandle make_mechanical(const py::object& M, const py::object& K, const py::
   mm.coordinates = std::move(names);
   mm.constraints = std::move(constraint_names);
   mech::fill_defaults(mm);
+  if (!friction.is_none()) {
+    std::size_t i = 0;
+    for (const py::handle& entry : friction)
+      mm.friction.push_back(frictional_contact(entry, i++, mm));
+  }
   mech::Model model = mech::model_of(std::move(mm), name);
   return checked(std::move(model), initial, t_end);
 }
@@ -82,9 +123,13 @@ or a general LCS x' = A x + B u, y = C x + D u, 0 <= y _|_ u >= 0. Built by lcsi
                py::arg("names") = std::vector<std::string>{},
                py::arg("constraint_names") = std::vector<std::string>{}, py::arg("name") = "model",
                py::arg("initial") = py::none(), py::arg("t_end") = py::none(),
+               py::arg("friction") = py::none(),
                R"(A mechanical model from matrices (numpy arrays or scipy.sparse matrices).
 Omitted D, K, f, g and restitution are zero; names default to q1.., constraint names to c1...
 `initial` is a default state (q then v), `t_end` a default horizon (s).
+`friction` lists frictional contacts as dicts {contact: 0-based row of E or its name,
+tangent: N numbers, mu: >= 0, velocity: the surface's velocity along the tangent
+(optional, 0)}, as the YAML `friction:` list (docs/model-format.md).
 Raises InputError (the library's message) when sizes disagree, M is not symmetric
 positive definite, a restitution lies outside [0, 1], ...)");
   c.def_static("lcs", &make_lcs, py::arg("A"), py::arg("B"), py::arg("C"), py::arg("D"),

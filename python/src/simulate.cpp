@@ -15,12 +15,17 @@ namespace {
 
 using Eigen::VectorXd;
 
+constexpr std::int8_t kNoFrictionMode = -1;
+
 // Samples as they stream from the run (sim::Options::sample_sink), row
 // after row, sized by the model (as the CSV is): a sample without u or y
 // (an event-only record; blank cells in the CSV) gives a row of NaN.
 struct SampleBuffers {
   std::vector<double> t, x, u, y, u_t;  // u_t: n x frictional contacts
   std::vector<std::uint8_t> active;     // n x k: 1 where the constraint is in the mode
+  // n x frictional contacts: sim::FrictionMode's value, kNoFrictionMode where
+  // the sample records none.
+  std::vector<std::int8_t> friction_mode;
   py::ssize_t nx = 0, k = 0, nf = 0;
   explicit SampleBuffers(const mech::Model& m)
       : nx(m.state_size()),
@@ -45,7 +50,13 @@ struct SampleBuffers {
     append(x, s.x, nx);
     append(u, s.u, k);
     append(y, s.y, k);
-    if (nf > 0) append(u_t, s.u_t, nf);
+    if (nf > 0) {
+      append(u_t, s.u_t, nf);
+      for (py::ssize_t j = 0; j < nf; ++j)
+        friction_mode.push_back(s.friction_mode.size() == static_cast<std::size_t>(nf)
+                                    ? static_cast<std::int8_t>(s.friction_mode[j])
+                                    : kNoFrictionMode);
+    }
     active.resize(t.size() * static_cast<std::size_t>(k), 0);
     for (int i : s.mode)
       if (i >= 0 && i < k) active[(t.size() - 1) * static_cast<std::size_t>(k) + i] = 1;
@@ -58,8 +69,9 @@ struct Run {
   ModelHandle model;
   sim::Trajectory traj;
   py::array_t<double> t, x, u, y;
-  py::array_t<double> u_t;  // tangential multipliers, n x frictional contacts
-  py::array modes;          // bool, n x k
+  py::array_t<double> u_t;                  // tangential multipliers, n x frictional contacts
+  py::array_t<std::int8_t> friction_modes;  // n x frictional contacts (SampleBuffers)
+  py::array modes;                          // bool, n x k
 
   // The run as the library gives it, samples included (for the writers).
   sim::Sample sample(py::ssize_t i) const {
@@ -73,6 +85,10 @@ struct Run {
     auto recorded = [](VectorXd v) { return v.array().isNaN().all() ? VectorXd() : v; };
     s.x = row(x), s.u = recorded(row(u)), s.y = recorded(row(y));
     if (u_t.shape(1) > 0) s.u_t = recorded(row(u_t));
+    const py::ssize_t nf = friction_modes.shape(1);
+    if (nf > 0 && friction_modes.at(i, 0) != kNoFrictionMode)
+      for (py::ssize_t j = 0; j < nf; ++j)
+        s.friction_mode.push_back(static_cast<sim::FrictionMode>(friction_modes.at(i, j)));
     const py::ssize_t k = modes.shape(1);
     const auto* on = static_cast<const std::uint8_t*>(modes.data()) + i * k;
     for (py::ssize_t j = 0; j < k; ++j)
@@ -151,6 +167,7 @@ std::shared_ptr<Run> simulate(const ModelHandle& model, const std::optional<Vect
   run->u = numpy_owning(std::move(buf.u), {n, buf.k});
   run->y = numpy_owning(std::move(buf.y), {n, buf.k});
   run->u_t = numpy_owning(std::move(buf.u_t), {n, buf.nf});
+  run->friction_modes = numpy_owning(std::move(buf.friction_mode), {n, buf.nf});
   run->modes =
       numpy_owning(std::move(buf.active), {n, buf.k}).attr("view")("bool").cast<py::array>();
   return run;
@@ -161,12 +178,23 @@ void bind_event(py::module_& m) {
   e.def_readonly("t", &sim::Event::t, "Time (s).");
   e.def_property_readonly(
       "type", [](const sim::Event& ev) { return std::string(sim::to_string(ev.type)); },
-      "'impact', 'release', 'contact', 'accumulation' or 'start'.");
+      "'impact', 'release', 'contact', 'accumulation', 'start', 'stick' or 'slip'.");
   e.def_readonly("state_before", &sim::Event::state_before, "State before the event.");
   e.def_readonly("state_after", &sim::Event::state_after, "State after the event.");
   e.def_readonly("impulse", &sim::Event::impulse, "Impulse per constraint (zero if no jump).");
   e.def_readonly("mode", &sim::Event::mode_after, "Active constraints after (0-based).");
   e.def_readonly("note", &sim::Event::note, "How the event was resolved when not plain.");
+  e.def_readonly("friction_impulse", &sim::Event::friction_impulse,
+                 "Tangential impulse per frictional contact (model order; empty without "
+                 "friction).");
+  e.def_property_readonly(
+      "friction_modes",
+      [](const sim::Event& ev) {
+        std::vector<std::string> out;
+        for (sim::FrictionMode fm : ev.friction_mode_after) out.emplace_back(sim::to_string(fm));
+        return out;
+      },
+      "Mode per frictional contact after the event: 'open', 'stick', 'slip+' or 'slip-'.");
   e.def("__repr__", [](const sim::Event& ev) {
     return "<lcsim.Event " + std::string(sim::to_string(ev.type)) +
            " at t = " + std::to_string(ev.t) + ">";
@@ -185,6 +213,10 @@ is a status ('numerical failure', 'event limit', ...) with a message, not an exc
   r.def_readonly("u_t", &Run::u_t,
                  "Tangential multipliers of the frictional contacts (model order), shape "
                  "(n, contacts); NaN where a sample records none.");
+  r.def_readonly("friction_modes", &Run::friction_modes,
+                 "Modes of the frictional contacts (model order), shape (n, contacts), int8: 0 "
+                 "open, 1 stick, 2 slip+, 3 slip- (lcsim.FRICTION_MODES); -1 where the method "
+                 "does not determine them.");
   r.def_readonly("x", &Run::x, "States, shape (n, state size): q then v for mechanical models.");
   r.def_readonly("u", &Run::u,
                  "Multipliers (regular part), shape (n, constraints); NaN where not recorded.");

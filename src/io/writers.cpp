@@ -208,6 +208,7 @@ std::vector<std::string> csv_header(const mech::Model& model) {
     for (const auto& c : m.constraints) header.push_back("y_" + c);
     // Friction only: models without it keep their columns byte for byte.
     for (const auto& f : m.friction) header.push_back("ut_" + m.constraints[f.contact]);
+    for (const auto& f : m.friction) header.push_back("fm_" + m.constraints[f.contact]);
   } else {
     for (int i = 1; i <= n; ++i) header.push_back(prefixed("x", std::to_string(i)));
     for (int i = 1; i <= k; ++i) header.push_back(prefixed("u", std::to_string(i)));
@@ -241,8 +242,21 @@ int friction_count(const mech::Model& model) {
   return model.is_mechanical() ? static_cast<int>(model.mechanical->friction.size()) : 0;
 }
 
-// Row `r` of the CSV: t, x, u, y, the tangential multipliers (nf of them,
-// models with friction only), mode.
+// The friction modes of a sample (nf cells, blank when it records none).
+void append_csv_friction_modes(std::string& out, const sim::Sample& s, int nf, std::size_t r) {
+  const std::size_t size = s.friction_mode.size();
+  if (size != 0 && size != static_cast<std::size_t>(nf))
+    throw std::logic_error("trajectory_csv: sample " + std::to_string(r) + " has " +
+                           std::to_string(size) + " friction modes, expected " +
+                           std::to_string(nf));
+  for (std::size_t j = 0; j < static_cast<std::size_t>(nf); ++j) {
+    out += ',';
+    if (size != 0) out += sim::to_string(s.friction_mode[j]);
+  }
+}
+
+// Row `r` of the CSV: t, x, u, y, the tangential multipliers and friction
+// modes (nf of each, models with friction only), mode.
 void append_csv_row(std::string& out, const sim::Sample& s, int n, int k, int nf, std::size_t r) {
   if (s.x.size() != n)
     throw std::logic_error("trajectory_csv: sample " + std::to_string(r) + " has a state of size " +
@@ -251,7 +265,10 @@ void append_csv_row(std::string& out, const sim::Sample& s, int n, int k, int nf
   append_csv_vector(out, s.x, n, "x", r);
   append_csv_vector(out, s.u, k, "u", r);
   append_csv_vector(out, s.y, k, "y", r);
-  if (nf > 0) append_csv_vector(out, s.u_t, nf, "u_t", r);
+  if (nf > 0) {
+    append_csv_vector(out, s.u_t, nf, "u_t", r);
+    append_csv_friction_modes(out, s, nf, r);
+  }
   out += ',';
   for (std::size_t j = 0; j < s.mode.size(); ++j)
     out += prefixed(j ? ";" : "", std::to_string(s.mode[j]));
@@ -338,6 +355,13 @@ nlohmann::json trajectory_json(const mech::Model& model, const sim::Trajectory& 
                       {"mode_after", index_set_json(e.mode_after)},
                       {"impulse", to_json(e.impulse)}});
     if (!e.note.empty()) events.back()["note"] = e.note;
+    if (friction_count(model) > 0) {  // frictionless models keep their keys
+      events.back()["friction_impulse"] = to_json(e.friction_impulse);
+      nlohmann::json modes = nlohmann::json::array();
+      for (sim::FrictionMode fm : e.friction_mode_after)
+        modes.push_back(std::string(sim::to_string(fm)));
+      events.back()["friction_mode_after"] = std::move(modes);
+    }
   }
   j["events"] = std::move(events);
   j["events_not_recorded"] = traj.events_not_recorded;

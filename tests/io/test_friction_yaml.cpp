@@ -49,6 +49,28 @@ TEST(FrictionYaml, WrittenBackAndReadAgain) {
   EXPECT_EQ(back.mechanical->friction[0].mu, 0.75);
 }
 
+// A moving surface (a belt): `velocity`, default 0, read and written back.
+TEST(FrictionYaml, SurfaceVelocity) {
+  const mech::Model m = parse_model(
+      model("  friction:\n    - {contact: floor, tangent: [1, 0], mu: 0.1, velocity: -0.5}\n"
+            "    - {contact: wall, tangent: [0, 1], mu: 0.1}\n"),
+      "ok.yaml");
+  EXPECT_EQ(m.mechanical->friction[0].velocity, -0.5);
+  EXPECT_EQ(m.mechanical->friction[1].velocity, 0.0);
+  // The sliding velocity is relative to the surface.
+  EXPECT_EQ(m.mechanical->friction[0].sliding(Eigen::Vector2d(2, 7)), 2.5);
+  const std::string text = model_yaml(m);
+  EXPECT_NE(text.find("{contact: 0, tangent: [1, 0], mu: 0.1, velocity: -0.5}\n"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("{contact: 1, tangent: [0, 1], mu: 0.1}\n"), std::string::npos) << text;
+  EXPECT_EQ(parse_model(text, "back.yaml").mechanical->friction[0].velocity, -0.5);
+  EXPECT_NE(error_of(model("  friction:\n    - {contact: 0, tangent: [1, 0], mu: 0.1, velocity: "
+                           ".nan}\n"))
+                .find("mechanical.friction[0].velocity"),
+            std::string::npos);
+}
+
 TEST(FrictionYaml, WithoutFrictionTheWrittenModelIsUnchanged) {
   const mech::Model m = parse_model(model(""), "ok.yaml");
   EXPECT_FALSE(m.mechanical->has_friction());

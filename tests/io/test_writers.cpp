@@ -286,6 +286,46 @@ TEST(TrajectoryJson, RoundTrip) {
   EXPECT_EQ(j["wall_time_s"].get<double>(), 0.125);
 }
 
+// A model with friction: the tangential multipliers and friction modes per
+// frictional contact in the CSV (blank where a sample records none) and the
+// events' tangential impulses and modes in the JSON summary.
+TEST(TrajectoryWriters, FrictionColumnsAndEventKeys) {
+  const mech::Model model = parse_model(
+      "name: f\nmechanical:\n  M: [[1, 0], [0, 1]]\n  E: [[0, 1]]\n  constraints: [floor]\n"
+      "  friction:\n    - {contact: floor, tangent: [1, 0], mu: 0.5, velocity: 0.25}\n",
+      "f.yaml");
+  sim::Trajectory tr;
+  sim::Sample a;
+  a.x = (VectorXd(4) << 0, 0, 1, 0).finished();
+  a.u = VectorXd::Constant(1, 2.0);
+  a.y = VectorXd::Zero(1);
+  a.mode = {0};
+  a.u_t = VectorXd::Constant(1, -1.0);
+  a.friction_mode = {sim::FrictionMode::kSlipPositive};
+  sim::Sample b = a;
+  b.t = 0.5;
+  b.u_t = VectorXd();
+  b.friction_mode.clear();
+  tr.samples = {a, b};
+  EXPECT_EQ(trajectory_csv(model, tr),
+            "t,q1,q2,v_q1,v_q2,u_floor,y_floor,ut_floor,fm_floor,mode\n"
+            "0,0,0,1,0,2,0,-1,slip+,0\n0.5,0,0,1,0,2,0,,,0\n");
+  sim::Event e;
+  e.state_before = e.state_after = a.x;
+  e.impulse = VectorXd::Constant(1, 0.5);
+  e.friction_impulse = VectorXd::Constant(1, -0.125);
+  e.friction_mode_after = {sim::FrictionMode::kStick};
+  tr.events = {e};
+  const nlohmann::json j = trajectory_json(model, tr);
+  EXPECT_EQ(j["events"][0]["friction_impulse"].get<std::vector<double>>(),
+            std::vector<double>{-0.125});
+  EXPECT_EQ(j["events"][0]["friction_mode_after"].get<std::vector<std::string>>(),
+            std::vector<std::string>{"stick"});
+  // Frictionless models keep their keys (byte-identical JSON as before).
+  EXPECT_FALSE(
+      trajectory_json(two_carts_model(), hand_made())["events"][0].contains("friction_impulse"));
+}
+
 TEST(TrajectoryJson, FailedRunAndLcsEnergies) {
   const mech::Model model = parse_model("lcs:\n  A: [[0]]\n  B: [[1]]\n  C: [[1]]\n", "lcs.yaml");
   sim::Trajectory tr;

@@ -83,3 +83,36 @@ def test_warnings_are_counted_per_kind(robots):
     (w,) = run.warnings
     assert w["kind"] == "restitution-ignored" and w["count"] == 1 and w["first_t"] == 0.0
     assert "ignores restitution" in w["message"]
+
+
+def test_friction_from_matrices_is_the_model_file(robots):
+    """Model.mechanical(friction=...) builds robots/belt_friction.yaml's model (a
+    contact by name, a moving surface), and the runs agree to the bit; the friction
+    modes come out as FRICTION_MODES indices, the multipliers as u_t."""
+    built = lcsim.Model.mechanical(
+        M=np.eye(2), K=np.diag([4.0, 0.0]), E=[[0.0, 1.0]], f=[0.0, -9.81],
+        names=["x", "y"], constraint_names=["belt"], name="belt_friction",
+        friction=[{"contact": "belt", "tangent": [1.0, 0.0], "mu": 0.1, "velocity": 0.2}])
+    shipped = lcsim.load(robots / "belt_friction.yaml")
+    x0 = np.zeros(4)
+    runs = [lcsim.simulate(m, x0=x0, t_end=0.5, method="moreau-jean", h=1e-3)
+            for m in (built, shipped)]
+    assert all(r.ok for r in runs), [r.message for r in runs]
+    np.testing.assert_array_equal(runs[0].x, runs[1].x)
+    np.testing.assert_array_equal(runs[0].u_t, runs[1].u_t)
+    assert runs[0].friction_modes.shape == (len(runs[0].t), 1)
+    assert runs[0].friction_modes.dtype == np.int8
+    assert set(np.unique(runs[0].friction_modes)) <= {-1, 0, 1, 2, 3}
+    assert lcsim.FRICTION_MODES == ("open", "stick", "slip+", "slip-")
+
+
+def test_bad_friction_entries_name_them():
+    with pytest.raises(lcsim.InputError, match=r"friction\[0\]\.contact: no constraint named"):
+        lcsim.Model.mechanical(M=np.eye(2), E=[[0.0, 1.0]],
+                               friction=[{"contact": "roof", "tangent": [1, 0], "mu": 0.1}])
+    with pytest.raises(lcsim.InputError, match=r"friction\[0\]\.mu: must be >= 0"):
+        lcsim.Model.mechanical(M=np.eye(2), E=[[0.0, 1.0]],
+                               friction=[{"contact": 0, "tangent": [1, 0], "mu": -1}])
+    with pytest.raises(lcsim.InputError, match=r"friction\[0\]\.speed: unknown key"):
+        lcsim.Model.mechanical(M=np.eye(2), E=[[0.0, 1.0]],
+                               friction=[{"contact": 0, "tangent": [1, 0], "mu": 1, "speed": 2}])

@@ -171,6 +171,37 @@ TEST(FrictionShippedModels, MatchTheirClosedForms) {
   EXPECT_EQ(r.outcome[0], impact::ContactOutcome::kStick);
 }
 
+// robots/belt_friction.yaml: a mass-spring riding a belt at v_b = 0.2 m/s.
+// Released at rest, it slides back on the belt until its velocity reaches
+// v_b at t1 = asin(v_b / (x_s omega)) / omega, sticks (v = v_b) until the
+// spring force reaches mu m g at x = x_s (t2), then slips with
+// v = v_b cos(omega (t - t2)) (the file's header).
+TEST(FrictionMoreauJean, BeltSticksAtT1AndSlipsAtT2) {
+  const mech::Model m = shipped("belt_friction.yaml");
+  const double vb = 0.2, omega = 2.0, xs = 0.1 * kG / 4.0;
+  const double t1 = std::asin(vb / (xs * omega)) / omega;
+  const double x1 = xs * (1 - std::cos(omega * t1)), t2 = t1 + (xs - x1) / vb;
+  const double h = 1e-4;
+  const sim::Trajectory tr = run_mj(m, m.initial, m.t_end, h);
+  ASSERT_EQ(tr.status, Status::kCompleted) << tr.message;
+  // Stuck to the belt: v - v_b zero to rounding (as `stuck` above).
+  double t_stick = NAN, t_slip = NAN;
+  for (const sim::Sample& s : tr.samples) {
+    const bool on_belt = stuck(s.x(2) - vb);
+    if (std::isnan(t_stick) && on_belt) t_stick = s.t;
+    if (!std::isnan(t_stick) && std::isnan(t_slip) && !on_belt) t_slip = s.t;
+  }
+  // First order, as the block's stick time: within h of t1. The slip starts
+  // when the spring force exceeds mu m g; the sliding velocity then grows
+  // like v_b omega^2 tau^2 / 2 and passes the rounding level after a few
+  // steps: within 3 h of t2.
+  EXPECT_LE(std::abs(t_stick - t1), h) << t_stick;
+  EXPECT_LE(std::abs(t_slip - t2), 3 * h) << t_slip;
+  // After the slip, v = v_b cos(omega (t - t2)) to first order (C = 4 as
+  // the mass-spring above, speed scale v_b).
+  EXPECT_NEAR(tr.final_state(2), vb * std::cos(omega * (m.t_end - t2)), 4 * h * vb * omega);
+}
+
 TEST(FrictionRefusal, MethodsWithoutFrictionRefuseIt) {
   const mech::Model model = block(1.0, 0.0, 0.3);
   const VectorXd x0 = (VectorXd(4) << 0, 0, 1, 0).finished();

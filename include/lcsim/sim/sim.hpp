@@ -54,6 +54,10 @@ struct Event {
   VectorXd state_before, state_after;
   IndexSet mode_after;
   VectorXd impulse;  // u^0 (size k); zero when no jump
+  // Models with friction (empty otherwise): the tangential impulse of each
+  // entry of mechanical.friction (N s, zero when no jump) and its mode after.
+  VectorXd friction_impulse;
+  std::vector<FrictionMode> friction_mode_after;
   // How the event was resolved when that is not plain: for an accumulation,
   // the contacts, the impacts seen and how the limit time and state were
   // extrapolated. Empty otherwise.
