@@ -90,15 +90,22 @@ bool EventDriven::friction_feedback(Phase& ph, std::string& err) const {
   const MatrixXd MinvGt = Minv_ * G.transpose();
   const MatrixXd S = H * MinvGt;
   if (err = painleve_phase(ph, S, static_cast<int>(ns)); !err.empty()) return false;
-  const Eigen::FullPivLU<MatrixXd> lu(S);
-  if (!lu.isInvertible()) {
+  const MatrixXd Av = sys_.A.middleRows(N_, N_);  // v' = Av x without forces
+  MatrixXd F_all;
+  if (const Eigen::FullPivLU<MatrixXd> lu(S); lu.isInvertible()) {
+    F_all = -lu.solve(H * Av);
+  } else if (std::none_of(ph.friction.begin(), ph.friction.end(), slipping)) {
+    // Dependent rows without slip (two corners of a box sticking on one
+    // floor): S = H M^-1 H' is symmetric semi-definite and H v' = 0 is
+    // consistent, so the forces are determined up to its null space; the
+    // minimum-norm ones are taken (a statically indeterminate split).
+    F_all = -S.completeOrthogonalDecomposition().solve(H * Av);
+  } else {
     err =
-        "the constraint matrix H M^-1 G' of the mode with stick / slip is singular (dependent "
+        "the constraint matrix H M^-1 G' of the mode with slip is singular (dependent "
         "normal and tangent rows): its forces are not determined";
     return false;
   }
-  const MatrixXd Av = sys_.A.middleRows(N_, N_);  // v' = Av x without forces
-  const MatrixXd F_all = -lu.solve(H * Av);
   ph.F = F_all.topRows(nI);
   ph.Acl.middleRows(N_, N_) += MinvGt * F_all;
   for (size_t f = 0; f < ph.friction.size(); ++f) {

@@ -293,6 +293,42 @@ TEST(EventFriction, KanesParadoxIsWarned) {
   EXPECT_NEAR(tr.energy_final - tr.energy_initial, 0.625 - 0.52, kTol);
 }
 
+TEST(EventFriction, BoxOnTwoCornersSlidesAndSticks) {
+  // A box (m = 1, width 1, height 0.5, I = m (w^2 + h^2) / 12), q = (x, y,
+  // theta) linearised, on its two bottom corners (back, front), both with
+  // mu = 0.4 and the tangent of a corner, t = (1, 0, h/2) (W_NT != 0).
+  // Sliding at v0 = 2 both slip: no rotation needs, about the centre,
+  // (u_front - u_back) w/2 = mu (u_back + u_front) h/2, so u_front - u_back
+  // = mu m g / 2 and u_back = 3.924, u_front = 5.886 N; it sticks at
+  // t* = v0 / (mu g) on both corners at once (dependent tangent rows: the
+  // minimum-norm split, u_N = m g / 2 each, no tangential force).
+  mech::MechanicalModel mm;
+  mm.M = Eigen::Vector3d(1, 1, (1 + 0.25) / 12).asDiagonal().toDenseMatrix().sparseView();
+  Eigen::MatrixXd E(2, 3);
+  E << 0, 1, -0.5, 0, 1, 0.5;
+  mm.E = E.sparseView();
+  mm.f = Eigen::Vector3d(0, -kG, 0);
+  mech::fill_defaults(mm);
+  mm.constraints = {"back", "front"};
+  for (int c : {0, 1}) mm.friction.push_back({c, Eigen::Vector3d(1, 0, 0.25), 0.4});
+  mech::Model m = mech::model_of(mm, "box");
+  m.t_end = 1.0;
+  const sim::Trajectory tr = run(m, 0.25, (VectorXd(6) << 0, 0, 0, 2, 0, 0).finished());
+  ASSERT_EQ(tr.status, Status::kCompleted) << tr.message;
+  ASSERT_EQ(tr.events.size(), 1u);
+  EXPECT_EQ(tr.events[0].type, EventType::kStick);
+  EXPECT_LE(error("box: stick time", tr.events[0].t, 2.0 / (0.4 * kG)), kTol);
+  const sim::Sample& sliding = sample_at(tr, 0.25);
+  EXPECT_NEAR(sliding.u(0), 3.924, kTol);
+  EXPECT_NEAR(sliding.u(1), 5.886, kTol);
+  EXPECT_NEAR(sliding.u_t(1), -0.4 * 5.886, kTol);
+  const sim::Sample& stuck = tr.samples.back();
+  EXPECT_EQ(stuck.friction_mode,
+            (std::vector<FrictionMode>{FrictionMode::kStick, FrictionMode::kStick}));
+  EXPECT_NEAR(stuck.u(0), kG / 2, kTol);
+  EXPECT_NEAR(stuck.u_t(0), 0.0, kTol);
+}
+
 TEST(EventFriction, ImpactLawWithoutFrictionIsRefused) {
   // "flip" and "sequential" ignore friction: refused before the run, not at
   // its first impact.
