@@ -51,6 +51,20 @@ EventType friction_event_type(const std::vector<FrictionMode>& before,
   return EventType::kSlip;
 }
 
+// Event::note of a stick / slip event: "'floor': slip+ -> stick", per
+// contact whose mode changed.
+std::string friction_note(const std::vector<FrictionMode>& before,
+                          const std::vector<FrictionMode>& after, const std::vector<int>& contacts,
+                          const std::vector<std::string>& names) {
+  std::string note;
+  for (size_t f = 0; f < after.size() && f < before.size(); ++f) {
+    if (before[f] == after[f]) continue;
+    note += (note.empty() ? "'" : "; '") + names[static_cast<size_t>(contacts[f])] +
+            "': " + std::string(to_string(before[f])) + " -> " + std::string(to_string(after[f]));
+  }
+  return note;
+}
+
 }  // namespace
 
 void EventDriven::record(Trajectory& tr, double t, const VectorXd& xa, const Phase& ph) const {
@@ -430,6 +444,8 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
       e.type = lost && !gained ? EventType::kRelease : EventType::kContact;
       if (!gained && !lost && ev.friction != old_friction) {
         e.type = friction_event_type(old_friction, ev.friction);
+        e.note = friction_note(old_friction, ev.friction, friction_contacts_,
+                               model_.mechanical->constraints);
       } else if (!gained && !lost) {
         // A graze or a re-selection of the same mode: not a mode change.
         if (keep) record(tr, t, xa, phase);

@@ -159,7 +159,9 @@ TEST(EventFriction, BeltStickSlip) {
   EXPECT_EQ(tr.events[0].type, EventType::kStick);
   EXPECT_LE(error("belt: stick time t1", tr.events[0].t, t1), kTol);
   EXPECT_NEAR(tr.events[0].state_after(0), x1, kTol);
+  EXPECT_EQ(tr.events[0].note, "'belt': slip- -> stick");
   EXPECT_EQ(tr.events[1].type, EventType::kSlip);
+  EXPECT_EQ(tr.events[1].note, "'belt': stick -> slip-");
   EXPECT_LE(error("belt: slip time t2", tr.events[1].t, t2), kTol);
   double worst = 0.0;
   for (const sim::Sample& s : tr.samples) {
