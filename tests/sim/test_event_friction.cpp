@@ -23,6 +23,7 @@
 #include <lcsim/io/io.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <numbers>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -329,6 +330,69 @@ TEST(EventFriction, BoxOnTwoCornersSlidesAndSticks) {
             (std::vector<FrictionMode>{FrictionMode::kStick, FrictionMode::kStick}));
   EXPECT_NEAR(stuck.u(0), kG / 2, kTol);
   EXPECT_NEAR(stuck.u_t(0), 0.0, kTol);
+}
+
+// A random model with frictional contacts: N = 3, M SPD, a spring, two
+// contact rows through q = 0 (closed) with random tangents and mu, gravity-
+// like force, inelastic impacts, fixed surfaces.
+mech::Model random_model(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const int N = 3;
+  Eigen::MatrixXd A(N, N), K = Eigen::MatrixXd::Zero(N, N);
+  for (int i = 0; i < N; ++i)
+    for (int j = 0; j < N; ++j) A(i, j) = u(rng);
+  const Eigen::MatrixXd M = A * A.transpose() + Eigen::MatrixXd::Identity(N, N);
+  K(0, 0) = 2.0 + u(rng);
+  Eigen::MatrixXd E(2, N);
+  for (int j = 0; j < N; ++j) E(0, j) = u(rng), E(1, j) = u(rng);
+  mech::MechanicalModel mm;
+  mm.M = M.sparseView();
+  mm.K = K.sparseView();
+  mm.E = E.sparseView();
+  mm.f = -5.0 * E.row(0).transpose() - 5.0 * E.row(1).transpose();
+  mech::fill_defaults(mm);
+  for (int c : {0, 1}) {
+    Eigen::Vector3d t(u(rng), u(rng), u(rng));
+    mm.friction.push_back({c, t, 0.5 * (1.0 + u(rng))});
+  }
+  mech::Model m = mech::model_of(mm, "random");
+  m.t_end = 1.0;
+  return m;
+}
+
+TEST(EventFriction, RandomModelsDissipateOrSayWhyNot) {
+  // With inelastic impacts and fixed surfaces, friction and impacts only
+  // dissipate: the total energy of a completed run never rises (beyond 1e-9
+  // relative: the rounding of the phases and events). A run that does not
+  // complete says why: a Painlevé-type case, or (kEventLimit) no progress:
+  // with both contacts sticking these 3-dof models have 4 stick rows, the
+  // forces are statically indeterminate and the minimum-norm split the
+  // phase takes can leave the cone where the friction LCP's split does not
+  // (a known limitation, counted here, not hidden).
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int completed = 0, painleve = 0, no_progress = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const mech::Model m = random_model(rng);
+    VectorXd x0 = VectorXd::Zero(6);
+    for (int i = 3; i < 6; ++i) x0(i) = 2.0 * u(rng);
+    const sim::Trajectory tr = run(m, 0.0, x0);
+    if (tr.status == Status::kCompleted) {
+      ++completed;
+      EXPECT_LE(tr.energy_final, tr.energy_initial + 1e-9 * (1.0 + std::abs(tr.energy_initial)))
+          << "trial " << trial;
+    } else if (tr.message.find("Painlev") != std::string::npos) {
+      ++painleve;
+      EXPECT_EQ(tr.status, Status::kNumericalFailure) << "trial " << trial;
+    } else {
+      ++no_progress;
+      EXPECT_EQ(tr.status, Status::kEventLimit) << "trial " << trial << ": " << tr.message;
+      EXPECT_NE(tr.message.find("no progress"), std::string::npos) << tr.message;
+    }
+  }
+  std::printf("[  random  ] %d completed, %d Painlevé, %d no progress\n", completed, painleve,
+              no_progress);
+  EXPECT_GE(completed, 100);  // most complete: a floor, not this code's count (137 of 200)
 }
 
 TEST(EventFriction, ImpactLawWithoutFrictionIsRefused) {
