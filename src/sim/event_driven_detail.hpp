@@ -186,7 +186,9 @@ class EventDriven {
                    const lcs::IndexSet& undetermined, const VectorXd& xa, std::string& err) const;
   // Friction (friction_phase.cpp, friction_modes.cpp).
   void init_friction();
-  bool friction_feedback(Phase& ph, std::string& err) const;
+  bool friction_feedback(Phase& ph, const VectorXd& xa, std::string& err) const;
+  void indeterminate_split(const Phase& ph, const MatrixXd& S, const std::vector<int>& stick,
+                           const VectorXd& xa, MatrixXd& F_all) const;
   void add_friction_monitors(Phase& ph) const;
   std::string painleve_phase(const Phase& ph, const MatrixXd& S, int n_stick) const;
   std::string select_friction(double t, const lcs::IndexSet& undetermined, VectorXd& xa,

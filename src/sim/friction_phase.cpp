@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <lcsim/lcp/lcp.hpp>
+#include <limits>
 #include <sstream>
 
 #include "sim/event_driven_detail.hpp"
@@ -69,7 +70,7 @@ std::string EventDriven::painleve_phase(const Phase& ph, const MatrixXd& S, int 
 
 // F (normals), Ft and Acl of a mode with closed frictional contacts; false
 // (err set) for a Painlevé-type or singular phase.
-bool EventDriven::friction_feedback(Phase& ph, std::string& err) const {
+bool EventDriven::friction_feedback(Phase& ph, const VectorXd& xa, std::string& err) const {
   const mech::MechanicalModel& m = *model_.mechanical;
   const Eigen::Index nI = static_cast<Eigen::Index>(ph.mode.size());
   std::vector<int> stick;
@@ -94,12 +95,15 @@ bool EventDriven::friction_feedback(Phase& ph, std::string& err) const {
   MatrixXd F_all;
   if (const Eigen::FullPivLU<MatrixXd> lu(S); lu.isInvertible()) {
     F_all = -lu.solve(H * Av);
+    ph.Acl.middleRows(N_, N_) += MinvGt * F_all;
   } else if (std::none_of(ph.friction.begin(), ph.friction.end(), slipping)) {
     // Dependent rows without slip (two corners of a box sticking on one
     // floor): S = H M^-1 H' is symmetric semi-definite and H v' = 0 is
-    // consistent, so the forces are determined up to its null space; the
-    // minimum-norm ones are taken (a statically indeterminate split).
+    // consistent, so the forces are determined up to its null space
+    // (a statically indeterminate split: indeterminate_split).
     F_all = -S.completeOrthogonalDecomposition().solve(H * Av);
+    ph.Acl.middleRows(N_, N_) += MinvGt * F_all;
+    indeterminate_split(ph, S, stick, xa, F_all);  // forces only: H' Z = 0
   } else {
     err =
         "the constraint matrix H M^-1 G' of the mode with slip is singular (dependent "
@@ -107,7 +111,6 @@ bool EventDriven::friction_feedback(Phase& ph, std::string& err) const {
     return false;
   }
   ph.F = F_all.topRows(nI);
-  ph.Acl.middleRows(N_, N_) += MinvGt * F_all;
   for (size_t f = 0; f < ph.friction.size(); ++f) {
     const Eigen::Index fi = static_cast<Eigen::Index>(f);
     if (ph.friction[f] == FrictionMode::kStick) {
@@ -118,6 +121,51 @@ bool EventDriven::friction_feedback(Phase& ph, std::string& err) const {
     }
   }
   return true;
+}
+
+// Statically indeterminate stick (more independent-looking rows than the
+// motion allows: S = H M^-1 H' singular): forces Z c in the null space of S
+// act on nothing (H' Z = 0), so any c gives the same motion. The
+// minimum-norm split can leave the friction cone where another does not;
+// with a one-dimensional null space, c is chosen to maximise the smallest
+// margin at the phase start (u_N >= 0, mu u_N -+ u_T >= 0), a 1-D max-min
+// of lines solved at their crossings, and held constant through the phase
+// (on the augmented state's constant entry). Larger null spaces keep the
+// minimum-norm split.
+void EventDriven::indeterminate_split(const Phase& ph, const MatrixXd& S,
+                                      const std::vector<int>& stick, const VectorXd& xa,
+                                      MatrixXd& F_all) const {
+  const Eigen::SelfAdjointEigenSolver<MatrixXd> es(S);
+  const double tol = 1e-10 * es.eigenvalues().cwiseAbs().maxCoeff();
+  if ((es.eigenvalues().array() <= tol).count() != 1) return;
+  const VectorXd z = es.eigenvectors().col(0);  // eigenvalues ascend
+  const VectorXd lambda = F_all * xa;
+  const mech::MechanicalModel& m = *model_.mechanical;
+  const Eigen::Index nI = static_cast<Eigen::Index>(ph.mode.size());
+  std::vector<double> g0, b;  // margins g0 + b c
+  for (Eigen::Index i = 0; i < nI; ++i) g0.push_back(lambda(i)), b.push_back(z(i));
+  for (size_t s = 0; s < stick.size(); ++s) {
+    const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(stick[s])];
+    const Eigen::Index i = std::find(ph.mode.begin(), ph.mode.end(), fc.contact) - ph.mode.begin();
+    const Eigen::Index r = nI + static_cast<Eigen::Index>(s);
+    for (const double side : {-1.0, 1.0}) {
+      g0.push_back(fc.mu * lambda(i) + side * lambda(r));
+      b.push_back(fc.mu * z(i) + side * z(r));
+    }
+  }
+  auto worst = [&](double c) {
+    double w = std::numeric_limits<double>::infinity();
+    for (size_t j = 0; j < g0.size(); ++j) w = std::min(w, g0[j] + b[j] * c);
+    return w;
+  };
+  double best_c = 0.0, best = worst(0.0);
+  for (size_t j = 0; j < g0.size(); ++j)
+    for (size_t k = 0; k < g0.size(); ++k) {
+      if (!(b[j] > 0.0 && b[k] < 0.0)) continue;
+      const double c = (g0[k] - g0[j]) / (b[j] - b[k]);
+      if (const double w = worst(c); w > best) best = w, best_c = c;
+    }
+  F_all.col(n_ - 1) += best_c * z;
 }
 
 // The monitors of the frictional contacts: sticking, the two edges of the

@@ -105,7 +105,7 @@ Phase EventDriven::make_phase(const lcs::IndexSet& mode, const std::vector<Frict
   const bool frictional = std::any_of(friction.begin(), friction.end(),
                                       [](FrictionMode f) { return f != FrictionMode::kOpen; });
   if (frictional) {
-    if (!friction_feedback(ph, err)) return ph;
+    if (!friction_feedback(ph, xa, err)) return ph;
   } else if (!mode.empty()) {
     auto it = feedback_cache_.find(mode);
     if (it == feedback_cache_.end())

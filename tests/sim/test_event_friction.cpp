@@ -303,8 +303,9 @@ TEST(EventFriction, BoxOnTwoCornersSlidesAndSticks) {
   // Sliding at v0 = 2 both slip: no rotation needs, about the centre,
   // (u_front - u_back) w/2 = mu (u_back + u_front) h/2, so u_front - u_back
   // = mu m g / 2 and u_back = 3.924, u_front = 5.886 N; it sticks at
-  // t* = v0 / (mu g) on both corners at once (dependent tangent rows: the
-  // minimum-norm split, u_N = m g / 2 each, no tangential force).
+  // t* = v0 / (mu g) on both corners at once (dependent tangent rows: only
+  // the tangential split is indeterminate, u_N = m g / 2 each, and the one
+  // with the largest cone margin has no tangential force).
   mech::MechanicalModel mm;
   mm.M = Eigen::Vector3d(1, 1, (1 + 0.25) / 12).asDiagonal().toDenseMatrix().sparseView();
   Eigen::MatrixXd E(2, 3);
@@ -364,11 +365,11 @@ TEST(EventFriction, RandomModelsDissipateOrSayWhyNot) {
   // With inelastic impacts and fixed surfaces, friction and impacts only
   // dissipate: the total energy of a completed run never rises (beyond 1e-9
   // relative: the rounding of the phases and events). A run that does not
-  // complete says why: a Painlevé-type case, or (kEventLimit) no progress:
-  // with both contacts sticking these 3-dof models have 4 stick rows, the
-  // forces are statically indeterminate and the minimum-norm split the
-  // phase takes can leave the cone where the friction LCP's split does not
-  // (a known limitation, counted here, not hidden).
+  // complete says why: a Painlevé-type case, or (kEventLimit) no progress.
+  // With both contacts sticking these 3-dof models have 4 stick rows: the
+  // split of the forces is indeterminate (a one-dimensional null space) and
+  // the phase takes the one with the largest cone margin; the minimum-norm
+  // split alone left 17 of these runs without progress.
   std::mt19937 rng(17);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   int completed = 0, painleve = 0, no_progress = 0;
@@ -392,7 +393,7 @@ TEST(EventFriction, RandomModelsDissipateOrSayWhyNot) {
   }
   std::printf("[  random  ] %d completed, %d Painlevé, %d no progress\n", completed, painleve,
               no_progress);
-  EXPECT_GE(completed, 100);  // most complete: a floor, not this code's count (137 of 200)
+  EXPECT_GE(completed, 100);  // most complete: a floor, not this code's count (154 of 200)
 }
 
 TEST(EventFriction, ImpactLawWithoutFrictionIsRefused) {
