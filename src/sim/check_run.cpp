@@ -135,6 +135,20 @@ std::string refuse_friction(const mech::Model& model, std::string_view method,
                        : "use method " + with);
 }
 
+// A method that applies an impact law to a model with friction: the law must
+// handle friction, else the run would fail at its first impact.
+std::string refuse_friction_law(const mech::Model& model, const Options& opt,
+                                const OptionsUsed& used) {
+  if (!used.impact || !model.is_mechanical() || !model.mechanical->has_friction()) return "";
+  if (impact::make_impact_law(opt.impact)->handles_friction()) return "";
+  std::string with;
+  for (const std::string& name : impact::laws().names())
+    if (auto law = impact::laws().make(name); law && law->handles_friction())
+      with += (with.empty() ? "'" : ", '") + name + "'";
+  return "impact law '" + opt.impact + "' does not handle friction (model '" + model.name +
+         "' has mechanical.friction); use impact law " + with;
+}
+
 }  // namespace
 
 Options keep_used(const Options& opt, const OptionsUsed& used) {
@@ -170,6 +184,7 @@ std::string check_run(const mech::Model& model, const VectorXd& x0, const Option
            " it allows; method 'moreau-jean' works on the sparse model";
   if (!opt.t_end) return "no horizon: set Options::t_end, or t_end in the model";
   if (std::string m = check_values(opt, used); !m.empty()) return m;
+  if (std::string m = refuse_friction_law(model, opt, used); !m.empty()) return m;
   if (std::string m = ignored_options(opt, method, used); !m.empty()) return m;
   if (std::string m = infeasible_start(model, x0); !m.empty()) return m;
   return check_output_size(model, opt, used);

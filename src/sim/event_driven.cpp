@@ -13,6 +13,15 @@
 // function, bracketed on a sampling grid fine enough for its frequencies and
 // refined by Brent's method; grazing minima between samples are checked.
 //
+// Friction (issue 17): a closed frictional contact is in stick, slip+ or
+// slip- (the thesis's relay systems, §4.6.2); its phase holds the sticking
+// tangents at acceleration level and carries the slipping contacts' friction
+// in their normal's force column (friction_phase.cpp); sliding velocities
+// reaching zero and stick forces reaching the cone's edge are monitors like
+// the others, and the next stick / slip modes come from the
+// acceleration-level friction LCP (friction_modes.cpp). Events that change
+// only those modes are kStick / kSlip.
+//
 // This file holds the main loop (EventDriven::run: phases, sampling, root
 // finding, events) and the entry point; event_driven_detail.hpp lists the
 // other parts.
@@ -30,6 +39,34 @@ namespace lcsim::sim {
 
 namespace detail {
 
+namespace {
+
+// A change of stick / slip modes with the normal mode unchanged: kStick if
+// some contact starts to stick, else kSlip.
+EventType friction_event_type(const std::vector<FrictionMode>& before,
+                              const std::vector<FrictionMode>& after) {
+  for (size_t f = 0; f < after.size(); ++f)
+    if (after[f] == FrictionMode::kStick && (f >= before.size() || before[f] != after[f]))
+      return EventType::kStick;
+  return EventType::kSlip;
+}
+
+// Event::note of a stick / slip event: "'floor': slip+ -> stick", per
+// contact whose mode changed.
+std::string friction_note(const std::vector<FrictionMode>& before,
+                          const std::vector<FrictionMode>& after, const std::vector<int>& contacts,
+                          const std::vector<std::string>& names) {
+  std::string note;
+  for (size_t f = 0; f < after.size() && f < before.size(); ++f) {
+    if (before[f] == after[f]) continue;
+    note += (note.empty() ? "'" : "; '") + names[static_cast<size_t>(contacts[f])] +
+            "': " + std::string(to_string(before[f])) + " -> " + std::string(to_string(after[f]));
+  }
+  return note;
+}
+
+}  // namespace
+
 void EventDriven::record(Trajectory& tr, double t, const VectorXd& xa, const Phase& ph) const {
   tr.max_violation = std::min(tr.max_violation, violation(xa));
   if (!opt_.record_samples) return;
@@ -39,6 +76,7 @@ void EventDriven::record(Trajectory& tr, double t, const VectorXd& xa, const Pha
   s.u = multipliers(ph, xa);
   s.y = sys_.C * xa + sys_.D * s.u;
   s.mode = ph.mode;
+  fill_friction(s, ph, xa);
   tr.record_sample(std::move(s), opt_);
 }
 
@@ -134,7 +172,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
   if (!ev.ok()) {
     fail(ev.message);
   } else {
-    phase = make_phase(ev.mode, ldcp_undetermined_, ev.x_plus, err);
+    phase = make_phase(ev.mode, ev.friction, ldcp_undetermined_, ev.x_plus, err);
     if (!err.empty()) fail(err);
   }
   if (tr.status != RunStatus::kCompleted) {
@@ -146,6 +184,8 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     Phase before = phase;
     before.mode.clear();
     before.F.resize(0, n_);
+    std::fill(before.friction.begin(), before.friction.end(), FrictionMode::kOpen);
+    before.Ft.setZero();
     record(tr, t, xa, before);
     Event e;
     e.t = t;
@@ -162,7 +202,8 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
   const double t_end = *opt_.t_end;
   LivelockGuard livelock(
       opt_.livelock_events, rho_A_,
-      model_.is_mechanical() ? model_.mechanical->constraints : std::vector<std::string>{});
+      model_.is_mechanical() ? model_.mechanical->constraints : std::vector<std::string>{},
+      friction_contacts_);
   long events_in_window = 0;
   double window_start = 0.0;
   while (t < t_end) {
@@ -363,7 +404,8 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
       break;
     }
     const lcs::IndexSet old_mode = phase.mode;
-    phase = make_phase(ev.mode, ldcp_undetermined_, ev.x_plus, err);
+    const std::vector<FrictionMode> old_friction = phase.friction;
+    phase = make_phase(ev.mode, ev.friction, ldcp_undetermined_, ev.x_plus, err);
     if (!err.empty()) {
       fail(err);
       xa = x_minus;
@@ -376,7 +418,8 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
       xa = phase.exp_apply(ev.t_star - t, xa);
       t = ev.t_star;
     }
-    if (const std::string why = livelock.after_event(t, x_minus, xa, old_mode, ev); !why.empty()) {
+    if (const std::string why = livelock.after_event(t, x_minus, xa, old_mode, ev, old_friction);
+        !why.empty()) {
       fail(why);
       tr.status = RunStatus::kEventLimit;
       break;
@@ -399,7 +442,11 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
       for (int r : old_mode)
         if (std::find(ev.mode.begin(), ev.mode.end(), r) == ev.mode.end()) lost = true;
       e.type = lost && !gained ? EventType::kRelease : EventType::kContact;
-      if (!gained && !lost) {
+      if (!gained && !lost && ev.friction != old_friction) {
+        e.type = friction_event_type(old_friction, ev.friction);
+        e.note = friction_note(old_friction, ev.friction, friction_contacts_,
+                               model_.mechanical->constraints);
+      } else if (!gained && !lost) {
         // A graze or a re-selection of the same mode: not a mode change.
         if (keep) record(tr, t, xa, phase);
         continue;

@@ -7,6 +7,11 @@
 //                         selection (mechanical), LDCP jumps (general LCS)
 //   accumulation.cpp      accumulations of impacts and their limit
 //   livelock.cpp          the guard against events that make no progress
+//   friction_phase.cpp    a phase with closed frictional contacts: stick rows
+//                         and slip columns in the feedback, the cone and
+//                         sliding monitors (issue 17)
+//   friction_modes.cpp    stick / slip selection at an event (the
+//                         acceleration-level friction LCP, thesis (4.44))
 #pragma once
 
 #include <Eigen/Dense>
@@ -36,12 +41,17 @@ struct Monitor {
   double scale = 0.0;       // |w| |x| scale for tolerances
   int constraint = -1;      // which constraint
   bool multiplier = false;  // true: u_i of an active constraint; false: free output y_i
+  int friction = -1;        // entry of mechanical.friction for a cone or sliding monitor
 };
 
 struct Phase {
   lcs::IndexSet mode;
   MatrixXd Acl;  // closed-loop matrix
   MatrixXd F;    // u_I = F x (|I| x n)
+  // Models with friction: the mode of each entry of mechanical.friction and
+  // its tangential multiplier u_T = Ft x (n_F x n); both empty otherwise.
+  std::vector<FrictionMode> friction;
+  MatrixXd Ft;
   // Balanced coordinates z = x ./ D with Ab = D^{-1} Acl D (powers of 2):
   // a stiff spring k makes Acl's entries span k and 1 while its frequencies
   // are sqrt(k); exponentials of the balanced matrix keep the relative
@@ -89,7 +99,8 @@ struct EventResult {
   std::string message;
   VectorXd x_plus;
   lcs::IndexSet mode;
-  VectorXd impulse;  // sum of the impulses applied (size k)
+  std::vector<FrictionMode> friction;  // models with friction: the selected stick / slip modes
+  VectorXd impulse;                    // sum of the impulses applied (size k)
   bool jumped = false;
   bool accumulation = false;
   double t_star = 0.0;  // extrapolated accumulation time (accumulation only)
@@ -109,16 +120,24 @@ constexpr double kIdleJump = 1e-6;
 
 class LivelockGuard {
  public:
-  LivelockGuard(int limit, double rho, std::vector<std::string> names)
-      : limit_(limit), rho_(rho), names_(std::move(names)) {}
+  // friction_contacts: the row of E of each entry of mechanical.friction
+  // (a stick / slip change there involves that contact).
+  LivelockGuard(int limit, double rho, std::vector<std::string> names,
+                std::vector<int> friction_contacts = {})
+      : limit_(limit),
+        rho_(rho),
+        names_(std::move(names)),
+        friction_contacts_(std::move(friction_contacts)) {}
   // "" while the run makes progress, else the failure message.
   std::string after_event(double t, const VectorXd& x_minus, const VectorXd& x_plus,
-                          const lcs::IndexSet& old_mode, const EventResult& ev);
+                          const lcs::IndexSet& old_mode, const EventResult& ev,
+                          const std::vector<FrictionMode>& old_friction = {});
 
  private:
   int limit_;
   double rho_;
   std::vector<std::string> names_;
+  std::vector<int> friction_contacts_;
   int streak_ = 0;
   double since_ = 0.0, last_t_ = -std::numeric_limits<double>::infinity();
   std::set<int> involved_;
@@ -142,6 +161,7 @@ class EventDriven {
     ldcp_data_ = lcs::ldcp_data(sys_);
     rho_A_ = spectral_radius_bound(sys_.A);
     ldcp_.data = &ldcp_data_;
+    if (model.is_mechanical() && model.mechanical->has_friction()) init_friction();
   }
 
   Trajectory run(const VectorXd& x0_user);
@@ -160,8 +180,27 @@ class EventDriven {
     return std::abs(value) <= ldcp_.tol_rel * scale + ldcp_.tol_abs;
   }
 
-  Phase make_phase(const lcs::IndexSet& mode, const lcs::IndexSet& undetermined, const VectorXd& xa,
-                   std::string& err) const;
+  // `friction`: the mode of each entry of mechanical.friction (empty for
+  // frictionless models).
+  Phase make_phase(const lcs::IndexSet& mode, const std::vector<FrictionMode>& friction,
+                   const lcs::IndexSet& undetermined, const VectorXd& xa, std::string& err) const;
+  // Friction (friction_phase.cpp, friction_modes.cpp).
+  void init_friction();
+  bool friction_feedback(Phase& ph, const VectorXd& xa, std::string& err) const;
+  void indeterminate_split(const Phase& ph, const MatrixXd& S, const std::vector<int>& stick,
+                           const VectorXd& xa, MatrixXd& F_all) const;
+  void add_friction_monitors(Phase& ph) const;
+  std::string painleve_phase(const Phase& ph, const MatrixXd& S, int n_stick) const;
+  std::string select_friction(double t, const lcs::IndexSet& undetermined, VectorXd& xa,
+                              EventResult& out);
+  std::vector<int> zero_sliding(const lcs::IndexSet& mode, const VectorXd& xa,
+                                std::vector<FrictionMode>& fm) const;
+  void project_sliding(const lcs::IndexSet& mode, const std::vector<int>& zero, VectorXd& xa) const;
+  std::vector<FrictionMode> friction_lcp_modes(const lcs::IndexSet& mode,
+                                               const std::vector<FrictionMode>& fixed,
+                                               const std::vector<int>& zero, const VectorXd& xa,
+                                               long& solves) const;
+  bool consistent(const Phase& ph, const VectorXd& xa, double t) const;
   EventResult process_event(double t, const VectorXd& xa);
   double accumulation_time(int r, double t, double* ratio) const;
   void project_onto(const std::vector<int>& rows, VectorXd& xa, bool positions) const;
@@ -182,6 +221,7 @@ class EventDriven {
   };
   MonitorStart monitor_start(const Phase& phase, const VectorXd& xstart, double t,
                              double h_max) const;
+  void fill_friction(Sample& s, const Phase& ph, const VectorXd& xa) const;
   VectorXd multipliers(const Phase& ph, const VectorXd& xa) const {
     VectorXd u = VectorXd::Zero(k_);
     if (!ph.mode.empty()) {
@@ -213,7 +253,13 @@ class EventDriven {
   lcs::LdcpData ldcp_data_;
   double rho_A_ = 0.0;  // bound on the spectral radius of the free dynamics
   mutable std::map<lcs::IndexSet, lcs::ModeFeedback> feedback_cache_;
-  mutable std::map<lcs::IndexSet, double> rho_cache_;
+  mutable std::map<std::pair<lcs::IndexSet, std::vector<FrictionMode>>, double> rho_cache_;
+  // Friction (empty for frictionless models): M^{-1} (dense), the row of E
+  // of each frictional contact, and the impact law's outcome per constraint
+  // at the current event (kNone where no impact).
+  MatrixXd Minv_;
+  std::vector<int> friction_contacts_;
+  std::vector<impact::ContactOutcome> outcome_;
 };
 
 }  // namespace lcsim::sim::detail

@@ -10,7 +10,8 @@
 namespace lcsim::sim::detail {
 
 std::string LivelockGuard::after_event(double t, const VectorXd& x_minus, const VectorXd& x_plus,
-                                       const lcs::IndexSet& old_mode, const EventResult& ev) {
+                                       const lcs::IndexSet& old_mode, const EventResult& ev,
+                                       const std::vector<FrictionMode>& old_friction) {
   const double dt = t - last_t_;
   last_t_ = t;
   const double quick = rho_ > 0.0 ? 1e-4 / rho_ : 1e-4 * std::max(1.0, std::abs(t));
@@ -26,6 +27,9 @@ std::string LivelockGuard::after_event(double t, const VectorXd& x_minus, const 
     if (std::find(old_mode.begin(), old_mode.end(), r) == old_mode.end()) involved_.insert(r);
   for (int r : old_mode)
     if (std::find(ev.mode.begin(), ev.mode.end(), r) == ev.mode.end()) involved_.insert(r);
+  for (size_t f = 0; f < ev.friction.size() && f < friction_contacts_.size(); ++f)
+    if (f >= old_friction.size() || ev.friction[f] != old_friction[f])
+      involved_.insert(friction_contacts_[f]);  // a stick / slip change
   for (int r = 0; r < static_cast<int>(ev.impulse.size()); ++r)
     if (ev.impulse(r) != 0.0) involved_.insert(r);
   if (streak_ < limit_) return "";

@@ -93,13 +93,20 @@ VectorXd Phase::expv(double tau, const VectorXd& z) const {
   return y;
 }
 
-Phase EventDriven::make_phase(const lcs::IndexSet& mode, const lcs::IndexSet& undetermined,
-                              const VectorXd& xa, std::string& err) const {
+Phase EventDriven::make_phase(const lcs::IndexSet& mode, const std::vector<FrictionMode>& friction,
+                              const lcs::IndexSet& undetermined, const VectorXd& xa,
+                              std::string& err) const {
   Phase ph;
   ph.mode = mode;
+  ph.friction = friction;
   ph.Acl = sys_.A;
   ph.F = MatrixXd::Zero(mode.size(), n_);
-  if (!mode.empty()) {
+  ph.Ft = MatrixXd::Zero(static_cast<Eigen::Index>(friction.size()), n_);
+  const bool frictional = std::any_of(friction.begin(), friction.end(),
+                                      [](FrictionMode f) { return f != FrictionMode::kOpen; });
+  if (frictional) {
+    if (!friction_feedback(ph, xa, err)) return ph;
+  } else if (!mode.empty()) {
     auto it = feedback_cache_.find(mode);
     if (it == feedback_cache_.end())
       it = feedback_cache_.emplace(mode, lcs::mode_feedback(sys_, mode)).first;
@@ -130,6 +137,7 @@ Phase EventDriven::make_phase(const lcs::IndexSet& mode, const lcs::IndexSet& un
     }
     ph.monitors.push_back(std::move(mon));
   }
+  if (frictional) add_friction_monitors(ph);
   ph.D = balancing(ph.Acl);
   ph.Ab = ph.D.cwiseInverse().asDiagonal() * ph.Acl * ph.D.asDiagonal();
   ph.Ab_norm1 = ph.Ab.cwiseAbs().colwise().sum().maxCoeff();
@@ -138,8 +146,9 @@ Phase EventDriven::make_phase(const lcs::IndexSet& mode, const lcs::IndexSet& un
     ph.use_sparse = ph.Ab_sparse.nonZeros() * 10 <= ph.Ab.size();
   }
   // Ab depends on the mode only: its bound (four n x n squarings) is kept.
-  auto rit = rho_cache_.find(mode);
-  if (rit == rho_cache_.end()) rit = rho_cache_.emplace(mode, spectral_radius_bound(ph.Ab)).first;
+  const auto key = std::make_pair(mode, friction);
+  auto rit = rho_cache_.find(key);
+  if (rit == rho_cache_.end()) rit = rho_cache_.emplace(key, spectral_radius_bound(ph.Ab)).first;
   ph.rho = rit->second;
   const VectorXd z = xa.cwiseQuotient(ph.D);
   for (Monitor& mon : ph.monitors) {

@@ -18,6 +18,7 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
   const mech::MechanicalModel& m = *model_.mechanical;
   std::vector<int> closed, resting;  // zero gap; zero gap and zero rate
   bool limit_taken = false;          // an accumulation's limit is being taken
+  std::fill(outcome_.begin(), outcome_.end(), impact::ContactOutcome::kNone);
   for (int iter = 0; iter < 100; ++iter) {
     closed.clear();
     resting.clear();
@@ -94,6 +95,10 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
                     "impact law '" + impact_->name() + "' at t = " + std::to_string(t) +
                         " gave a non-admissible jump (negative impulse or E_J v+ < 0)" +
                         (ir.message.empty() ? "" : ": " + ir.message));
+    if (ir.energy_gain) count_warning(out.warnings, "impact-energy-gain", t, ir.message);
+    // The last round's stick / slip / no-impulse per contact: stick leaves a
+    // sliding velocity zero to the law's tolerance (friction_modes.cpp).
+    if (!ir.outcome.empty()) outcome_ = ir.outcome;
     xa.segment(N_, N_) = ir.v_after;
     out.impulse += ir.impulse;
     out.jumped = true;
@@ -122,6 +127,12 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
     return out;
   }
   out.mode = sel.mode;
+  if (m.has_friction()) {
+    if (std::string why = select_friction(t, sel.undetermined, xa, out); !why.empty()) {
+      out.message = why;
+      return out;
+    }
+  }
   out.x_plus = xa;
   out.status = Status::kOk;
   ldcp_undetermined_ = sel.undetermined;

@@ -111,6 +111,7 @@ class EventDrivenIntegrator : public Integrator {
   OptionsUsed options_used() const override {
     OptionsUsed u;
     u.impact = u.lcp_solver = u.event_search = u.dense_lcs = true;
+    u.friction = true;  // stick / slip modes (friction_phase.cpp, friction_modes.cpp)
     return u;
   }
   Trajectory integrate(const mech::Model& model, const VectorXd& x0,

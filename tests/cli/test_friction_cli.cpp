@@ -43,9 +43,9 @@ TEST(FrictionCli, LawsAndMethodsWithoutFrictionAreInputErrors) {
   const CliRun r = lcsim("impacts '" + kRobots + "spinning_disk_friction.yaml' --rules flip");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("impact law 'flip' does not handle friction"), std::string::npos) << r.err;
-  const CliRun s = lcsim("simulate '" + kRobots + "block_on_floor_friction.yaml' --method event");
+  const CliRun s = lcsim("simulate '" + kRobots + "block_on_floor_friction.yaml' --method euler");
   EXPECT_EQ(s.exit_code, 2);
-  EXPECT_NE(s.err.find("method 'event' does not support friction"), std::string::npos) << s.err;
+  EXPECT_NE(s.err.find("method 'euler' does not support friction"), std::string::npos) << s.err;
 }
 
 TEST(FrictionCli, SimulateRecordsTheFrictionForce) {

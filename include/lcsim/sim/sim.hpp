@@ -60,7 +60,8 @@ struct Event {
   std::vector<FrictionMode> friction_mode_after;
   // How the event was resolved when that is not plain: for an accumulation,
   // the contacts, the impacts seen and how the limit time and state were
-  // extrapolated. Empty otherwise.
+  // extrapolated; for a kStick / kSlip event, each contact whose mode
+  // changed ("'floor': slip+ -> stick"). Empty otherwise.
   std::string note;
 };
 
