@@ -194,6 +194,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     e.state_after = user(ev.x_plus);
     e.mode_after = ev.mode;
     e.impulse = ev.impulse;
+    set_friction(e, ev);
     tr.events.push_back(std::move(e));
   }
   xa = ev.x_plus;
@@ -430,6 +431,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     e.state_after = user(xa);
     e.mode_after = ev.mode;
     e.impulse = ev.impulse;
+    set_friction(e, ev);
     e.note = ev.note;
     if (ev.accumulation) {
       e.type = EventType::kAccumulation;

@@ -101,6 +101,9 @@ struct EventResult {
   lcs::IndexSet mode;
   std::vector<FrictionMode> friction;  // models with friction: the selected stick / slip modes
   VectorXd impulse;                    // sum of the impulses applied (size k)
+  // Models with friction: the sum of the tangential impulses applied, per
+  // entry of mechanical.friction (empty otherwise).
+  VectorXd friction_impulse;
   bool jumped = false;
   bool accumulation = false;
   double t_star = 0.0;  // extrapolated accumulation time (accumulation only)
@@ -222,6 +225,9 @@ class EventDriven {
   MonitorStart monitor_start(const Phase& phase, const VectorXd& xstart, double t,
                              double h_max) const;
   void fill_friction(Sample& s, const Phase& ph, const VectorXd& xa) const;
+  // An event's tangential impulses and friction modes after (models with
+  // friction only).
+  void set_friction(Event& e, const EventResult& ev) const;
   VectorXd multipliers(const Phase& ph, const VectorXd& xa) const {
     VectorXd u = VectorXd::Zero(k_);
     if (!ph.mode.empty()) {

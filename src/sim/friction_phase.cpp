@@ -211,4 +211,12 @@ void EventDriven::fill_friction(Sample& s, const Phase& ph, const VectorXd& xa) 
               : VectorXd::Zero(static_cast<Eigen::Index>(friction_contacts_.size()));
 }
 
+void EventDriven::set_friction(Event& e, const EventResult& ev) const {
+  const auto nf = static_cast<Eigen::Index>(friction_contacts_.size());
+  if (nf == 0) return;
+  e.friction_impulse = ev.friction_impulse.size() == nf ? ev.friction_impulse : VectorXd::Zero(nf);
+  e.friction_mode_after = ev.friction;
+  e.friction_mode_after.resize(friction_contacts_.size(), FrictionMode::kOpen);
+}
+
 }  // namespace lcsim::sim::detail

@@ -14,6 +14,7 @@ namespace lcsim::sim::detail {
 EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
   EventResult out;
   out.impulse = VectorXd::Zero(k_);
+  out.friction_impulse = VectorXd::Zero(static_cast<Eigen::Index>(friction_contacts_.size()));
   VectorXd xa = xa0;
   const mech::MechanicalModel& m = *model_.mechanical;
   std::vector<int> closed, resting;  // zero gap; zero gap and zero rate
@@ -101,6 +102,10 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
     if (!ir.outcome.empty()) outcome_ = ir.outcome;
     xa.segment(N_, N_) = ir.v_after;
     out.impulse += ir.impulse;
+    if (ir.friction_impulse.size() == k_)
+      for (size_t f = 0; f < friction_contacts_.size(); ++f)
+        out.friction_impulse(static_cast<Eigen::Index>(f)) +=
+            ir.friction_impulse(friction_contacts_[f]);
     out.jumped = true;
     for (int r : in.closed)
       if (ir.impulse(r) > 0.0) {
