@@ -6,8 +6,10 @@
 // chain of `lcsim generate chain`, without its wall spring), a floor y_i >= 0
 // per cart, gravity 9.81 m/s^2 in -y, and per cart the frictional contact
 // {floor_i, tangent e_{x_i}, mu = 0.3}. Start: resting on the floor
-// (y = v_y = 0), x_i = 0.1 (i mod 3) (springs stretched), v_x = 1 m/s: the
-// carts slide, the springs and friction bring some to a stick. Both models
+// (y = v_y = 0), x_i = 0.1 (i mod 3) (springs stretched), and v_x = 1 m/s
+// (second argument 1: every cart slides through the window, friction
+// taking mu g t = 0.6 m/s off) or v_x = 0 (argument 0: every cart sticks,
+// the springs' forces, at most 0.4 N, are inside the cone mu g = 2.9 N). Both models
 // have the same floor contacts, so the same active sets (every cart on the
 // floor); only `friction` differs.
 //
@@ -18,7 +20,8 @@
 // (`plain_s`), the ratio, LCP solves per step of each, the LCP sizes of a
 // step when every cart is on the floor (|A| = n unknowns frictionless,
 // |A| + 2 |F| = 3 n with friction) and the peak resident memory of a
-// process that builds one of the models and runs it (KiB; peak_kib below).
+// process that builds one of the models and runs it (KiB; peak_kib below;
+// sliding runs only).
 // Times: the fastest of the iterations (manual time: each iteration's
 // friction step).
 #include <benchmark/benchmark.h>
@@ -39,7 +42,7 @@ using Eigen::VectorXd;
 constexpr double kG = 9.81, kMu = 0.3, kH = 1e-3;
 constexpr long kSteps = 200;
 
-lcsim::mech::Model planar_chain(int n, bool friction) {
+lcsim::mech::Model planar_chain(int n, bool friction, double vx) {
   using T = Eigen::Triplet<double>;
   lcsim::mech::MechanicalModel m;
   const int N = 2 * n;
@@ -70,7 +73,7 @@ lcsim::mech::Model planar_chain(int n, bool friction) {
   model.initial = VectorXd::Zero(2 * N);
   for (int i = 0; i < n; ++i) {
     model.initial(2 * i) = 0.1 * (i % 3);
-    model.initial(N + 2 * i) = 1.0;
+    model.initial(N + 2 * i) = vx;
   }
   return model;
 }
@@ -131,7 +134,8 @@ double own_peak_kib() {
 
 void BM_MoreauJeanFrictionVsPlain(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
-  const auto plain = planar_chain(n, false), fric = planar_chain(n, true);
+  const double vx = static_cast<double>(state.range(1));
+  const auto plain = planar_chain(n, false, vx), fric = planar_chain(n, true, vx);
   Timed p, f;
   // The fastest of the iterations for each: the machine is shared, and the
   // slower samples are other processes' time.
@@ -142,7 +146,8 @@ void BM_MoreauJeanFrictionVsPlain(benchmark::State& state) {
     fric_s = std::min(fric_s, fs);
     state.SetIterationTime(fs);
   }
-  const double mem_plain = peak_kib(n, false), mem_fric = peak_kib(n, true);
+  const double mem_plain = vx > 0 ? peak_kib(n, false) : 0.0;
+  const double mem_fric = vx > 0 ? peak_kib(n, true) : 0.0;
   const bool ok = p.tr.status == lcsim::sim::RunStatus::kCompleted &&
                   f.tr.status == lcsim::sim::RunStatus::kCompleted;
   state.counters["N_carts"] = n;
@@ -156,22 +161,26 @@ void BM_MoreauJeanFrictionVsPlain(benchmark::State& state) {
   state.counters["peak_plain_KiB"] = mem_plain;
   state.counters["peak_friction_KiB"] = mem_fric;
   state.counters["warnings"] = static_cast<double>(f.tr.warnings.size());
-  state.SetLabel(ok ? "friction step" : p.tr.message + " | " + f.tr.message);
+  state.SetLabel(ok ? (vx > 0 ? "friction step, sliding" : "friction step, sticking")
+                    : p.tr.message + " | " + f.tr.message);
 }
 
 }  // namespace
 
 BENCHMARK(BM_MoreauJeanFrictionVsPlain)
-    ->Arg(100)
-    ->Arg(1000)
-    ->Arg(10000)
+    ->Args({100, 1})
+    ->Args({1000, 1})
+    ->Args({10000, 1})
+    ->Args({100, 0})
+    ->Args({1000, 0})
+    ->Args({10000, 0})
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond)
     ->Iterations(5);
 
 int main(int argc, char** argv) {
   if (argc == 4 && std::string(argv[1]) == "--peak-child") {
-    const auto model = planar_chain(std::stoi(argv[2]), std::string(argv[3]) == "1");
+    const auto model = planar_chain(std::stoi(argv[2]), std::string(argv[3]) == "1", 1.0);
     if (run(model, kSteps).tr.status != lcsim::sim::RunStatus::kCompleted) return 1;
     std::printf("%.0f\n", own_peak_kib());
     return 0;
