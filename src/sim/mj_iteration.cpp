@@ -1,6 +1,6 @@
 // The factored Moreau–Jean iteration matrix W = M + h theta D + h^2 theta^2 K
 // (MjIteration, step_kernels.hpp): dense LLT or sparse LDLT, and the columns
-// W^{-1} E_i' computed on first use, by a local solve where W is sparse.
+// W^{-1} E_i' (and W^{-1} t_f') computed on first use, by a local solve where W is sparse.
 #include <algorithm>
 #include <cmath>
 #include <utility>
@@ -26,10 +26,9 @@ bool MjIteration::factor(const MjOperators& ops, double h, double theta) {
                short_number(h) + " (D or K indefinite?)";
     return false;
   }
-  const SparseCol& E = ops.E_by_columns();
-  Et_ = E.transpose();  // column i = E_i'
-  cols_.assign(ops.constraints(), SparseCol());
-  have_.assign(ops.constraints(), 0);
+  Et_ = ops.rows_transposed();  // column i = E_i', then the tangent rows
+  cols_.assign(static_cast<size_t>(Et_.cols()), SparseCol());
+  have_.assign(static_cast<size_t>(Et_.cols()), 0);
   return true;
 }
 

@@ -57,6 +57,10 @@
 //   does not reach the
 //   tolerance falls back to the pivoting solver when |A| <= kPivotFallbackMax,
 //   else the step keeps the PGS iterate and a warning is counted.
+// - Friction (mj_friction.hpp) follows the same pattern: cached columns
+//   W^{-1} t_f', the Delassus matrix over [E_A; T_F] assembled from them and
+//   kept while A stays, the dense friction LCP (warm-started on the previous
+//   basis) up to pivot_max_active rows, block Gauss–Seidel above.
 #include <algorithm>
 #include <lcsim/lcp/sparse.hpp>
 #include <lcsim/sim/sim.hpp>
@@ -120,7 +124,8 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
   // solve the friction LCP (mj_friction.hpp); the others are the
   // frictionless step below, unchanged.
   std::unique_ptr<MjFriction> friction;
-  if (m.has_friction()) friction = std::make_unique<MjFriction>(m);
+  if (m.has_friction()) friction = std::make_unique<MjFriction>(m, ops);
+  std::string friction_warning;
   VectorXd lambda_T = VectorXd::Zero(m.has_friction() ? k : 0);
   // Mean friction force over the step (N), per entry of m.friction: the
   // samples' u_t.
@@ -219,8 +224,14 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
       if (!f.column(A[a], cols[a]))
         return fail("moreau-jean: iteration matrix too ill-conditioned at h = " + short_number(h));
     if (friction && friction->any_in(A)) {
-      if (!friction->step(f, A, cols, Ev, e, *solver, v_next, z, lambda_T, tr.lcp_solves, failed))
+      if (!friction->step(f, A, cols, Ev, e, *solver, opt.pivot_max_active, v_next, z, lambda_T,
+                          tr.lcp_solves, failed, friction_warning))
         return fail(lcp_failure("moreau-jean", (j - 1) * grid.h, failed));
+      if (!friction_warning.empty()) {
+        tr.warn("pgs-not-converged", (j - 1) * grid.h,
+                friction_warning + " at t = " + short_number((j - 1) * grid.h));
+        friction_warning.clear();
+      }
       for (size_t fi = 0; fi < m.friction.size(); ++fi)
         u_t(static_cast<Eigen::Index>(fi)) = lambda_T(m.friction[fi].contact) / h;
       for (int a = 0; a < na; ++a) {

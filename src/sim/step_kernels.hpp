@@ -63,11 +63,27 @@ class MjOperators {
     Er_.makeCompressed();
     K_.makeCompressed();
     D_.makeCompressed();
+    Gt_ = contact_rows_transposed(m);
   }
   bool sparse() const { return sparse_; }
   int dofs() const { return m_.dofs(); }
   int constraints() const { return m_.num_constraints(); }
   const SparseCol& E_by_columns() const { return Ec_; }
+  // [E; T]' (N x (k + n_F)): column i < k is E_i', column k + f the tangent
+  // row of m.friction[f] (the rows whose W^{-1} columns MjIteration caches).
+  const SparseCol& rows_transposed() const { return Gt_; }
+  static SparseCol contact_rows_transposed(const mech::MechanicalModel& m) {
+    SparseCol Gt = m.E.transpose();
+    Gt.conservativeResize(m.dofs(), m.num_constraints() + static_cast<int>(m.friction.size()));
+    for (size_t f = 0; f < m.friction.size(); ++f) {
+      const VectorXd& t = m.friction[f].tangent;
+      const int col = m.num_constraints() + static_cast<int>(f);
+      for (Eigen::Index r = 0; r < t.size(); ++r)
+        if (t(r) != 0.0) Gt.insert(r, col) = t(r);
+    }
+    Gt.makeCompressed();
+    return Gt;
+  }
   // f - D v - K (q + h theta v): the smooth force of the step. No allocation
   // after the first call (the scratch vector is kept).
   void step_force(const VectorXd& q, const VectorXd& v, double h, double theta,
@@ -96,12 +112,14 @@ class MjOperators {
   SparseCol Ec_;         // E by columns: assembles the active Delassus matrix
   SparseRow Er_;         // E by rows: the gap rates E v
   SparseCol K_, D_;      // compressed copies for add_times
+  SparseCol Gt_;         // [E; T]': normal and tangent rows as columns
   mutable VectorXd qt_;  // step_force scratch: q + h theta v
 };
 
 // The factored iteration matrix W for one step length, and the cached columns
-// W^{-1} E_i' (computed on first use, pruned of entries below
-// kPruneRelative times the largest).
+// W^{-1} E_i' and, for models with friction, W^{-1} t_f' (column k + f;
+// MjOperators::rows_transposed), computed on first use, pruned of entries
+// below kPruneRelative times the largest.
 class MjIteration {
  public:
   static constexpr double kPruneRelative = 1e-17;  // columns keep |x| > this * max|x|
@@ -122,7 +140,8 @@ class MjIteration {
     else
       out = llt_.solve(rhs);
   }
-  // W^{-1} E_i' as an N x 1 sparse column; false if not finite.
+  // W^{-1} E_i' (i < k) or W^{-1} t_{i-k}' as an N x 1 sparse column; false
+  // if not finite.
   bool column(int i, const SparseCol*& out) {
     if (!have_[i] && !compute_column(i)) return false;
     out = &cols_[i];
