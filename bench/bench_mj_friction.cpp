@@ -109,8 +109,8 @@ double per_step(const lcsim::mech::Model& model, Timed& full) {
 // and runs it kSteps steps: this program re-executed with `--peak-child n
 // friction` (main below), which prints its own VmHWM (/proc/self/status;
 // ru_maxrss of a child would include this process's peak, inherited through
-// fork). Counts the model itself, which with friction holds n dense tangent
-// rows of length 2n (mech::FrictionalContact::tangent).
+// fork). Counts the model itself (with friction n sparse tangent rows of one
+// entry each, mech::FrictionalContact::tangent).
 double peak_kib(int n, bool friction) {
   char exe[4096] = {};
   if (readlink("/proc/self/exe", exe, sizeof exe - 1) <= 0) return -1.0;

@@ -59,7 +59,7 @@ mech::FrictionalContact frictional_contact(const py::handle& entry, std::size_t 
   } else {
     c.contact = contact.cast<int>();
   }
-  c.tangent = d["tangent"].cast<VectorXd>();
+  c.tangent = d["tangent"].cast<VectorXd>().sparseView();
   c.mu = d["mu"].cast<double>();
   if (d.contains("velocity")) c.velocity = d["velocity"].cast<double>();
   return c;

@@ -94,10 +94,10 @@ FrictionBlockOf friction_block_of(const mech::Model& model, const Eigen::VectorX
     return refuse(model, "mechanical.E[0] must be c e_n with c > 0 (a floor c q_n + g >= 0)");
   const int t = 1 - n;
   const mech::FrictionalContact& fc = m.friction[0];
-  if (fc.tangent(n) != 0.0 || fc.tangent(t) == 0.0)
+  if (fc.tangent.coeff(n) != 0.0 || fc.tangent.coeff(t) == 0.0)
     return refuse(model, "mechanical.friction[0].tangent must be along coordinate " +
-                             std::to_string(t) + " only (got " + fmt(fc.tangent(0)) + ", " +
-                             fmt(fc.tangent(1)) + ")");
+                             std::to_string(t) + " only (got " + fmt(fc.tangent.coeff(0)) + ", " +
+                             fmt(fc.tangent.coeff(1)) + ")");
   if (std::string why = rigid_block_error(m); !why.empty()) return refuse(model, why);
   if (m.f(t) != 0.0)
     return refuse(model, "mechanical.f[" + std::to_string(t) + "] = " + fmt(m.f(t)) +
@@ -119,7 +119,7 @@ FrictionBlockOf friction_block_of(const mech::Model& model, const Eigen::VectorX
   FrictionBlockOf out;
   FrictionBlock& b = out.block;
   b.mass = m.M.coeff(0, 0);
-  b.mu = fc.mu * std::abs(fc.tangent(t)) / c;  // |s P_T| <= mu |s| / c (c P_N)
+  b.mu = fc.mu * std::abs(fc.tangent.coeff(t)) / c;  // |s P_T| <= mu |s| / c (c P_N)
   b.gravity = -m.f(n) / b.mass;
   b.x0 = x0(t);
   b.v0 = x0(2 + t);

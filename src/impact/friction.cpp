@@ -118,7 +118,7 @@ ClosedFriction closed_friction(const mech::MechanicalModel& m, const IndexSet& c
   c.velocity.resize(nf);
   for (Eigen::Index f = 0; f < nf; ++f) {
     const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(c.index[f])];
-    c.T.row(f) = fc.tangent.transpose();
+    c.T.row(f) = VectorXd(fc.tangent).transpose();
     c.mu(f) = fc.mu;
     c.velocity(f) = fc.velocity;
   }

@@ -83,7 +83,7 @@ std::string model_yaml(const mech::Model& model, const std::string& header) {
   if (m.has_friction()) {
     out << "  friction:\n";
     for (const mech::FrictionalContact& c : m.friction)
-      out << "    - {contact: " << c.contact << ", tangent: " << list(c.tangent)
+      out << "    - {contact: " << c.contact << ", tangent: " << list(VectorXd(c.tangent))
           << ", mu: " << format_number(c.mu)
           << (c.velocity != 0.0 ? ", velocity: " + format_number(c.velocity) : std::string())
           << "}\n";

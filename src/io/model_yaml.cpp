@@ -215,7 +215,7 @@ std::vector<mech::FrictionalContact> parse_friction(const YAML::Node& n,
              "no constraint named '" + text + "' (the constraints: " + join(m.constraints) + ")");
       c.contact = static_cast<int>(it - m.constraints.begin());
     }
-    c.tangent = vector(keys.at("tangent"), source, ikey + ".tangent");
+    c.tangent = vector(keys.at("tangent"), source, ikey + ".tangent").sparseView();
     c.mu = number(keys.at("mu"), source, ikey + ".mu");
     if (keys.count("velocity"))
       c.velocity = number(keys.at("velocity"), source, ikey + ".velocity");

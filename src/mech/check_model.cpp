@@ -76,10 +76,14 @@ std::optional<ModelProblem> check_friction(const MechanicalModel& m) {
       return ModelProblem{at + ".tangent", "expected " + std::to_string(N) + " entries (N = " +
                                                std::to_string(N) + " coordinates, from M) (got " +
                                                std::to_string(c.tangent.size()) + ")"};
-    if (auto bad = non_finite_vector(c.tangent))
-      return ModelProblem{at + ".tangent" + *bad, "not finite"};
-    if (!(c.tangent.cwiseAbs().maxCoeff() > 0.0))
-      return ModelProblem{at + ".tangent", "all zero (it measures no sliding)"};
+    double largest = 0.0;
+    for (Eigen::SparseVector<double>::InnerIterator it(c.tangent); it; ++it) {
+      if (!std::isfinite(it.value()))
+        return ModelProblem{
+            at + ".tangent[" + std::to_string(it.index()) + "] = " + num(it.value()), "not finite"};
+      largest = std::max(largest, std::abs(it.value()));
+    }
+    if (!(largest > 0.0)) return ModelProblem{at + ".tangent", "all zero (it measures no sliding)"};
     if (!std::isfinite(c.mu)) return ModelProblem{at + ".mu", "not finite (got " + num(c.mu) + ")"};
     if (c.mu < 0.0) return ModelProblem{at + ".mu", "must be >= 0 (got " + num(c.mu) + ")"};
     if (!std::isfinite(c.velocity))

@@ -76,10 +76,9 @@ class MjOperators {
     SparseCol Gt = m.E.transpose();
     Gt.conservativeResize(m.dofs(), m.num_constraints() + static_cast<int>(m.friction.size()));
     for (size_t f = 0; f < m.friction.size(); ++f) {
-      const VectorXd& t = m.friction[f].tangent;
       const int col = m.num_constraints() + static_cast<int>(f);
-      for (Eigen::Index r = 0; r < t.size(); ++r)
-        if (t(r) != 0.0) Gt.insert(r, col) = t(r);
+      for (Eigen::SparseVector<double>::InnerIterator it(m.friction[f].tangent); it; ++it)
+        if (it.value() != 0.0) Gt.insert(it.index(), col) = it.value();
     }
     Gt.makeCompressed();
     return Gt;

@@ -119,7 +119,7 @@ TEST(FrictionBox, FollowsTheSemiImplicitEulerRecurrence) {
 // Against the closed form. Stop time: the box sticks at the end of the step
 // in which t* falls, so 0 <= t - t* < h (exactly; 1e-9 h for the time grid's
 // round-off). Here t* = 0.509684 and h = 1e-3 divides 0.51, so the error is
-// 0.51 - t* = 3.16e-4 (measured, docs/friction-bullet.md): bounded by h but
+// 0.51 - t* = 3.16e-4 (measured, docs/friction.md): bounded by h but
 // with no observable rate. Distance: d* - d_h in [v0 h/2 - a h^2/8, v0 h/2]
 // (the recurrence above); measured C = |d - d*| / h = 0.9996 at h = 1e-3 and
 // 1.000 at 1e-4, against v0 / 2 = 1. The bound 1.01 v0 h / 2 allows 1% for
@@ -207,7 +207,7 @@ TEST(FrictionBox, FrictionlessBoxNeverStops) {
 TEST(FrictionBox, ScaledRowsGiveThePhysicalCoefficient) {
   mech::MechanicalModel m = block_mech();
   m.E = Eigen::MatrixXd{{0.0, 2.0}}.sparseView();
-  m.friction[0].tangent = Eigen::Vector2d(0.5, 0.0);
+  m.friction[0].tangent = Eigen::Vector2d(0.5, 0.0).sparseView();
   mech::Model model = model_with(m, Eigen::Vector4d(0, 0, 0.5, 0));
   const FrictionBlockOf of = friction_block_of(model);
   ASSERT_EQ(of.status, Status::kOk) << of.message;
@@ -243,7 +243,7 @@ TEST(FrictionBox, RefusesModelsThatAreNotABlockOnAFloor) {
     m.M = Eigen::MatrixXd::Identity(3, 3).sparseView();
     m.E = Eigen::MatrixXd{{0.0, 1.0, 0.0}}.sparseView();
     m.f = Eigen::Vector3d(0.0, -9.81, 0.0);
-    m.friction[0].tangent = Eigen::Vector3d(1.0, 0.0, 0.0);
+    m.friction[0].tangent = Eigen::Vector3d(1.0, 0.0, 0.0).sparseView();
     Eigen::VectorXd x0 = Eigen::VectorXd::Zero(6);
     cases.push_back({"it has 3 coordinates", model_with(m, x0)});
   }
@@ -269,7 +269,7 @@ TEST(FrictionBox, RefusesModelsThatAreNotABlockOnAFloor) {
   }
   {
     mech::MechanicalModel m = block_mech();
-    m.friction[0].tangent = Eigen::Vector2d(1.0, 1.0);
+    m.friction[0].tangent = Eigen::Vector2d(1.0, 1.0).sparseView();
     cases.push_back({"tangent must be along coordinate 0 only (got 1, 1)", model_with(m)});
   }
   {

@@ -28,10 +28,10 @@ TEST(FrictionYaml, ByIndexAndByName) {
   const auto& f = m.mechanical->friction;
   ASSERT_EQ(f.size(), 2u);
   EXPECT_EQ(f[0].contact, 1);
-  EXPECT_EQ(f[0].tangent, Eigen::Vector2d(0, 1));
+  EXPECT_EQ(Eigen::VectorXd(f[0].tangent), Eigen::Vector2d(0, 1));
   EXPECT_EQ(f[0].mu, 0.5);
   EXPECT_EQ(f[1].contact, 0);
-  EXPECT_EQ(f[1].tangent, Eigen::Vector2d(1, 0.25));
+  EXPECT_EQ(Eigen::VectorXd(f[1].tangent), Eigen::Vector2d(1, 0.25));
   EXPECT_EQ(f[1].mu, 0.0);
 }
 
@@ -45,7 +45,7 @@ TEST(FrictionYaml, WrittenBackAndReadAgain) {
   const mech::Model back = parse_model(text, "back.yaml");
   ASSERT_EQ(back.mechanical->friction.size(), 1u);
   EXPECT_EQ(back.mechanical->friction[0].contact, 1);
-  EXPECT_EQ(back.mechanical->friction[0].tangent, Eigen::Vector2d(0.1, -3));
+  EXPECT_EQ(Eigen::VectorXd(back.mechanical->friction[0].tangent), Eigen::Vector2d(0.1, -3));
   EXPECT_EQ(back.mechanical->friction[0].mu, 0.75);
 }
 
