@@ -64,6 +64,7 @@
 #include <algorithm>
 #include <lcsim/lcp/sparse.hpp>
 #include <lcsim/sim/sim.hpp>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -82,6 +83,18 @@ constexpr double kActivationGap = 0.0;  // predicted gap (model units) at or bel
 constexpr double kPgsTolerance = 1e-13;  // natural residual <= tol * (1 + ||b||_inf)
 constexpr int kPgsMaxSweeps = 5000;
 constexpr int kPivotFallbackMax = 2000;
+
+// A closed frictional contact's mode after a step with velocity v: stick
+// when its sliding velocity is zero to rounding (a stuck velocity is a
+// cancellation of terms of the size of |t| |v|, exact to a few hundred eps
+// of it: 1e-12 of it), else slip along the sliding velocity's sign.
+FrictionMode friction_mode_after_step(const mech::FrictionalContact& fc, const VectorXd& v) {
+  const double s = fc.sliding(v);
+  const double scale = fc.tangent.cwiseAbs().dot(v.cwiseAbs()) + std::abs(fc.velocity);
+  if (std::abs(s) <= 1e-12 * scale + std::numeric_limits<double>::min())
+    return FrictionMode::kStick;
+  return s > 0.0 ? FrictionMode::kSlipPositive : FrictionMode::kSlipNegative;
+}
 
 }  // namespace
 
@@ -130,6 +143,10 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
   // Mean friction force over the step (N), per entry of m.friction: the
   // samples' u_t.
   VectorXd u_t = VectorXd::Zero(static_cast<Eigen::Index>(m.friction.size()));
+  // Their modes over the step (the samples' friction_mode): open unless the
+  // normal impulse is positive; then stick when the sliding velocity at the
+  // step's end is zero to rounding, else slip along its sign.
+  std::vector<FrictionMode> fmode(m.friction.size(), FrictionMode::kOpen);
   OutputSampler sampler(opt.dt_out);
   auto record = [&](double t, const VectorXd& y, const VectorXd& uu, const IndexSet& mode) {
     if (!opt.record_samples) return;
@@ -140,7 +157,10 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     s.u = uu;
     s.y = y;
     s.mode = mode;
-    if (friction) s.u_t = u_t;
+    if (friction) {
+      s.u_t = u_t;
+      s.friction_mode = fmode;
+    }
     tr.record_sample(std::move(s), opt);
   };
   VectorXd y(k);
@@ -210,6 +230,7 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     if (friction) {
       lambda_T.setZero();
       u_t.setZero();
+      std::fill(fmode.begin(), fmode.end(), FrictionMode::kOpen);
     }
     u_set.clear();
     mode.clear();
@@ -232,8 +253,12 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
                 friction_warning + " at t = " + short_number((j - 1) * grid.h));
         friction_warning.clear();
       }
-      for (size_t fi = 0; fi < m.friction.size(); ++fi)
-        u_t(static_cast<Eigen::Index>(fi)) = lambda_T(m.friction[fi].contact) / h;
+      for (size_t fi = 0; fi < m.friction.size(); ++fi) {
+        const mech::FrictionalContact& fc = m.friction[fi];
+        u_t(static_cast<Eigen::Index>(fi)) = lambda_T(fc.contact) / h;
+        if (const int p = pos[static_cast<size_t>(fc.contact)]; p >= 0 && z(p) > 0.0)
+          fmode[fi] = friction_mode_after_step(fc, v_next);
+      }
       for (int a = 0; a < na; ++a) {
         lambda_prev(A[a]) = z(a);
         if (z(a) > 0.0) mode.push_back(A[a]);

@@ -200,6 +200,20 @@ TEST(FrictionMoreauJean, BeltSticksAtT1AndSlipsAtT2) {
   // After the slip, v = v_b cos(omega (t - t2)) to first order (C = 4 as
   // the mass-spring above, speed scale v_b).
   EXPECT_NEAR(tr.final_state(2), vb * std::cos(omega * (m.t_end - t2)), 4 * h * vb * omega);
+  // The samples' friction modes: sliding backwards on the belt (slip-)
+  // before t1 and after t2, stuck in between (away from the switching steps
+  // by the bounds above).
+  int checked = 0;
+  for (const sim::Sample& s : tr.samples) {
+    ASSERT_EQ(s.friction_mode.size(), 1u);
+    const sim::FrictionMode want = s.t > t1 + h && s.t < t2 - 3 * h ? sim::FrictionMode::kStick
+                                   : s.t > 0 && (s.t < t1 - h || s.t > t2 + 3 * h)
+                                       ? sim::FrictionMode::kSlipNegative
+                                       : s.friction_mode[0];  // near a switch: either
+    EXPECT_EQ(s.friction_mode[0], want) << "t = " << s.t;
+    checked += s.t > 0;
+  }
+  EXPECT_GT(checked, 100);
 }
 
 TEST(FrictionRefusal, MethodsWithoutFrictionRefuseIt) {
