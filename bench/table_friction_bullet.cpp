@@ -1,5 +1,5 @@
 // Bullet's friction box beside lcsim's Moreau–Jean on a block sliding on a
-// rough floor (issue 17, docs/friction-bullet.md): stop time and slide
+// rough floor (issue 17, docs/friction.md): stop time and slide
 // distance against the closed form t* = |v0| / (mu g), d = v0^2 / (2 mu g) at
 // h = 1e-2 ... 1e-4, and the observed orders (least-squares slope of
 // log |error| against log h over the step sizes with a nonzero error). Run

@@ -40,7 +40,7 @@
 //   degrees apart whenever the manifold holds fewer than n points: with
 //   n = 8 > 4 at every step, and the diagonal tilts find each corner, so the
 //   bottom face is held at its 4 corners at every step. Measured
-//   (docs/friction-bullet.md): n = 8 gives 4 points at every step and a box
+//   (docs/friction.md): n = 8 gives 4 points at every step and a box
 //   that never tilts; n = 3 or 4 leave it on 1 to 4 points, on one corner for
 //   a step every 0.02 m, where friction below the centre tips it (tilt 0.034
 //   rad at h = 1e-2; it then rocks and does not stop within the horizon).

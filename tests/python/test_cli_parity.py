@@ -30,15 +30,19 @@ def without_wall_time(text):
     return re.sub(r'\n *"wall_time_s": [^\n]*\n', "\n", text)
 
 
-@pytest.mark.parametrize("name", MODELS)
-def test_cli_and_python_agree(name, robots, lcsim_binary, tmp_path):
+CASES = [(name, "default") for name in MODELS] + \
+    [(name, "moreau-jean") for name in MODELS if "friction" in name]
+
+
+@pytest.mark.parametrize("name,how", CASES)
+def test_cli_and_python_agree(name, how, robots, lcsim_binary, tmp_path):
     path = robots / name
     model = lcsim.load(path)
     t_end = min(model.t_end or HORIZON, HORIZON)
     dt_out = t_end / 50
-    # Friction has only Moreau-Jean so far (the exact method refuses it): the
-    # tangential multipliers' CSV columns are compared too.
-    method = ["--method", "moreau-jean", "--h", "1e-3"] if "friction" in name else []
+    # Friction models run twice, exact and Moreau-Jean: the tangential
+    # multipliers' and friction modes' CSV columns are compared too.
+    method = ["--method", "moreau-jean", "--h", "1e-3"] if how == "moreau-jean" else []
     kwargs = {"method": "moreau-jean", "h": 1e-3} if method else {}
     csv_path = tmp_path / "cli.csv"
     cli = subprocess.run([str(lcsim_binary), "simulate", str(path), "--t-end", repr(t_end),
@@ -58,8 +62,9 @@ def test_cli_and_python_agree(name, robots, lcsim_binary, tmp_path):
         assert (tmp_path / "py.csv").read_bytes() == csv_path.read_bytes()
     summary = json.loads(run.to_json())
     assert summary["status"] == run.status
-    if method:
+    if "friction" in name:
         assert run.ok and "ut_" in run.to_csv().splitlines()[0], run.message
+        assert "fm_" in run.to_csv().splitlines()[0]
     assert len(summary["events"]) == len(run.events)
 
 

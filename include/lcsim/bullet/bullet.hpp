@@ -181,7 +181,7 @@ Eigen::MatrixXd multibody_mass_matrix(const urdf::ModelInterface& model,
 // btSequentialImpulseConstraintSolver at a fixed step, against the closed form
 // of a block on a floor (robots/block_on_floor_friction.yaml): from v0 it
 // decelerates at mu g and sticks at t* = |v0| / (mu g) after sliding
-// d = v0^2 / (2 mu g). docs/friction-bullet.md has the measured table.
+// d = v0^2 / (2 mu g). docs/friction.md has the measured table.
 
 #include <lcsim/core/status.hpp>
 #include <limits>
@@ -239,7 +239,7 @@ struct FrictionBoxSettings {
   // n copies of the box tilted towards directions 360/n degrees apart (while
   // the manifold holds fewer than n points: always, for n > 4). 8 finds the
   // 4 corners of the bottom face at every step (measured in
-  // docs/friction-bullet.md; 3 or 4 leave the box on 1 to 4 points). 0: not
+  // docs/friction.md; 3 or 4 leave the box on 1 to 4 points). 0: not
   // called (Bullet's default, one point per step).
   int multipoint_iterations = 8;
   // The box rotates freely (a btBoxShape rigid body); false: angular factor
