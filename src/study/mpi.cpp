@@ -1,10 +1,11 @@
 // Running a study over MPI ranks. Rank 0 opens the journal and hands out the
 // runs it lacks (Dispenser: to the workers in blocks by guided
 // self-scheduling, to itself one at a time). Every rank computes, rank 0 on
-// its one thread: it answers the workers' messages between its own runs, so
-// no second thread competes for its core. Workers send their finished rows
-// (encode_row, one a line) to rank 0, which appends them to the journal and
-// writes the table.
+// its main thread: it answers the workers' messages between its own runs (and
+// a second thread, asleep otherwise, during one of its runs that lasts: see
+// Server::Watch), so that no service thread competes for its core.
+// Workers send their finished rows (encode_row, one a line) to rank 0, which
+// appends them to the journal and writes the table.
 //
 // Messages, all text:
 //   rank 0 -> worker, kBlock: a block (encode_ranges); empty: none is left.
@@ -13,20 +14,23 @@
 //     worker has held rows for kFlushSeconds; kDone: its last rows.
 // Rank 0 sends every worker a block at the start; a worker asks for the next
 // one when half of its block is left, so that the answer (given after rank
-// 0's current run) is there before it runs out. Nobody blocks in an MPI call,
-// which spins a core in OpenMPI: a rank with nothing to do polls with sleeps.
+// 0's current run, or within kWatchPeriod) is there before it runs out. Nobody blocks in an MPI
+// call, which spins a core in OpenMPI: a rank with nothing to do polls with sleeps.
 #include <mpi.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
 #include <deque>
 #include <exception>
 #include <lcsim/study/execute.hpp>
 #include <list>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include "study/collector.hpp"
@@ -44,6 +48,7 @@ constexpr double kFlushSeconds = 0.1;
 // A rank with nothing to do polls after this long, doubling up to the
 // maximum while nothing comes.
 constexpr unsigned kMinSleepMicroseconds = 20, kMaxSleepMicroseconds = 1000;
+constexpr std::chrono::milliseconds kWatchPeriod{10};
 
 using Clock = std::chrono::steady_clock;
 
@@ -51,14 +56,14 @@ using Clock = std::chrono::steady_clock;
 // exception leaves run_study_mpi).
 struct MpiSession {
   MpiSession() {
-    MPI_Init(nullptr, nullptr);
+    MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &threads);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     MPI_Comm_size(MPI_COMM_WORLD, &size);
   }
   ~MpiSession() { MPI_Finalize(); }
   MpiSession(const MpiSession&) = delete;
   MpiSession& operator=(const MpiSession&) = delete;
-  int rank = 0, size = 1;
+  int rank = 0, size = 1, threads = MPI_THREAD_SINGLE;
 };
 
 class Backoff {
@@ -176,29 +181,84 @@ class Worker {
 // workers are still answered so that every rank ends, then it is thrown.
 class Server {
  public:
-  Server(const Study& s, Collector& c, int size) : s_(s), c_(c), d_(c.todo()), size_(size) {}
+  Server(const Study& s, Collector& c, int size, bool watch)
+      : s_(s), c_(c), d_(c.todo()), size_(size), watch_(watch) {}
   void run() {
+    std::unique_lock lock(m_);
     for (int w = 1; w < size_; ++w) reply(w);
+    Watch watch(*this, lock);
     for (Backoff idle;;) {
-      bool served = false;
-      for (std::optional<MPI_Status> st; (st = probe(MPI_ANY_SOURCE, MPI_ANY_TAG)); served = true)
-        handle(*st);
-      out_.test();
+      const bool served = serve();
       if (const auto i = d_.next()) {
-        add(run_one(s_, *i));
+        ++runs_started_;
+        running_ = true;
+        lock.unlock();
+        const Row row = run_one(s_, *i);
+        lock.lock();
+        running_ = false;
+        add(row);
       } else if (done_ == size_ - 1) {
         break;
-      } else if (served) {
-        idle.reset();
       } else {
+        if (served) idle.reset();
+        lock.unlock();
         idle.sleep();
+        lock.lock();
       }
     }
+    lock.unlock();
+    watch.stop();
     out_.drain();
     if (error_) std::rethrow_exception(error_);
   }
 
  private:
+  // While one of rank 0's own runs lasts longer than kWatchPeriod, a second
+  // thread serves the workers every kWatchPeriod, so that a long run does not
+  // leave them waiting for their next block. It sleeps otherwise (a hundred
+  // wake-ups a second). MPI_THREAD_SERIALIZED: both threads call MPI only
+  // holding m_, which the main thread releases during its runs.
+  class Watch {
+   public:
+    Watch(Server& s, std::unique_lock<std::mutex>& lock) : s_(s), lock_(lock) {
+      if (s.watch_) thread_ = std::thread([this] { watch(); });
+    }
+    ~Watch() { stop(); }
+    Watch(const Watch&) = delete;
+    Watch& operator=(const Watch&) = delete;
+    void stop() {
+      if (!thread_.joinable()) return;
+      if (!lock_.owns_lock()) lock_.lock();
+      finished_ = true;
+      lock_.unlock();
+      woken_.notify_one();
+      thread_.join();
+    }
+
+   private:
+    void watch() {
+      std::unique_lock lock(s_.m_);
+      for (std::size_t seen = 0;;) {
+        if (woken_.wait_for(lock, kWatchPeriod, [&] { return finished_; })) return;
+        if (s_.running_ && s_.runs_started_ == seen) s_.serve();
+        seen = s_.runs_started_;
+      }
+    }
+    Server& s_;
+    std::unique_lock<std::mutex>& lock_;
+    bool finished_ = false;
+    std::condition_variable woken_;
+    std::thread thread_;
+  };
+
+  // Answers every message waiting; true if there was one.
+  bool serve() {
+    bool served = false;
+    for (std::optional<MPI_Status> st; (st = probe(MPI_ANY_SOURCE, MPI_ANY_TAG)); served = true)
+      handle(*st);
+    out_.test();
+    return served;
+  }
   void reply(int to) { out_.send(encode_ranges(d_.block(size_)), kBlock, to); }
   void handle(const MPI_Status& st) {
     const std::string text = receive(st);
@@ -229,8 +289,11 @@ class Server {
   Collector& c_;
   Dispenser d_;
   int size_, done_ = 0;
+  bool watch_, running_ = false;
+  std::size_t runs_started_ = 0;
   std::exception_ptr error_;
   Outbox out_;
+  std::mutex m_;
 };
 
 // Rank 0 could not start (it throws why): every worker is told to stop and
@@ -259,7 +322,7 @@ Summary run_study_mpi(const Study& s, const ExecOptions& opt) {
     stop_workers(mpi.size);
     throw;
   }
-  Server(s, *c, mpi.size).run();
+  Server(s, *c, mpi.size, mpi.threads >= MPI_THREAD_SERIALIZED).run();
   return c->finish();
 }
 
