@@ -13,9 +13,10 @@
 //     and a request for the next block; kRows: rows only, sent whenever the
 //     worker has held rows for kFlushSeconds; kDone: its last rows.
 // Rank 0 sends every worker a block at the start; a worker asks for the next
-// one when half of its block is left, so that the answer (given after rank
-// 0's current run, or within kWatchPeriod) is there before it runs out. Nobody blocks in an MPI
-// call, which spins a core in OpenMPI: a rank with nothing to do polls with sleeps.
+// one when half of its block (or kKeepAhead runs) is left, so that the
+// answer (given after rank 0's current run, or within kWatchPeriod) is there
+// before it runs out. Nobody blocks in an MPI call, which spins a core in
+// OpenMPI: a rank with nothing to do polls with sleeps.
 #include <mpi.h>
 #include <unistd.h>
 
@@ -45,6 +46,10 @@ constexpr int kBlock = 1, kRequest = 2, kRows = 3, kDone = 4;
 // A killed study loses the runs in progress and at most this much of each
 // worker's finished work besides.
 constexpr double kFlushSeconds = 0.1;
+// A worker asks for its next block when half of its block is left, or this
+// many runs (the last blocks are single runs, and rank 0 answers only after
+// its current run, which may be slower than the worker's).
+constexpr std::size_t kKeepAhead = 4;
 // A rank with nothing to do polls after this long, doubling up to the
 // maximum while nothing comes.
 constexpr unsigned kMinSleepMicroseconds = 20, kMaxSleepMicroseconds = 1000;
@@ -131,14 +136,13 @@ class Worker {
   void run() {
     take(receive(wait_for(0, kBlock)));
     while (!queue_.empty() || !stopped_) {
+      if (!asked_ && !stopped_ && queue_.size() <= std::max(half_, kKeepAhead)) send(kRequest);
       if (queue_.empty()) {
-        if (!asked_) send(kRequest);
         take(receive(wait_for(0, kBlock)));
         continue;
       }
       const std::size_t i = queue_.front();
       queue_.pop_front();
-      if (!asked_ && !stopped_ && queue_.size() <= half_) send(kRequest);
       rows_ += encode_row(run_one(s_, i)) + '\n';
       if (const auto st = probe(0, kBlock)) take(receive(*st));
       if (std::chrono::duration<double>(Clock::now() - last_sent_).count() >= kFlushSeconds)
