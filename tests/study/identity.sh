@@ -28,6 +28,25 @@ cmp "$dir/serial.csv" "$dir/threads.csv"
 cmp "$dir/serial.csv" "$dir/mpi.csv"
 echo "serial, 2 threads, 3 MPI ranks: identical"
 
+# Rank 0 hands out blocks (docs/study.md): more ranks than runs (2 runs and 1
+# run on 3 ranks: a worker with nothing to do), and a resumed journal that
+# lacks nothing (every worker told to stop at once).
+for n in 1 2; do
+  printf 'model: %s/robots/two_carts.yaml\naxes:\n  - restitution.stop: [%s]\n' \
+    "$src" "$([ $n -eq 1 ] && echo 0.5 || echo 0.5, 1)" > "$dir/few$n.yaml"
+  "$lcsim" study "$dir/few$n.yaml" --out "$dir/few$n-serial.csv" --jobs 1 2>/dev/null
+  mpirun --oversubscribe --allow-run-as-root -np 3 "$lcsim" study "$dir/few$n.yaml" \
+    --out "$dir/few$n-mpi.csv" 2>/dev/null
+  [ "$(wc -l < "$dir/few$n-serial.csv")" -eq $((n + 1)) ]
+  cmp "$dir/few$n-serial.csv" "$dir/few$n-mpi.csv"
+done
+rm "$dir/mpi.csv"
+summary=$(mpirun --oversubscribe --allow-run-as-root -np 3 "$lcsim" study "$study" \
+  --out "$dir/mpi.csv" --resume 2>&1 | tail -1)
+echo "$summary" | grep -q "(80 from the journal, 0 computed)"
+cmp "$dir/serial.csv" "$dir/mpi.csv"
+echo "1 and 2 runs on 3 ranks, a complete journal resumed on 3 ranks: identical"
+
 # 80 runs and a header; a quarter refused (restitution 1.5), the rest completed.
 [ "$(wc -l < "$dir/serial.csv")" -eq 81 ]
 [ "$(grep -c ',1.5,invalid input,' "$dir/serial.csv")" -eq 20 ]

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "study/detail.hpp"
+#include "study/dispenser.hpp"
 #include "study/journal.hpp"
 
 namespace lcsim::study {
@@ -196,6 +197,58 @@ TEST(StudyJournal, ResumeReadsWholeLinesAndRefusesAnotherStudy) {
   ASSERT_EQ(j.rows().size(), 2u);
   EXPECT_EQ(j.rows()[1].index, 5u);
   std::filesystem::remove(path);
+}
+
+TEST(StudyDispenser, GuidedBlocksOfTheIndicesLeft) {
+  // 2000 runs on 2 ranks: blocks of max(1, remaining / 8): 2000 / 8 = 250,
+  // then (2000 - 250 - 1) / 8 = 218 after rank 0 took run 250 for itself.
+  std::vector<std::size_t> fresh(2000);
+  for (std::size_t i = 0; i < fresh.size(); ++i) fresh[i] = i;
+  Dispenser d(fresh);
+  EXPECT_EQ(d.block(2), (std::vector<Range>{{0, 250}}));
+  EXPECT_EQ(d.next(), 250u);
+  EXPECT_EQ(d.block(2), (std::vector<Range>{{251, 218}}));
+  EXPECT_EQ(d.remaining(), 2000u - 250 - 1 - 218);
+  d.stop();
+  EXPECT_EQ(d.next(), std::nullopt);
+  EXPECT_TRUE(d.block(2).empty());
+}
+
+TEST(StudyDispenser, ResumedGapsGiveSeveralRangesAndEveryIndexOnce) {
+  // 16 indices left by a resumed journal, one rank: blocks of 16/4 = 4,
+  // then 12/4 = 3, then (after next()) 8/4 = 2, then single indices.
+  const std::vector<std::size_t> todo = {3, 4, 7, 8, 9, 15, 16, 17, 18, 19, 30, 31, 32, 33, 34, 35};
+  Dispenser d(todo);
+  EXPECT_EQ(d.block(1), (std::vector<Range>{{3, 2}, {7, 2}}));
+  EXPECT_EQ(d.block(1), (std::vector<Range>{{9, 1}, {15, 2}}));
+  EXPECT_EQ(d.next(), 17u);
+  EXPECT_EQ(d.block(1), (std::vector<Range>{{18, 2}}));
+  for (std::size_t i : {30, 31, 32, 33, 34, 35})
+    EXPECT_EQ(d.block(1), (std::vector<Range>{{i, 1}}));
+  EXPECT_TRUE(d.block(1).empty());
+}
+
+TEST(StudyDispenser, MoreRanksThanRunsGetOneEachThenNone) {
+  const std::vector<std::size_t> todo = {0, 1};
+  Dispenser d(todo);
+  EXPECT_EQ(d.block(3), (std::vector<Range>{{0, 1}}));
+  EXPECT_EQ(d.block(3), (std::vector<Range>{{1, 1}}));
+  EXPECT_TRUE(d.block(3).empty());
+  EXPECT_EQ(d.next(), std::nullopt);
+}
+
+TEST(StudyDispenser, BlocksTravelAsTextAndOtherTextIsRefused) {
+  EXPECT_EQ(encode_ranges({{3, 2}, {7, 12}}), "3 2 7 12");
+  EXPECT_EQ(decode_ranges("3 2 7 12"), (std::vector<Range>{{3, 2}, {7, 12}}));
+  EXPECT_EQ(encode_ranges({}), "");
+  EXPECT_EQ(decode_ranges(""), std::vector<Range>{});  // the stop message
+  for (const char* bad : {"3", "3 0", "3  2", "3 2 ", " 3 2", "x 2", "-1 2", "3,2"})
+    EXPECT_EQ(decode_ranges(bad), std::nullopt) << bad;
+  // Rows travel one a line (mpi.cpp): an encoded row never holds a newline.
+  Row r;
+  r.cells = {"a\nb", "c\r\n"};
+  EXPECT_EQ(encode_row(r).find('\n'), std::string::npos);
+  EXPECT_EQ(decode_row(encode_row(r))->cells, r.cells);
 }
 
 TEST(StudyFile, MalformedFilesGiveOneLineErrorsNamingFileKeyAndValue) {
