@@ -60,26 +60,37 @@ TEST(FrictionCli, SimulateRecordsTheFrictionForce) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string csv = lcsim::cli_test::slurp(out);
   std::filesystem::remove(out);
-  ASSERT_EQ(csv.rfind("t,x,y,v_x,v_y,u_floor,y_floor,ut_floor,mode\n", 0), 0u) << csv.substr(0, 80);
+  ASSERT_EQ(csv.rfind("t,x,y,v_x,v_y,u_floor,y_floor,ut_floor,fm_floor,mode\n", 0), 0u)
+      << csv.substr(0, 80);
   std::istringstream rows(csv);
   std::string line;
   std::getline(rows, line);
-  int sliding = 0, stuck = 0;
+  int sliding = 0, stuck = 0, slip_mode = 0, stick_mode = 0;
   double sliding_sum = 0.0;
   while (std::getline(rows, line)) {
-    std::vector<double> v;
+    std::vector<std::string> cell;
     std::istringstream cells(line);
-    for (std::string c; std::getline(cells, c, ',');) v.push_back(c.empty() ? 0.0 : std::stod(c));
-    const double t = v[0], ut = v[7];
+    for (std::string c; std::getline(cells, c, ',');) cell.push_back(c);
+    ASSERT_GE(cell.size(), 9u) << line;
+    const double t = std::stod(cell[0]), ut = cell[7].empty() ? 0.0 : std::stod(cell[7]);
+    // The mode column: slip+ while sliding, stick after; "open" in the
+    // steps the activation rule below leaves the contact out.
+    const std::string& fm = cell[8];
     if (t > 0 && t < 0.5) {
       sliding_sum += ut;
       ++sliding;
+      EXPECT_TRUE(fm == "slip+" || fm == "open") << line;
+      slip_mode += fm == "slip+";
     }
     if (t > 0.52) {
       EXPECT_NEAR(ut, 0.0, 1e-12) << line;
       ++stuck;
+      EXPECT_TRUE(fm == "stick" || fm == "open") << line;
+      stick_mode += fm == "stick";
     }
   }
+  EXPECT_GT(slip_mode, 20);
+  EXPECT_GT(stick_mode, 20);
   // The friction impulse over the sliding steps is -mu m g per step on the
   // whole: a step whose normal rate came out +1e-17 leaves the contact out of
   // the next step's active set (no force there), and the step after catches
