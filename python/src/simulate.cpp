@@ -174,7 +174,8 @@ std::shared_ptr<Run> simulate(const ModelHandle& model, const std::optional<Vect
 }
 
 void bind_event(py::module_& m) {
-  py::class_<sim::Event> e(m, "Event", "An event of a run: an impact, a contact, a release, ...");
+  py::class_<sim::Event> e(
+      m, "Event", "An event of a run: an impact, a contact, a release, a stick, a slip, ...");
   e.def_readonly("t", &sim::Event::t, "Time (s).");
   e.def_property_readonly(
       "type", [](const sim::Event& ev) { return std::string(sim::to_string(ev.type)); },
