@@ -12,6 +12,9 @@
 //   energy_drift   Bullet's (E_final - E_initial) minus the exact run's (J),
 //   max_violation  Bullet's most negative gap,
 //   bullet_solver  which Bullet constraint solver ran.
+// A model with friction must be a block on a floor (bullet::friction_block_of):
+// Bullet's box on a plane runs beside the exact run, and the stick times and
+// slide distances of the closed form, the exact run and Bullet are printed.
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -44,9 +47,47 @@ nlohmann::json num(double x) {
   return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
 }
 
+// A block on a floor with friction: Bullet's box beside the exact run
+// (bullet::compare_friction_box), along the floor.
+void print_friction(const mech::Model& model, const CompareArgs& a,
+                    const bullet::FrictionComparison& c) {
+  const bullet::SlideStop* stops[] = {&c.closed_form, &c.exact, &c.bullet};
+  const char* names[] = {"closed form", "exact run", "bullet"};
+  if (a.json) {
+    nlohmann::json j;
+    j["model"] = model.name;
+    j["h"] = a.h;
+    j["t_end"] = c.block.t_end;
+    j["bullet_scene"] = "friction box";
+    for (int i = 0; i < 3; ++i)
+      j["stop"][names[i]] = {{"time", num(stops[i]->time)}, {"distance", num(stops[i]->distance)}};
+    j["deviation_max"] = c.deviation_max;
+    j["deviation_t"] = c.deviation_t;
+    j["error_final"] = c.error_final;
+    j["max_tilt"] = c.max_tilt;
+    j["min_contact_points"] = c.min_contact_points;
+    j["bullet_version"] = bullet::version_string();
+    j["steps"] = c.steps;
+    std::printf("%s\n", j.dump(2).c_str());
+    return;
+  }
+  std::printf(
+      "model %s, t_end %g, h %g: %s, a box on a plane (sequential impulse, %d iterations)\n",
+      model.name.c_str(), c.block.t_end, a.h, bullet::version_string().c_str(), a.iterations);
+  std::printf("               stick time      slide distance  (NaN: still sliding)\n");
+  for (int i = 0; i < 3; ++i)
+    std::printf("%-14s %-15.9g %-15.9g\n", names[i], stops[i]->time, stops[i]->distance);
+  std::printf("deviation max  %.3e (position and velocity along the floor, at t = %.6g)\n",
+              c.deviation_max, c.deviation_t);
+  std::printf("error final    %.3e\n", c.error_final);
+  std::printf("bullet's box   tilts at most %.3e rad, on at least %d contact points\n", c.max_tilt,
+              c.min_contact_points);
+}
+
 void run_compare(const CompareArgs& a) {
   const mech::Model model = io::load_model(a.model);
-  bullet::check_expressible(model);  // std::invalid_argument naming the constraint: exit 2
+  const bool friction = model.is_mechanical() && !model.mechanical->friction.empty();
+  if (!friction) bullet::check_expressible(model);  // invalid_argument naming it: exit 2
   const Eigen::VectorXd x0 = resolve_initial_state(model, a.model, a.x0);
   sim::Options opt;
   opt.t_end = resolve_horizon(model, a.model, a.t_end_given, a.t_end);
@@ -61,6 +102,16 @@ void run_compare(const CompareArgs& a) {
   const io::ReferenceLaw law = io::reference_law("bullet", opt.impact, model);
   const sim::Trajectory exact = io::run_reference(model, x0, law, opt);
   check_status(exact.status, "compare: the exact event-driven run failed: " + exact.message);
+  if (friction) {
+    bullet::FrictionBoxSettings fs;
+    fs.h = a.h;
+    fs.solver_iterations = a.iterations;
+    const bullet::FrictionComparison c =
+        bullet::compare_friction_box(model, x0, exact, fs, 1e-9 * a.h);
+    check_status(c.status, "compare: " + c.message);
+    print_friction(model, a, c);
+    return;
+  }
   bullet::WorldSettings ws;
   ws.stop_erp = a.stop_erp;
   ws.solver_iterations = a.iterations;

@@ -351,6 +351,52 @@ TEST(FrictionBox, RefusesBadBlocksAndSettings) {
                 "stop_velocity must be finite and >= 0");
 }
 
+// `lcsim compare` on the block (compare_friction_box): the exact run sticks
+// where the closed form does (its stick event is located to rounding:
+// docs/friction.md measures 0 to 4.4e-16 s; 1e-12 allows the sample
+// grid's round-off), Bullet at the end of the step containing t* (as
+// AgreesWithTheClosedFormToFirstOrder). Along the floor the two runs have
+// the same velocities at the step times (Bullet's v_k = v0 - a k h is the
+// exact v(kh)) and positions that part by a h^2 k / 2, growing to the
+// distance error v0 h / 2 at the stop; so the deviation and the final error
+// are that error, within the bounds of the closed-form test.
+TEST(FrictionBox, CompareFrictionBoxBesideTheExactRun) {
+  const mech::Model model = shipped();
+  const double h = 1e-3;
+  sim::Options o;
+  o.dt_out = 5 * h;
+  const sim::Trajectory exact = sim::integrators().make("event")->run(model, model.initial, o);
+  ASSERT_EQ(exact.status, sim::RunStatus::kCompleted) << exact.message;
+  FrictionBoxSettings s;
+  s.h = h;
+  const FrictionComparison c = compare_friction_box(model, model.initial, exact, s, 1e-9 * h);
+  ASSERT_EQ(c.status, Status::kOk) << c.message;
+  EXPECT_NEAR(c.closed_form.time, kStopTime, 1e-15);
+  EXPECT_NEAR(c.closed_form.distance, kDistance, 1e-15);
+  EXPECT_NEAR(c.exact.time, kStopTime, 1e-12);
+  EXPECT_NEAR(c.exact.distance, kDistance, 1e-12);
+  EXPECT_GE(c.bullet.time - kStopTime, -1e-9 * h);
+  EXPECT_LT(c.bullet.time - kStopTime, h);
+  const double lo = kV0 * h / 2 - kMu * kG * h * h / 8 - 1e-9, hi = 1.01 * kV0 * h / 2;
+  EXPECT_GE(c.deviation_max, lo);
+  EXPECT_LE(c.deviation_max, hi);
+  EXPECT_GE(c.error_final, lo);
+  EXPECT_LE(c.error_final, hi);
+  EXPECT_NEAR(c.deviation_t, c.bullet.time, 1e-9);  // the gap is widest at Bullet's stop
+  EXPECT_EQ(c.samples_compared, 201);               // t = 0, 5h, ..., 1 s
+  EXPECT_EQ(c.steps, 1000);
+  EXPECT_EQ(c.min_contact_points, 4);
+  EXPECT_LE(c.max_tilt, 1e-12);  // flat, as ReportsCoulombForcesOnFourPoints measures
+
+  // A frictional model of another shape is refused, naming why.
+  const mech::Model incline =
+      io::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/incline_friction.yaml");
+  const FrictionComparison r = compare_friction_box(incline, incline.initial, exact, s);
+  EXPECT_EQ(r.status, Status::kInvalidInput);
+  EXPECT_NE(r.message.find("is not a block on a floor: mechanical.f[0]"), std::string::npos)
+      << r.message;
+}
+
 TEST(FrictionBox, SlideStopFindsTheLastStartOfRest) {
   // Rests at t = 1, moves again at t = 2, rests for good from t = 3.
   const std::vector<double> t{0, 1, 2, 3, 4}, x{0, 1, 1, 1.5, 1.5}, v{1, 0, 0.5, 0, 0};

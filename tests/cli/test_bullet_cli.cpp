@@ -67,4 +67,25 @@ TEST(BulletCli, CompareRunsOnEveryShippedScene) {
   }
 }
 
+// A block on a rough floor: compare runs Bullet's box beside the exact run
+// and prints the stick times and distances of the closed form, the exact
+// run and Bullet (the figures are asserted in tests/bullet's
+// CompareFrictionBoxBesideTheExactRun; here: what the command prints, and
+// that Bullet sticks within a step h = 1e-2 of the exact t* = 0.5097 s). A
+// frictional model that is not a block on a floor exits 2 with one line.
+TEST(BulletCli, CompareShowsTheFrictionBox) {
+  const auto r = lcsim("compare '" + kRobots + "block_on_floor_friction.yaml' --h 1e-2 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["bullet_scene"], "friction box");
+  const double t_exact = j["stop"]["exact run"]["time"], t_bullet = j["stop"]["bullet"]["time"];
+  EXPECT_NEAR(t_exact, 2.0 / (0.4 * 9.81), 1e-12);
+  EXPECT_GE(t_bullet, t_exact);
+  EXPECT_LT(t_bullet, t_exact + 1e-2);
+  const auto bad = lcsim("compare '" + kRobots + "incline_friction.yaml'");
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_EQ(lcsim::cli_test::count_lines(bad.err), 1) << bad.err;
+  EXPECT_NE(bad.err.find("not a block on a floor"), std::string::npos) << bad.err;
+}
+
 }  // namespace

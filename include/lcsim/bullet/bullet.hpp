@@ -289,4 +289,33 @@ FrictionBoxRun simulate_friction_box(const FrictionBlock& block, const FrictionB
 // a floor).
 FrictionBoxRun simulate_friction_box(const mech::Model& model, const FrictionBoxSettings& s = {});
 
+// `lcsim compare` on a block on a floor: the box run in Bullet beside an
+// exact run of the same model (the tangential coordinate and velocity only;
+// the box's own normal motion and tilt are Bullet's, reported apart).
+struct FrictionComparison {
+  Status status = Status::kOk;  // kInvalidInput / kNumericalFailure, with message
+  std::string message;
+  FrictionBlock block;    // as read from the model (t_end: the exact run's)
+  SlideStop closed_form;  // block.stop_time(), block.slide_distance() (NaN: never sticks)
+  SlideStop exact;        // slide_stop of the exact run's samples
+  SlideStop bullet;       // slide_stop of Bullet's samples
+  // Over Bullet's samples paired in time (within time_tol) with exact
+  // samples: max of |x_b - x| and |v_b - v| along the floor, and where.
+  double deviation_max = 0.0;
+  double deviation_t = 0.0;
+  double error_final = 0.0;  // the same at t_end
+  long samples_compared = 0;
+  double max_tilt = 0.0;       // Bullet's largest rotation of the box (rad)
+  int min_contact_points = 0;  // fewest box-plane points after the first step
+  long steps = 0;              // Bullet steps
+};
+// Reads the block from `model` at x0 (friction_block_of), runs it in Bullet
+// for exact.t_end with `s`, and compares with `exact` (an event-driven run of
+// the same model and x0, sampled on a grid that is a multiple of s.h). Stops
+// use s.stop_velocity on both runs. Not a block on a floor, or bad settings:
+// kInvalidInput naming why; Bullet's failure: its status and message.
+FrictionComparison compare_friction_box(const mech::Model& model, const Eigen::VectorXd& x0,
+                                        const sim::Trajectory& exact,
+                                        const FrictionBoxSettings& s = {}, double time_tol = 1e-9);
+
 }  // namespace lcsim::bullet
