@@ -117,7 +117,7 @@ std::vector<LinearRange> linear_ranges(const Scene& scene, double threshold) {
     for (const double dir : {-1.0, 1.0}) {
       double end = j->type == urdf::Joint::PRISMATIC ? 1.0 : M_PI;
       std::string why = "search";
-      if (j->limits) {
+      if (j->limits && j->type != urdf::Joint::CONTINUOUS) {  // URDF: no limits
         const double lim = dir < 0 ? q0 - j->limits->lower : j->limits->upper - q0;
         if (lim >= 0.0) {
           end = lim;

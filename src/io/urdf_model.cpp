@@ -132,9 +132,9 @@ void check_urdf(const urdf::ModelInterface& m, const std::string& source) {
         fail(source, el + ": <limit>",
              "lower and upper must be finite (got lower=" + num(l.lower) +
                  ", upper=" + num(l.upper) + ")");
-      if (moves(*joint) && joint->type != urdf::Joint::CONTINUOUS && l.lower > l.upper)
-        fail(source, el + ": <limit>",
-             "lower > upper (got lower=" + num(l.lower) + ", upper=" + num(l.upper) + ")");
+      // lower > upper (Bullet's data files use it for "no limit") is refused
+      // only where the limit becomes a stop (scene.cpp): a frozen joint's
+      // limits are never used.
     }
     if (joint->mimic &&
         (!std::isfinite(joint->mimic->multiplier) || !std::isfinite(joint->mimic->offset)))
@@ -176,10 +176,10 @@ Tree make_tree(const urdf::ModelInterface& model, const std::vector<std::string>
   for (std::size_t i = 0; i < joints.size(); ++i) {
     const auto j = model.getJoint(joints[i]);
     if (!j) fail(source, "joint '" + joints[i] + "'", "no such joint in the URDF");
-    if (j->type != urdf::Joint::REVOLUTE && j->type != urdf::Joint::PRISMATIC)
+    if (!moves(*j))
       fail(source, "joint '" + joints[i] + "'",
-           "unsupported type for a simulated joint (only revolute and prismatic joints can be "
-           "simulated; freeze it by leaving it out of the scene)");
+           "unsupported type for a simulated joint (only revolute, continuous and prismatic "
+           "joints can be simulated; freeze it by leaving it out of the scene)");
     t.index[joints[i]] = static_cast<int>(i);
     t.coord.push_back(static_cast<int>(i));
   }
