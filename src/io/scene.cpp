@@ -365,11 +365,20 @@ Scene read_scene(const std::string& yaml_text, const std::string& source) {
     const Eigen::SelfAdjointEigenSolver<MatrixXd> es(lin.M);
     const double eps = std::numeric_limits<double>::epsilon();
     if (es.eigenvalues().minCoeff() <=
-        static_cast<double>(N) * eps * std::abs(es.eigenvalues().maxCoeff()))
+        static_cast<double>(N) * eps * std::abs(es.eigenvalues().maxCoeff())) {
+      // The joints that move along the null direction (its largest
+      // components: a unit vector has one of at least 1/sqrt(N)).
+      const VectorXd v = es.eigenvectors().col(0).cwiseAbs();
+      std::vector<std::string> which;
+      for (Eigen::Index i = 0; i < N; ++i)
+        if (v(i) >= 0.5 * v.maxCoeff())
+          which.push_back("'" + joints[static_cast<std::size_t>(i)] + "'");
       fail(source, "joints",
            "the mass matrix at q0 is not positive definite (smallest eigenvalue " +
-               format_number(es.eigenvalues().minCoeff()) +
-               "); a simulated joint moves no inertia about its axis");
+               format_number(es.eigenvalues().minCoeff()) + ", along joint " + join(which) +
+               "): the joint moves no inertia about its axis (a point mass or massless links on "
+               "the axis)");
+    }
   }
 
   // The initial state: q0 at rest, except the positions and velocities that

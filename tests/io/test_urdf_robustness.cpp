@@ -171,5 +171,23 @@ TEST_F(UrdfRobustness, LinkWithoutInertialIsMassless) {
   EXPECT_NEAR(MatrixXd(s.model.mechanical->M)(0, 0), 0.6, 1e-15);  // as the pendulum above
 }
 
+TEST_F(UrdfRobustness, SingularMassMatrixNamesTheJoint) {
+  // j2 turns a point mass (zero inertia tensor) about a vertical axis
+  // through it, as bullet3's sphere_small_zeroinertia.urdf would: its column
+  // of M is zero, so M is singular along e_j2 and the message names j2 only.
+  const std::string u =
+      "<robot name='pm'><link name='base'/>" + link("a", 1.0, 0.0, 0.1) +
+      "<link name='b'><inertial><mass value='1'/><inertia ixx='0' ixy='0' ixz='0' iyy='0' "
+      "iyz='0' izz='0'/></inertial></link>" +
+      joint("j1", "revolute", "base", "a", limit(-1, 1)) +
+      "<joint name='j2' type='revolute'><parent link='a'/><child link='b'/><axis xyz='0 0 1'/>" +
+      limit(-1, 1) + "</joint></robot>";
+  const std::string e = error(u, "joints: [j1, j2]\n");
+  EXPECT_NE(e.find("s.yaml: joints: the mass matrix at q0 is not positive definite"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("along joint 'j2')"), std::string::npos) << e;
+}
+
 }  // namespace
 }  // namespace lcsim
