@@ -171,6 +171,39 @@ TEST_F(UrdfRobustness, LinkWithoutInertialIsMassless) {
   EXPECT_NEAR(MatrixXd(s.model.mechanical->M)(0, 0), 0.6, 1e-15);  // as the pendulum above
 }
 
+TEST_F(UrdfRobustness, JointCarryingNoMassIsRefused) {
+  // The leaf link 'tip' has no <inertial> and nothing below it: joint t
+  // moves nothing.
+  const std::string u = "<robot name='w'><link name='base'/><link name='tip'/>" +
+                        link("bob", 2.0, 0.5, 0.1) +
+                        joint("j", "revolute", "base", "bob", limit(-1, 1)) +
+                        joint("t", "revolute", "bob", "tip", limit(-1, 1)) + "</robot>";
+  const std::string e = error(u, "joints: [j, t]\n");
+  EXPECT_NE(e.find("r.urdf: link 'tip': moved by joint 't' but it (with every link fixed, frozen "
+                   "or jointed below it) has no <inertial> mass (got total mass 0)"),
+            std::string::npos)
+      << e;
+}
+
+TEST_F(UrdfRobustness, MasslessLinkBetweenSimulatedJoints) {
+  // A two-axis hip as bullet3's humanoid.urdf writes it: joint z turns a
+  // massless link, joint x below it turns the leg (mass 2, centre 0.5 below
+  // the hip, inertia 0.1 about every axis through its centre). At q = 0,
+  // about z the leg's centre is on the axis: M_zz = 0.1; about x as the
+  // pendulum above, M_xx = 0.6; the axes are orthogonal and the centre is
+  // on z, so M_zx = 0. Up to one rounding each (1e-15).
+  const std::string u =
+      "<robot name='h'><link name='base'/><link name='mid'/>" + link("leg", 2.0, 0.5, 0.1) +
+      "<joint name='z' type='revolute'><parent link='base'/><child link='mid'/><axis xyz='0 0 "
+      "1'/>" +
+      limit(-1, 1) + "</joint>" + joint("x", "revolute", "mid", "leg", limit(-1, 1)) + "</robot>";
+  const io::Scene s = load(u, "joints: [z, x]\n");
+  const MatrixXd M = MatrixXd(s.model.mechanical->M);
+  EXPECT_NEAR(M(0, 0), 0.1, 1e-15);
+  EXPECT_NEAR(M(1, 1), 0.6, 1e-15);
+  EXPECT_NEAR(M(0, 1), 0.0, 1e-15);
+}
+
 TEST_F(UrdfRobustness, SingularMassMatrixNamesTheJoint) {
   // j2 turns a point mass (zero inertia tensor) about a vertical axis
   // through it, as bullet3's sphere_small_zeroinertia.urdf would: its column
