@@ -204,6 +204,31 @@ TEST_F(UrdfRobustness, MasslessLinkBetweenSimulatedJoints) {
   EXPECT_NEAR(M(0, 1), 0.0, 1e-15);
 }
 
+TEST_F(UrdfRobustness, GeometryIsNotRead) {
+  // What urdfdom refuses in public robots' geometry, which lcsim never
+  // uses: Bullet's capsule (humanoid.urdf), a mesh scale of four numbers
+  // (racecar_differential.urdf), two materials of one name; a comment
+  // holding an unclosed <visual> tag and a quoted '>' in an attribute must
+  // not confuse the scan.
+  const std::string u =
+      "<?xml version='1.0'?><robot name='g'><material name='white'/><material name='white'/>"
+      "<!-- <visual> --><link name='base'><visual name='a>b'><geometry><mesh filename='x.obj' "
+      "scale='1 1 1 1'/></geometry><material name='white'/></visual></link>"
+      "<link name='bob'><collision><geometry><capsule radius='0.1' length='1'/></geometry>"
+      "</collision><visual/>"
+      "<inertial><origin xyz='0 0 -0.500000'/><mass value='2'/><inertia ixx='0.1' ixy='0' "
+      "ixz='0' iyy='0.1' iyz='0' izz='0.1'/></inertial></link>" +
+      joint("j", "revolute", "base", "bob", limit(-1, 1)) + "</robot>";
+  const io::Scene s = load(u, "joints: [j]\n");
+  EXPECT_NEAR(MatrixXd(s.model.mechanical->M)(0, 0), 0.6, 1e-15);  // the pendulum above
+}
+
+TEST_F(UrdfRobustness, UnclosedVisualIsStillAnError) {
+  const std::string e =
+      error("<robot name='g'><link name='base'><visual></link></robot>", "joints: [j]\n");
+  EXPECT_NE(e.find("r.urdf: not a valid URDF: "), std::string::npos) << e;
+}
+
 TEST_F(UrdfRobustness, SingularMassMatrixNamesTheJoint) {
   // j2 turns a point mass (zero inertia tensor) about a vertical axis
   // through it, as bullet3's sphere_small_zeroinertia.urdf would: its column
