@@ -10,6 +10,7 @@
 #include <lcsim/sim/sim.hpp>
 #include <random>
 
+#include "io/scene_files.hpp"
 #include "support/same_model.hpp"
 
 namespace lcsim {
@@ -228,33 +229,7 @@ TEST(Scene, FrozenJointsAddMassButNoCoordinates) {
 
 // ---- bad input ----
 
-class SceneErrors : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("lcsim_scene_" + std::to_string(std::random_device{}()));
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-  std::string write(const std::string& name, const std::string& text) {
-    const auto p = dir_ / name;
-    std::ofstream(p) << text;
-    return p.string();
-  }
-  // Loads scene text beside `urdf` text; returns the error message.
-  std::string error(const std::string& urdf, const std::string& scene) {
-    if (!urdf.empty()) write("r.urdf", urdf);
-    const std::string path = write("s.yaml", scene);
-    try {
-      io::load_model(path);
-    } catch (const io::InputError& e) {
-      return e.what();
-    }
-    ADD_FAILURE() << "no error for:\n" << scene;
-    return "";
-  }
-  std::filesystem::path dir_;
-};
+using SceneErrors = test_support::SceneFiles;
 
 std::string urdf_with(const std::string& extra_joint_attrs, const std::string& limit,
                       bool inertial = true) {

@@ -5,45 +5,25 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <lcsim/io/io.hpp>
-#include <random>
+
+#include "io/scene_files.hpp"
 
 namespace lcsim {
 namespace {
 
 using Eigen::MatrixXd;
 
-class UrdfRobustness : public ::testing::Test {
+// Scenes below are written with "urdf: r.urdf" in front.
+class UrdfRobustness : public test_support::SceneFiles {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("lcsim_robust_" + std::to_string(std::random_device{}()));
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-  std::string write(const std::string& name, const std::string& text) {
-    const auto p = dir_ / name;
-    std::ofstream(p) << text;
-    return p.string();
-  }
   io::Scene load(const std::string& urdf, const std::string& scene) {
     write("r.urdf", urdf);
     return *io::load_scene_details(write("s.yaml", "urdf: r.urdf\n" + scene));
   }
   std::string error(const std::string& urdf, const std::string& scene) {
-    write("r.urdf", urdf);
-    const std::string path = write("s.yaml", "urdf: r.urdf\n" + scene);
-    try {
-      io::load_model(path);
-    } catch (const io::InputError& e) {
-      return e.what();
-    }
-    ADD_FAILURE() << "no error for:\n" << scene;
-    return "";
+    return SceneFiles::error(urdf, "urdf: r.urdf\n" + scene);
   }
-  std::filesystem::path dir_;
 };
 
 // A link of mass m with its centre l below its joint and rotational inertia
