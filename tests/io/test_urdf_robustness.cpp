@@ -113,6 +113,13 @@ TEST_F(UrdfRobustness, LowerAboveUpperOnAFrozenJointIsUnused) {
 TEST_F(UrdfRobustness, LowerAboveUpperIsSimulatedWithoutStops) {
   const io::Scene s = load(cart_with_unlimited_pendulum(), "joints: [x, {name: p, stops: []}]\n");
   EXPECT_EQ(s.model.mechanical->constraints, (std::vector<std::string>{"x_lower", "x_upper"}));
+  // Nor does the unusable limit bound p's linear range (it used to end at
+  // "limit" upper = 0, the reference position itself).
+  const auto r = io::linear_ranges(s, 0.01);
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_NE(r[1].lower_end, "limit");
+  EXPECT_NE(r[1].upper_end, "limit");
+  EXPECT_GT(r[1].upper, 0.0);
 }
 
 TEST_F(UrdfRobustness, LowerAboveUpperCannotBeAStop) {
