@@ -28,4 +28,10 @@ YAML::Node load_model_root(const std::string& yaml_text, const std::string& sour
 bool is_scene(const YAML::Node& root);
 mech::Model parse_model_root(const YAML::Node& root, const std::string& source);
 
+// URDF text without its <visual>, <collision> and <material> elements
+// (urdf_geometry.cpp): lcsim reads no geometry, and urdfdom refuses a whole
+// robot for an error in one of them (Bullet's capsule or plane geometry, a
+// malformed mesh scale, two materials of one name).
+std::string without_geometry(const std::string& xml);
+
 }  // namespace lcsim::io

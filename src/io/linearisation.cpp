@@ -117,7 +117,9 @@ std::vector<LinearRange> linear_ranges(const Scene& scene, double threshold) {
     for (const double dir : {-1.0, 1.0}) {
       double end = j->type == urdf::Joint::PRISMATIC ? 1.0 : M_PI;
       std::string why = "search";
-      if (j->limits) {
+      // No limit on a continuous joint (URDF ignores it there) nor where
+      // lower > upper (Bullet's "no limit"; scene.cpp refuses it as a stop).
+      if (j->limits && j->type != urdf::Joint::CONTINUOUS && j->limits->lower <= j->limits->upper) {
         const double lim = dir < 0 ? q0 - j->limits->lower : j->limits->upper - q0;
         if (lim >= 0.0) {
           end = lim;

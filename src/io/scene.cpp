@@ -71,21 +71,53 @@ std::vector<std::string> stop_list(const YAML::Node& s, const std::string& sourc
   return st;
 }
 
+// The stops `st` of simulated joint j (entry `key` of joints:). A continuous
+// joint has no limits (URDF ignores lower/upper on it): no stops by
+// default, and asking for one is an error. A limit with lower > upper
+// (Bullet's data files use it for "no limit") cannot be a stop; it is only
+// refused when used, so such a joint can still be frozen or simulated with
+// stops: [].
+void check_stops(const urdf::Joint& j, bool explicit_stops, std::vector<std::string>& st,
+                 const std::string& source, const std::string& key, const std::string& urdf) {
+  if (j.type == urdf::Joint::CONTINUOUS) {
+    if (explicit_stops && !st.empty())
+      fail(source, key + ".stops",
+           "joint '" + j.name + "' is continuous: it has no limits to stop at (write stops: [])");
+    st.clear();
+    return;
+  }
+  if (st.empty()) return;
+  if (!j.limits)
+    fail(source, key, "joint '" + j.name + "' has no <limit> in " + urdf + " (write stops: [])");
+  if (j.limits->lower > j.limits->upper)
+    throw InputError(urdf + ": joint '" + j.name +
+                     "': <limit>: lower > upper (got lower=" + format_number(j.limits->lower) +
+                     ", upper=" + format_number(j.limits->upper) + "), so it cannot be a stop (" +
+                     source + ": " + key + ": write stops: [] to simulate it without stops)");
+}
+
 // The limits of each mimic m of simulated joint `leader` (coordinate i) as
 // stops on the leader through q_m = a q_i + b: lower <= a q_i + b <= upper
 // gives the rows a e_i (gap b - lower) and -a e_i (gap upper - b), named
 // m_lower and m_upper. A row and gap equal to one already present (the
 // Panda's fingers: multiplier 1, equal limits) says nothing new and is not
 // repeated; a mimic with multiplier 0 or no <limit> adds none.
-void add_mimic_stops(const urdf::ModelInterface& um, const std::map<std::string, Mimic>& mimics,
+void add_mimic_stops(const urdf::ModelInterface& um, const std::string& urdf,
+                     const std::string& key, const std::map<std::string, Mimic>& mimics,
                      const std::string& leader, Eigen::Index i, Eigen::Index n,
                      const std::vector<std::string>& which, std::vector<VectorXd>& rows,
                      std::vector<double>& gaps, std::vector<std::string>& names) {
   for (const auto& [name, mm] : mimics) {
     const auto j = um.getJoint(name);
     if (mm.leader != leader || !j->limits || j->type == urdf::Joint::CONTINUOUS ||
-        mm.multiplier == 0.0)
+        mm.multiplier == 0.0 || which.empty())
       continue;
+    if (j->limits->lower > j->limits->upper)
+      throw InputError(urdf + ": joint '" + name +
+                       "': <limit>: lower > upper (got lower=" + format_number(j->limits->lower) +
+                       ", upper=" + format_number(j->limits->upper) +
+                       "), so it cannot be a stop (" + key + ": write mimic_stops: [] to follow '" +
+                       leader + "' without them)");
     for (const auto& s : which) {
       const double sign = s == "lower" ? 1.0 : -1.0;
       VectorXd r = VectorXd::Zero(n);
@@ -139,11 +171,13 @@ Scene read_scene(const std::string& yaml_text, const std::string& source) {
     const std::string k = "joints[" + std::to_string(i) + "]";
     std::string name;
     std::vector<std::string> st{"lower", "upper"}, mst{"lower", "upper"};
+    bool explicit_stops = false;
     if (jn[i].IsMap()) {
       const Keys jk = mapping(jn[i], source, k, {"name", "stops", "mimic_stops"});
       if (!jk.count("name")) fail(source, k + ".name", "missing");
       name = name_of(jk.at("name"), source, k + ".name");
-      if (jk.count("stops")) st = stop_list(jk.at("stops"), source, k + ".stops");
+      explicit_stops = jk.count("stops") > 0;
+      if (explicit_stops) st = stop_list(jk.at("stops"), source, k + ".stops");
       if (jk.count("mimic_stops"))
         mst = stop_list(jk.at("mimic_stops"), source, k + ".mimic_stops");
     } else {
@@ -151,15 +185,15 @@ Scene read_scene(const std::string& yaml_text, const std::string& source) {
     }
     const auto j = um.getJoint(name);
     if (!j) fail(source, k, "no joint '" + name + "' in " + us);
-    if (j->type != urdf::Joint::REVOLUTE && j->type != urdf::Joint::PRISMATIC)
+    if (j->type != urdf::Joint::REVOLUTE && j->type != urdf::Joint::PRISMATIC &&
+        j->type != urdf::Joint::CONTINUOUS)
       fail(source, k,
            "joint '" + name +
-               "' is not revolute or prismatic (only those can be simulated; leave it out to "
-               "freeze it)");
+               "' is not revolute, continuous or prismatic (only those can be simulated; leave "
+               "it out to freeze it)");
     if (std::count(joints.begin(), joints.end(), name))
       fail(source, k, "duplicate joint '" + name + "'");
-    if (!st.empty() && !j->limits)
-      fail(source, k, "joint '" + name + "' has no <limit> in " + us + " (write stops: [])");
+    check_stops(*j, explicit_stops, st, source, k, us);
     joints.push_back(name);
     stops.push_back(st);
     mimic_stops.push_back(mst);
@@ -269,8 +303,8 @@ Scene read_scene(const std::string& yaml_text, const std::string& source) {
       rows.push_back(r);
       m.constraints.push_back(joints[i] + "_" + s);
     }
-    add_mimic_stops(um, mimics, joints[i], static_cast<Eigen::Index>(i), N, mimic_stops[i], rows,
-                    gaps, m.constraints);
+    add_mimic_stops(um, us, source + ": joints[" + std::to_string(i) + "]", mimics, joints[i],
+                    static_cast<Eigen::Index>(i), N, mimic_stops[i], rows, gaps, m.constraints);
   }
   if (keys.count("constraints")) {
     const YAML::Node& cn = keys.at("constraints");
@@ -331,11 +365,20 @@ Scene read_scene(const std::string& yaml_text, const std::string& source) {
     const Eigen::SelfAdjointEigenSolver<MatrixXd> es(lin.M);
     const double eps = std::numeric_limits<double>::epsilon();
     if (es.eigenvalues().minCoeff() <=
-        static_cast<double>(N) * eps * std::abs(es.eigenvalues().maxCoeff()))
+        static_cast<double>(N) * eps * std::abs(es.eigenvalues().maxCoeff())) {
+      // The joints that move along the null direction (its largest
+      // components: a unit vector has one of at least 1/sqrt(N)).
+      const VectorXd v = es.eigenvectors().col(0).cwiseAbs();
+      std::vector<std::string> which;
+      for (Eigen::Index i = 0; i < N; ++i)
+        if (v(i) >= 0.5 * v.maxCoeff())
+          which.push_back("'" + joints[static_cast<std::size_t>(i)] + "'");
       fail(source, "joints",
            "the mass matrix at q0 is not positive definite (smallest eigenvalue " +
-               format_number(es.eigenvalues().minCoeff()) +
-               "); a simulated joint moves no inertia about its axis");
+               format_number(es.eigenvalues().minCoeff()) + ", along joint " + join(which) +
+               "): the joint moves no inertia about its axis (a point mass or massless links on "
+               "the axis)");
+    }
   }
 
   // The initial state: q0 at rest, except the positions and velocities that

@@ -132,9 +132,9 @@ void check_urdf(const urdf::ModelInterface& m, const std::string& source) {
         fail(source, el + ": <limit>",
              "lower and upper must be finite (got lower=" + num(l.lower) +
                  ", upper=" + num(l.upper) + ")");
-      if (moves(*joint) && joint->type != urdf::Joint::CONTINUOUS && l.lower > l.upper)
-        fail(source, el + ": <limit>",
-             "lower > upper (got lower=" + num(l.lower) + ", upper=" + num(l.upper) + ")");
+      // lower > upper (Bullet's data files use it for "no limit") is refused
+      // only where the limit becomes a stop (scene.cpp): a frozen joint's
+      // limits are never used.
     }
     if (joint->mimic &&
         (!std::isfinite(joint->mimic->multiplier) || !std::isfinite(joint->mimic->offset)))
@@ -176,10 +176,10 @@ Tree make_tree(const urdf::ModelInterface& model, const std::vector<std::string>
   for (std::size_t i = 0; i < joints.size(); ++i) {
     const auto j = model.getJoint(joints[i]);
     if (!j) fail(source, "joint '" + joints[i] + "'", "no such joint in the URDF");
-    if (j->type != urdf::Joint::REVOLUTE && j->type != urdf::Joint::PRISMATIC)
+    if (!moves(*j))
       fail(source, "joint '" + joints[i] + "'",
-           "unsupported type for a simulated joint (only revolute and prismatic joints can be "
-           "simulated; freeze it by leaving it out of the scene)");
+           "unsupported type for a simulated joint (only revolute, continuous and prismatic "
+           "joints can be simulated; freeze it by leaving it out of the scene)");
     t.index[joints[i]] = static_cast<int>(i);
     t.coord.push_back(static_cast<int>(i));
   }
@@ -373,7 +373,7 @@ static std::shared_ptr<urdf::ModelInterface> parse_urdf_unfolded(const std::stri
   try {
     const CapturedLog capture;
     try {
-      m = urdf::parseURDF(xml);
+      m = urdf::parseURDF(without_geometry(xml));
     } catch (const std::exception& e) {
       throw InputError(source + ": not a valid URDF: " + one_line(e.what()));
     }
@@ -455,21 +455,29 @@ static std::shared_ptr<const UrdfDynamics::Impl> make_dynamics(
     const std::map<std::string, double>& q0, const Eigen::Vector3d& gravity,
     const std::string& source) {
   Tree t = make_tree(model, joints, source);
-  // A simulated joint must move some mass: its body (its child link, the
-  // links frozen to it and those its mimics move) needs an <inertial> with
-  // mass > 0.
+  // A simulated joint must move some mass: the links it carries (its child
+  // link, the links fixed or frozen to it, those its mimics move, and
+  // everything below them, simulated or not) need an <inertial> with mass
+  // > 0. A massless link between two simulated joints (a hip or shoulder
+  // written as chained revolute joints) is fine: the joint above still
+  // moves the limb below it.
+  std::vector<double> moved(joints.size(), 0.0);
+  for (const auto& [name, o] : t.owner) {
+    const auto link = model.getLink(name);
+    if (o < 0 || !link->inertial) continue;
+    std::set<int> coords;  // each coordinate once, even if it and a mimic both carry the link
+    up(t, o, [&](int b) { coords.insert(t.coord[static_cast<std::size_t>(b)]); });
+    for (int c : coords) moved[static_cast<std::size_t>(c)] += link->inertial->mass;
+  }
   for (std::size_t i = 0; i < joints.size(); ++i) {
-    double mass = 0.0;
-    for (const auto& [name, o] : t.owner)
-      if (o >= 0 && t.coord[static_cast<std::size_t>(o)] == static_cast<int>(i) &&
-          model.getLink(name)->inertial)
-        mass += model.getLink(name)->inertial->mass;
+    const double mass = moved[i];
     if (!(mass > 0.0))
-      fail(source, "link '" + model.getJoint(joints[i])->child_link_name + "'",
-           "moved by joint '" + joints[i] +
-               "' but it (with the links fixed or frozen to it) has no <inertial> mass "
-               "(got total mass " +
-               num(mass) + ")");
+      fail(
+          source, "link '" + model.getJoint(joints[i])->child_link_name + "'",
+          "moved by joint '" + joints[i] +
+              "' but it (with every link fixed, frozen or jointed below it) has no <inertial> mass "
+              "(got total mass " +
+              num(mass) + ")");
   }
   return std::make_shared<const UrdfDynamics::Impl>(UrdfDynamics::Impl{std::move(t), q0, gravity});
 }
