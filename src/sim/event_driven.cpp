@@ -253,6 +253,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     double h_phi = -1.0;
     double h = h_first;
     double t_event = std::numeric_limits<double>::infinity();
+    int trigger = -1;  // the constraint whose monitor gave t_event
     bool event_found = false;
     double next_out = opt_.dt_out > 0 ? (std::floor(t / opt_.dt_out + 1e-9) + 1) * opt_.dt_out
                                       : std::numeric_limits<double>::infinity();
@@ -352,7 +353,10 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
             }
           }
         }
-        if (root < t_event) t_event = root;
+        if (root < t_event) {
+          t_event = root;
+          trigger = mon.constraint;
+        }
       }
       if (std::isfinite(t_event)) {
         event_found = true;
@@ -422,7 +426,8 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
       xa = phase.exp_apply(ev.t_star - t, xa);
       t = ev.t_star;
     }
-    if (const std::string why = livelock.after_event(t, x_minus, xa, old_mode, ev, old_friction);
+    if (const std::string why =
+            livelock.after_event(t, x_minus, xa, old_mode, ev, old_friction, trigger);
         !why.empty()) {
       fail(why);
       tr.status = RunStatus::kEventLimit;

@@ -9,6 +9,8 @@
 #include <cmath>
 #include <lcsim/sim/sim.hpp>
 
+#include "sim/event_driven_detail.hpp"
+
 namespace lcsim {
 namespace {
 
@@ -78,6 +80,26 @@ TEST(GoldenCoupled, RayleighDampingWithoutSpringsHitsTheStopOnTime) {
   EXPECT_LT((tr.final_state - x_T).cwiseAbs().maxCoeff(), 1e-11);
   // Every sample is feasible up to rounding (the bug went to -0.78).
   EXPECT_GT(tr.max_violation, -1e-12);
+}
+
+// The livelock guard names the contact whose monitor stops each phase: events
+// that re-select the same mode with no impulse (a monitor at rounding level
+// giving a root at once, golden seed 176 before 5c95e8e) said "at contacts
+// (none)". 64 such events 1e-9 s apart with no state change (rho = 1, so
+// "quick" is 1e-4 s) must fail naming 'knee' and only it.
+TEST(GoldenCoupled, LivelockNamesTheContactWhoseMonitorStopsThePhase) {
+  sim::detail::LivelockGuard guard(64, 1.0, {"hip", "knee"});
+  sim::detail::EventResult ev;
+  ev.impulse = VectorXd::Zero(2);
+  const VectorXd x = VectorXd::Ones(4);
+  std::string why;
+  // The first call only sets the clock (no event before it to be quick after).
+  for (int i = 0; i < 65 && why.empty(); ++i)
+    why = guard.after_event(0.2 + 1e-9 * i, x, x, {}, ev, {}, /*trigger=*/1);
+  ASSERT_FALSE(why.empty());
+  EXPECT_NE(why.find("at contacts 'knee'"), std::string::npos) << why;
+  EXPECT_EQ(why.find("'hip'"), std::string::npos) << why;
+  EXPECT_EQ(why.find("(none)"), std::string::npos) << why;
 }
 
 }  // namespace
