@@ -212,7 +212,7 @@ class EventDriven {
   EventResult process_mechanical(double t, const VectorXd& xa);
   std::string take_accumulation_limit(int r, double t, double ratio, double t_star,
                                       const VectorXd& gap, const VectorXd& gap_scale,
-                                      VectorXd& xa) const;
+                                      const VectorXd& rate, VectorXd& xa) const;
   EventResult process_lcs(const VectorXd& xa);
   void record(Trajectory& tr, double t, const VectorXd& xa, const Phase& ph) const;
   // A phase's start, per monitor: the noise level of its value, the order m0
