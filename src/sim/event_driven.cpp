@@ -235,6 +235,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     // nonzero derivative is negative (mode selection rules that out up to
     // rounding), only counts once it leaves the noise band.
     std::vector<char> armed(phase.monitors.size());
+    std::vector<char> opening(phase.monitors.size(), 0);  // armed by a positive derivative
     std::vector<double> offset(phase.monitors.size(), 0.0);
     for (size_t j = 0; j < phase.monitors.size(); ++j) {
       const double value = phase.monitors[j].w.dot(xstart);
@@ -242,6 +243,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
         armed[j] = value > 0.0;
       } else if (m0[j] > 0 && d0[j] > 0.0) {
         armed[j] = true;
+        opening[j] = 1;
         offset[j] = value;
       }
     }
@@ -251,6 +253,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     double h_phi = -1.0;
     double h = h_first;
     double t_event = std::numeric_limits<double>::infinity();
+    int trigger = -1;  // the constraint whose monitor gave t_event
     bool event_found = false;
     double next_out = opt_.dt_out > 0 ? (std::floor(t / opt_.dt_out + 1e-9) + 1) * opt_.dt_out
                                       : std::numeric_limits<double>::infinity();
@@ -332,9 +335,10 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
           // within rounding of zero, of either sign: it is a graze, not an
           // impact with a spurious 1e-8 rate.
           const bool touch_shape = fa > 0.0 && da < 0.0 && db >= 0.0 && fb >= -tol_f;
-          if (fb < 0.0 && !touch_shape && fa <= 0.0 && ta == t && offset[j] != 0.0) {
+          if (fb < 0.0 && !touch_shape && fa <= 0.0 && ta == t && opening[j]) {
             // Opened at the phase start and back below zero by tb: the
-            // return lies after a positive stretch that starts at t.
+            // return lies after a positive stretch that starts at t. (Its
+            // start may be exactly zero, a projected gap: offset 0.)
             root = return_after_opening(phi, ta, tb, fb, opt_.event_time_tol);
           } else if (fb < 0.0 && !touch_shape) {
             root = fa <= 0.0 ? ta : brent_root(phi, ta, tb, fa, fb, opt_.event_time_tol);
@@ -349,7 +353,10 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
             }
           }
         }
-        if (root < t_event) t_event = root;
+        if (root < t_event) {
+          t_event = root;
+          trigger = mon.constraint;
+        }
       }
       if (std::isfinite(t_event)) {
         event_found = true;
@@ -419,7 +426,8 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
       xa = phase.exp_apply(ev.t_star - t, xa);
       t = ev.t_star;
     }
-    if (const std::string why = livelock.after_event(t, x_minus, xa, old_mode, ev, old_friction);
+    if (const std::string why =
+            livelock.after_event(t, x_minus, xa, old_mode, ev, old_friction, trigger);
         !why.empty()) {
       fail(why);
       tr.status = RunStatus::kEventLimit;

@@ -131,10 +131,12 @@ class LivelockGuard {
         rho_(rho),
         names_(std::move(names)),
         friction_contacts_(std::move(friction_contacts)) {}
-  // "" while the run makes progress, else the failure message.
+  // "" while the run makes progress, else the failure message. `trigger`:
+  // the constraint whose monitor ended the phase (-1 if none), named with
+  // the contacts whose modes or impulses changed.
   std::string after_event(double t, const VectorXd& x_minus, const VectorXd& x_plus,
                           const lcs::IndexSet& old_mode, const EventResult& ev,
-                          const std::vector<FrictionMode>& old_friction = {});
+                          const std::vector<FrictionMode>& old_friction = {}, int trigger = -1);
 
  private:
   int limit_;
@@ -210,7 +212,7 @@ class EventDriven {
   EventResult process_mechanical(double t, const VectorXd& xa);
   std::string take_accumulation_limit(int r, double t, double ratio, double t_star,
                                       const VectorXd& gap, const VectorXd& gap_scale,
-                                      VectorXd& xa) const;
+                                      const VectorXd& rate, VectorXd& xa) const;
   EventResult process_lcs(const VectorXd& xa);
   void record(Trajectory& tr, double t, const VectorXd& xa, const Phase& ph) const;
   // A phase's start, per monitor: the noise level of its value, the order m0

@@ -11,7 +11,7 @@ namespace lcsim::sim::detail {
 
 std::string LivelockGuard::after_event(double t, const VectorXd& x_minus, const VectorXd& x_plus,
                                        const lcs::IndexSet& old_mode, const EventResult& ev,
-                                       const std::vector<FrictionMode>& old_friction) {
+                                       const std::vector<FrictionMode>& old_friction, int trigger) {
   const double dt = t - last_t_;
   last_t_ = t;
   const double quick = rho_ > 0.0 ? 1e-4 / rho_ : 1e-4 * std::max(1.0, std::abs(t));
@@ -23,6 +23,9 @@ std::string LivelockGuard::after_event(double t, const VectorXd& x_minus, const 
     return "";
   }
   if (streak_++ == 0) since_ = t;
+  // The contact whose monitor stopped the phase: an event that selects the
+  // same mode again without an impulse involves no other.
+  if (trigger >= 0) involved_.insert(trigger);
   for (int r : ev.mode)
     if (std::find(old_mode.begin(), old_mode.end(), r) == old_mode.end()) involved_.insert(r);
   for (int r : old_mode)

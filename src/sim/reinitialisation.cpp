@@ -80,7 +80,7 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
       limit_taken = true;
       out.accumulation = true;
       out.note =
-          take_accumulation_limit(accumulating, t, acc_ratio, out.t_star, gap, gap_scale, xa);
+          take_accumulation_limit(accumulating, t, acc_ratio, out.t_star, gap, gap_scale, rate, xa);
       continue;
     }
     if (!approaching) break;
