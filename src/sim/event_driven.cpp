@@ -67,8 +67,26 @@ std::string friction_note(const std::vector<FrictionMode>& before,
 
 }  // namespace
 
+void EventDriven::check_feasible(double t, const VectorXd& xa) const {
+  if (!model_.is_mechanical() || k_ == 0 || !infeasible_.empty()) return;
+  const VectorXd y = sys_.C * xa;
+  Eigen::Index r = 0;
+  if (y.minCoeff(&r) >= -ldcp_.tol_abs) return;
+  // The state's scale, not the row's own terms: a held contact's gap drifts
+  // with the rounding of the whole state (reinitialisation.cpp).
+  const double terms = sys_.C.row(r).cwiseAbs().sum() * xa.cwiseAbs().maxCoeff();
+  if (y(r) >= -(kSqrtEps * terms + ldcp_.tol_abs)) return;
+  std::ostringstream msg;
+  msg.precision(6);
+  msg << "constraint '" << model_.mechanical->constraints[static_cast<size_t>(r)]
+      << "' is violated at t = " << t << " (gap = " << y(r)
+      << "): the exact method missed a contact event; please report the model";
+  infeasible_ = msg.str();
+}
+
 void EventDriven::record(Trajectory& tr, double t, const VectorXd& xa, const Phase& ph) const {
   tr.max_violation = std::min(tr.max_violation, violation(xa));
+  check_feasible(t, xa);
   if (!opt_.record_samples) return;
   Sample s;
   s.t = t;
@@ -403,7 +421,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
       xa = x_minus;
       break;
     }
-    ev = process_event(t, x_minus);
+    ev = process_event(t, x_minus, phase.mode);
     tr.lcp_solves += ev.lcp_solves;
     for (const auto& w : ev.warnings) tr.warn(w.kind, w.first_t, w.message);
     if (!ev.ok()) {
@@ -472,6 +490,8 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     tr.events.push_back(std::move(e));
     record(tr, t, xa, phase);
   }
+  check_feasible(t, xa);
+  if (tr.status == RunStatus::kCompleted && !infeasible_.empty()) fail(infeasible_);
   tr.final_state = user(xa);
   tr.energy_final = energy(xa);
   return tr;

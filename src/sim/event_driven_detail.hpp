@@ -30,6 +30,7 @@ using Eigen::MatrixXd;
 using Eigen::RowVectorXd;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
+constexpr double kSqrtEps = 0x1p-26;  // sqrt(kEps), exactly
 
 // An upper bound on the spectral radius, ||B^16||^(1/16) ||A|| with
 // B = A/||A|| (Gelfand's formula; 4 squarings, no eigen-decomposition).
@@ -206,10 +207,11 @@ class EventDriven {
                                                const std::vector<int>& zero, const VectorXd& xa,
                                                long& solves) const;
   bool consistent(const Phase& ph, const VectorXd& xa, double t) const;
-  EventResult process_event(double t, const VectorXd& xa);
+  // held: the constraints the ending phase kept closed (empty at the start).
+  EventResult process_event(double t, const VectorXd& xa, const lcs::IndexSet& held = {});
   double accumulation_time(int r, double t, double* ratio) const;
   void project_onto(const std::vector<int>& rows, VectorXd& xa, bool positions) const;
-  EventResult process_mechanical(double t, const VectorXd& xa);
+  EventResult process_mechanical(double t, const VectorXd& xa, const lcs::IndexSet& held);
   std::string take_accumulation_limit(int r, double t, double ratio, double t_star,
                                       const VectorXd& gap, const VectorXd& gap_scale,
                                       const VectorXd& rate, VectorXd& xa) const;
@@ -243,6 +245,10 @@ class EventDriven {
     const VectorXd y = sys_.C * xa;  // D u is zero for mechanical models
     return std::min(0.0, y.minCoeff());
   }
+  // Keeps the first gap of a mechanical model below -(sqrt(eps) |C_r|_1
+  // max|x| + tol_abs) in infeasible_: far beyond the rounding the exact
+  // method leaves (1e-13 relative), far below any missed contact.
+  void check_feasible(double t, const VectorXd& xa) const;
   double energy(const VectorXd& xa) const {
     if (!model_.is_mechanical()) return 0.0;
     return mech::total_energy(*model_.mechanical, xa.head(N_), xa.segment(N_, N_));
@@ -257,7 +263,10 @@ class EventDriven {
   std::unique_ptr<impact::ImpactLaw> impact_;
   lcs::LdcpOptions ldcp_;
   std::vector<std::vector<double>> impact_times_;  // last few impacts per contact
-  lcs::IndexSet ldcp_undetermined_;                // K of the last mode selection
+  // The first recorded state whose gap is negative beyond rounding (a
+  // missed event: the run cannot say "completed"), as a message; "" if none.
+  mutable std::string infeasible_;
+  lcs::IndexSet ldcp_undetermined_;  // K of the last mode selection
   lcs::LdcpData ldcp_data_;
   double rho_A_ = 0.0;  // bound on the spectral radius of the free dynamics
   mutable std::map<lcs::IndexSet, lcs::ModeFeedback> feedback_cache_;

@@ -23,7 +23,6 @@ namespace {
 // contact (tests/sim/test_golden_coupled.cpp). An entry that matters in
 // its row or its column is kept (a stiff spring's 1 against 1e18 in a row).
 VectorXd balancing(const MatrixXd& A) {
-  static const double kSqrtEps = std::sqrt(kEps);
   const int n = static_cast<int>(A.rows());
   VectorXd d = VectorXd::Ones(n);
   const Eigen::ArrayXXd abs = A.array().abs();

@@ -11,7 +11,8 @@
 
 namespace lcsim::sim::detail {
 
-EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
+EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0,
+                                            const lcs::IndexSet& held) {
   EventResult out;
   out.impulse = VectorXd::Zero(k_);
   out.friction_impulse = VectorXd::Zero(static_cast<Eigen::Index>(friction_contacts_.size()));
@@ -38,8 +39,17 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0) {
     for (int r = 0; r < k_; ++r) {
       // Zero within rounding, or within what the event time's resolution
       // (a few ulp of t times the rate) leaves in the gap.
-      const double gap_tol = ldcp_.tol_rel * gap_scale(r) + ldcp_.tol_abs +
-                             16.0 * kEps * std::max(1.0, std::abs(t)) * std::abs(rate(r));
+      double gap_tol = ldcp_.tol_rel * gap_scale(r) + ldcp_.tol_abs +
+                       16.0 * kEps * std::max(1.0, std::abs(t)) * std::abs(rate(r));
+      // A constraint the ending phase held closed has a zero gap by
+      // construction; what it shows is the phase's drift, the rounding of
+      // the whole state carried through the coupling (its own entries may be
+      // tiny: a light finger on a heavy arm, gap 4e-13 at q ~ 1). Closed
+      // within sqrt(eps) of the state's scale, so that the impact law sees
+      // it: left open, an impact elsewhere can drive it into its stop.
+      if (std::find(held.begin(), held.end(), r) != held.end())
+        gap_tol +=
+            kSqrtEps * (m.E.row(r).cwiseAbs().sum() * q.cwiseAbs().maxCoeff() + std::abs(m.g(r)));
       if (gap(r) < -gap_tol) {
         std::ostringstream msg;
         msg.precision(6);
@@ -175,8 +185,8 @@ EventResult EventDriven::process_lcs(const VectorXd& xa0) {
   return out;
 }
 
-EventResult EventDriven::process_event(double t, const VectorXd& xa) {
-  return model_.is_mechanical() ? process_mechanical(t, xa) : process_lcs(xa);
+EventResult EventDriven::process_event(double t, const VectorXd& xa, const lcs::IndexSet& held) {
+  return model_.is_mechanical() ? process_mechanical(t, xa, held) : process_lcs(xa);
 }
 
 }  // namespace lcsim::sim::detail
