@@ -45,6 +45,7 @@
 #include <btBulletDynamicsCommon.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <lcsim/bullet/bullet.hpp>
 #include <memory>
@@ -190,9 +191,27 @@ void warn(sim::Trajectory& tr, const mech::MechanicalModel& m, const MatrixXd& K
     }
 }
 
+// Bullet's multibody has no mimic coupling here: a mimic of a simulated
+// joint is frozen at its q0 (a q0_J + b), where lcsim moves it with its
+// leader (its mass acts through the leader, io::UrdfDynamics).
+void warn_frozen_mimics(sim::Trajectory& tr, const io::Scene& setup,
+                        const mech::MechanicalModel& m) {
+  for (const auto& [name, mm] : io::mimic_joints(*setup.urdf, setup.urdf_source, m.coordinates)) {
+    if (std::find(m.coordinates.begin(), m.coordinates.end(), mm.leader) == m.coordinates.end())
+      continue;
+    tr.warn("bullet-mimic-frozen", 0.0,
+            "bullet: mimic joint '" + name + "' (follows '" + mm.leader + "', multiplier " +
+                fmt(mm.multiplier) +
+                ") is frozen at its q0 in Bullet's multibody: the links below "
+                "it do not move with '" +
+                mm.leader + "', so Bullet's '" + mm.leader +
+                "' lacks their mass and forces and its motion differs from lcsim's");
+  }
+}
+
 }  // namespace
 
-std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m) {
+std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m, const std::string& source) {
   std::vector<JointLimit> out;
   for (int i = 0; i < m.num_constraints(); ++i) {
     std::vector<int> nz;
@@ -200,8 +219,9 @@ std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m) {
       if (m.E.coeff(i, j) != 0.0) nz.push_back(j);
     if (nz.size() != 1)
       throw std::invalid_argument(
-          "bullet: constraint '" + m.constraints[static_cast<std::size_t>(i)] + "' (row " +
-          std::to_string(i) + " of E) involves " + std::to_string(nz.size()) +
+          "bullet: " + (source.empty() ? std::string() : source + ": ") + "constraint '" +
+          m.constraints[static_cast<std::size_t>(i)] + "' (row " + std::to_string(i) +
+          " of E) involves " + std::to_string(nz.size()) +
           " joints: Bullet's multibody expresses only joint limits (one joint each)");
     JointLimit L;
     L.row = i;
@@ -249,6 +269,7 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const io::Scene& se
   const VectorXd f_s = m.f - lin.tau_g - lin.K_g * q_ref;
   const MatrixXd D = MatrixXd(m.D);
   warn(tr, m, K_s, opt);
+  warn_frozen_mimics(tr, setup, m);
 
   VectorXd q = x0.head(N), v = x0.tail(N);
   std::unique_ptr<MbWorld> w;
