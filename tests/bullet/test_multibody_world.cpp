@@ -390,5 +390,21 @@ TEST(MultibodyScene, MimicFingerMovesWithItsLeader) {
   EXPECT_LE(std::abs(r.c.event_shifts[0].shift), 5e-3);
 }
 
+// tests/bullet/data/mimic_pair_scene.yaml: the gear with a negative ratio
+// and an offset (q_follow = -0.7 q_lead + 0.02), one simulated joint. The
+// follower carries two thirds of the mass, so a wrong sign or a frozen
+// follower changes the period at O(1). Measured final errors 1.94e-4
+// (h = 1e-3) and 2.27e-5 (h = 1e-4): 0.19 h and 0.23 h; bound 0.4 h, and a
+// fall of at least 5 per decade (measured 8.6).
+TEST(MultibodyScene, MimicWithNegativeMultiplierAndOffsetIsFirstOrder) {
+  const mech::Model m =
+      io::load_model(std::string(LCSIM_SOURCE_DIR) + "/tests/bullet/data/mimic_pair_scene.yaml");
+  const BulletRun coarse = compare_at(m, m.initial, 1e-3, 1.0);
+  const BulletRun fine = compare_at(m, m.initial, 1e-4, 1.0);
+  EXPECT_LE(coarse.c.error_final, 0.4 * 1e-3);
+  EXPECT_LE(fine.c.error_final, 0.4 * 1e-4);
+  EXPECT_GE(coarse.c.error_final / fine.c.error_final, 5.0);
+}
+
 }  // namespace
 }  // namespace lcsim::bullet
