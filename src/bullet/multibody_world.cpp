@@ -4,7 +4,9 @@
 //
 // What Bullet integrates. The scene's simulated joints are the links of the
 // multibody, every other joint is frozen at the scene's q0 (merged into its
-// parent link), the URDF root is the fixed base. Bullet integrates the
+// parent link), the URDF root is the fixed base. A mimic of a simulated
+// joint is a link of its own geared to its leader (FollowingMimic), as
+// lcsim's model moves it with the leader. Bullet integrates the
 // nonlinear rigid-body dynamics (gravity is the world's, set to the scene's);
 // lcsim's model is their linearisation about q0. The rest of the scene is
 // added as joint torques before every step:
