@@ -6,6 +6,7 @@
 #include <BulletDynamics/Featherstone/btMultiBodyLink.h>
 #include <urdf_model/model.h>
 
+#include <algorithm>
 #include <functional>
 #include <lcsim/bullet/bullet.hpp>
 #include <memory>
@@ -42,16 +43,57 @@ struct Body {
   btMatrix3x3 inertia;     // about com, world axes
   btTransform com_frame;   // world pose of the principal-axes frame at com
   btVector3 principal{0, 0, 0};
+  double speck = 0.0;  // > 0: a massless body's stand-in inertia (give_massless_bodies_a_speck)
 };
+
+// Turns the summed mass moments of each body into its centre of mass. A
+// body whose links carry no mass (a link without <inertial> between two
+// simulated joints, e.g. the yoke of a universal joint) is massless in
+// lcsim's model, where it contributes nothing to M (io counts the mass
+// below a joint). btMultiBody cannot take a zero mass (its centre of mass
+// divides by it, its articulated inertia must be positive), so such a body
+// gets a speck: a mass 1e-9 times the total at its pivot, with an isotropic
+// inertia 1e-9 times the largest link inertia. At the pivot the speck adds no
+// torque about its own joint, and it changes M and the gravity torques by
+// ~1e-9 relative, far below Bullet's O(h) step error: the dynamics stay
+// lcsim's. std::invalid_argument naming the link when no body has mass.
+void give_massless_bodies_a_speck(const urdf::ModelInterface& model,
+                                  std::map<std::string, btTransform>& X,
+                                  std::vector<Body>& bodies) {
+  double total = 0.0, inertia = 0.0;
+  for (const auto& b : bodies) total += b.mass;
+  for (const auto& [name, link] : model.links_)
+    if (link->inertial)
+      inertia = std::max({inertia, link->inertial->ixx, link->inertial->iyy, link->inertial->izz});
+  for (auto& b : bodies) {
+    if (b.mass > 0.0) {
+      b.com /= b.mass;
+      continue;
+    }
+    const auto j = model.getJoint(b.joint);
+    if (!(total > 0.0))
+      throw std::invalid_argument("link '" + j->child_link_name + "' (child of joint '" + b.joint +
+                                  "') and every other simulated link have no mass");
+    b.mass = 1e-9 * total;
+    b.com = X[j->child_link_name].getOrigin();
+    b.speck = 1e-9 * (inertia > 0.0 ? inertia : total);
+  }
+}
 
 }  // namespace
 
 UrdfMultiBody build_urdf_multibody(const urdf::ModelInterface& model,
                                    const std::vector<std::string>& joints,
                                    const std::map<std::string, double>& q0) {
-  const auto q_of = [&](const std::string& name) {
+  // A joint's position: q0, or for a mimic not in q0 a q_leader + b (the
+  // mimic of a simulated joint is frozen there: see warn_frozen_mimics).
+  std::function<double(const std::string&)> q_of = [&](const std::string& name) {
     const auto it = q0.find(name);
-    return it == q0.end() ? 0.0 : it->second;
+    if (it != q0.end()) return it->second;
+    const auto j = model.getJoint(name);
+    if (j && j->mimic && j->type != urdf::Joint::FIXED)
+      return j->mimic->multiplier * q_of(j->mimic->joint_name) + j->mimic->offset;
+    return 0.0;
   };
   const auto simulated_index = [&](const std::string& name) {
     for (std::size_t i = 0; i < joints.size(); ++i)
@@ -97,10 +139,8 @@ UrdfMultiBody build_urdf_multibody(const urdf::ModelInterface& model,
     b.com += link->inertial->mass * Xi.getOrigin();
     b.mass += link->inertial->mass;
   }
-  for (auto& b : bodies) {
-    b.com /= b.mass;
-    b.inertia.setValue(0, 0, 0, 0, 0, 0, 0, 0, 0);
-  }
+  give_massless_bodies_a_speck(model, X, bodies);
+  for (auto& b : bodies) b.inertia.setValue(0, 0, 0, 0, 0, 0, 0, 0, 0);
   for (const auto& [name, own] : owner) {
     const auto link = model.getLink(name);
     if (own < 0 || !link->inertial) continue;
@@ -115,6 +155,8 @@ UrdfMultiBody build_urdf_multibody(const urdf::ModelInterface& model,
                                -d.z() * d.x(), -d.z() * d.y(), d.dot(d) - d.z() * d.z());
     b.inertia = b.inertia + R * I * R.transpose() + parallel * in.mass;
   }
+  for (auto& b : bodies)
+    if (b.speck > 0.0) b.inertia = b.inertia + btMatrix3x3::getIdentity() * b.speck;
   for (auto& b : bodies) {
     btMatrix3x3 rot;
     btMatrix3x3 diag = b.inertia;

@@ -20,15 +20,16 @@ struct JointLimit {
   bool lower = true;
 };
 
-// One JointLimit per row of E; std::invalid_argument naming the first row
-// that involves more or fewer than one coordinate (0-based).
-std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m);
+// One JointLimit per row of E; std::invalid_argument naming the file
+// `source` (the scene's path; omitted when empty) and the first row that
+// involves more or fewer than one coordinate (0-based).
+std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m, const std::string& source);
 
 // "btMultiBody from the URDF, btMultiBodyConstraintSolver (100 iterations), ..."
 std::string multibody_description(const WorldSettings& s);
 
 // The scene run as a btMultiBody (multibody_world.cpp); `limits` from
-// joint_limits_of(*model.mechanical). Never throws.
+// joint_limits_of. Never throws.
 sim::Trajectory simulate_multibody(const mech::Model& model, const io::Scene& setup,
                                    const std::vector<JointLimit>& limits, const Eigen::VectorXd& x0,
                                    const sim::Options& opt, const WorldSettings& s);

@@ -4,7 +4,9 @@
 //
 // What Bullet integrates. The scene's simulated joints are the links of the
 // multibody, every other joint is frozen at the scene's q0 (merged into its
-// parent link), the URDF root is the fixed base. Bullet integrates the
+// parent link), the URDF root is the fixed base. A mimic of a simulated
+// joint is a link of its own geared to its leader (FollowingMimic), as
+// lcsim's model moves it with the leader. Bullet integrates the
 // nonlinear rigid-body dynamics (gravity is the world's, set to the scene's);
 // lcsim's model is their linearisation about q0. The rest of the scene is
 // added as joint torques before every step:
@@ -38,6 +40,7 @@
 // the limits' max impulse (default 100).
 #include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
 #include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
+#include <BulletDynamics/Featherstone/btMultiBodyGearConstraint.h>
 #include <BulletDynamics/Featherstone/btMultiBodyJointLimitConstraint.h>
 #include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
 #include <BulletDynamics/Featherstone/btMultiBodyMLCPConstraintSolver.h>
@@ -45,6 +48,7 @@
 #include <btBulletDynamicsCommon.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <lcsim/bullet/bullet.hpp>
 #include <memory>
@@ -63,6 +67,27 @@ using Eigen::VectorXd;
 
 std::string fmt(double x) { return sim::short_number(x); }
 
+// A mimic joint m of a simulated joint J (coordinate `leader`), q_m = a q_J + b:
+// a link of its own in Bullet, tied to J's by a gear constraint.
+struct FollowingMimic {
+  std::string joint;
+  int leader = 0;
+  double a = 1.0, b = 0.0;
+  int link = 0;  // Bullet link
+};
+
+// The mimics of `coordinates` in the URDF (io::mimic_joints, chains resolved).
+std::vector<FollowingMimic> following_mimics(const io::Scene& setup,
+                                             const std::vector<std::string>& coordinates) {
+  std::vector<FollowingMimic> out;
+  for (const auto& [name, mm] : io::mimic_joints(*setup.urdf, setup.urdf_source, coordinates)) {
+    const auto it = std::find(coordinates.begin(), coordinates.end(), mm.leader);
+    if (it == coordinates.end()) continue;  // frozen with its frozen leader
+    out.push_back({name, static_cast<int>(it - coordinates.begin()), mm.multiplier, mm.offset, 0});
+  }
+  return out;
+}
+
 // Members in construction order, so that destruction runs limits ->
 // colliders -> multibody -> world -> solvers.
 struct MbWorld {
@@ -76,17 +101,25 @@ struct MbWorld {
   UrdfMultiBody mb;
   std::vector<std::unique_ptr<btMultiBodyLinkCollider>> colliders;
   std::vector<std::unique_ptr<btMultiBodyJointLimitConstraint>> limits;
+  std::vector<FollowingMimic> mimics;
+  std::vector<std::unique_ptr<btMultiBodyGearConstraint>> gears;  // one per mimic
   ~MbWorld() {
+    for (auto& c : gears) world->removeMultiBodyConstraint(c.get());
     for (auto& c : limits) world->removeMultiBodyConstraint(c.get());
     for (auto& c : colliders) world->removeCollisionObject(c.get());
     if (mb.body) world->removeMultiBody(mb.body.get());
   }
 };
 
-void set_state(btMultiBody& b, const UrdfMultiBody& mb, const VectorXd& q, const VectorXd& v) {
+void set_state(btMultiBody& b, const UrdfMultiBody& mb, const std::vector<FollowingMimic>& mimics,
+               const VectorXd& q, const VectorXd& v) {
   for (int c = 0; c < q.size(); ++c) {
     b.setJointPos(mb.link[static_cast<std::size_t>(c)], q(c));
     b.setJointVel(mb.link[static_cast<std::size_t>(c)], v(c));
+  }
+  for (const FollowingMimic& f : mimics) {
+    b.setJointPos(f.link, f.a * q(f.leader) + f.b);
+    b.setJointVel(f.link, f.a * v(f.leader));
   }
   btAlignedObjectArray<btQuaternion> world_to_local;
   btAlignedObjectArray<btVector3> local_origin;
@@ -122,7 +155,12 @@ std::unique_ptr<MbWorld> build(const io::Scene& setup, const mech::MechanicalMod
   info.m_leastSquaresResidualThreshold = 0.0;
   info.m_solverMode = SOLVER_USE_WARMSTARTING | SOLVER_SIMD;  // no articulated warm start
 
-  w->mb = build_urdf_multibody(*setup.urdf, m.coordinates, setup.q0);
+  w->mimics = following_mimics(setup, m.coordinates);
+  std::vector<std::string> moving = m.coordinates;
+  for (const FollowingMimic& f : w->mimics) moving.push_back(f.joint);
+  w->mb = build_urdf_multibody(*setup.urdf, moving, setup.q0);
+  for (std::size_t i = 0; i < w->mimics.size(); ++i)
+    w->mimics[i].link = w->mb.link[m.coordinates.size() + i];
   btMultiBody& b = *w->mb.body;
   b.setLinearDamping(0);
   b.setAngularDamping(0);
@@ -143,7 +181,22 @@ std::unique_ptr<MbWorld> build(const io::Scene& setup, const mech::MechanicalMod
     b.getLink(i).m_collider = col.get();
     w->colliders.push_back(std::move(col));
   }
-  set_state(b, w->mb, q0, v0);
+  set_state(b, w->mb, w->mimics, q0, v0);
+  // The gear's row is v_m + r v_J = 0 (Jacobian 1 on link A, r on link B):
+  // r = -a. ERP 0: no position correction; the velocity equality, solved
+  // every step, keeps q_m - a q_J at b up to the solver's residual.
+  for (const FollowingMimic& f : w->mimics) {
+    const int leader = w->mb.link[static_cast<std::size_t>(f.leader)];
+    auto g = std::make_unique<btMultiBodyGearConstraint>(
+        &b, f.link, &b, leader, btVector3(0, 0, 0), btVector3(0, 0, 0), btMatrix3x3::getIdentity(),
+        btMatrix3x3::getIdentity());
+    g->setGearRatio(-f.a);
+    g->setErp(0.0);
+    g->finalizeMultiDof();
+    g->setMaxAppliedImpulse(1e30);
+    w->world->addMultiBodyConstraint(g.get());
+    w->gears.push_back(std::move(g));
+  }
   for (const JointLimit& L : limits) {
     const double lo = L.lower ? L.bound : L.bound - s.limit_range;
     const double hi = L.lower ? L.bound + s.limit_range : L.bound;
@@ -192,7 +245,7 @@ void warn(sim::Trajectory& tr, const mech::MechanicalModel& m, const MatrixXd& K
 
 }  // namespace
 
-std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m) {
+std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m, const std::string& source) {
   std::vector<JointLimit> out;
   for (int i = 0; i < m.num_constraints(); ++i) {
     std::vector<int> nz;
@@ -200,8 +253,9 @@ std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m) {
       if (m.E.coeff(i, j) != 0.0) nz.push_back(j);
     if (nz.size() != 1)
       throw std::invalid_argument(
-          "bullet: constraint '" + m.constraints[static_cast<std::size_t>(i)] + "' (row " +
-          std::to_string(i) + " of E) involves " + std::to_string(nz.size()) +
+          "bullet: " + (source.empty() ? std::string() : source + ": ") + "constraint '" +
+          m.constraints[static_cast<std::size_t>(i)] + "' (row " + std::to_string(i) +
+          " of E) involves " + std::to_string(nz.size()) +
           " joints: Bullet's multibody expresses only joint limits (one joint each)");
     JointLimit L;
     L.row = i;

@@ -23,13 +23,16 @@ struct UrdfMultiBody {
 };
 
 // A fixed-base btMultiBody (base at the URDF root, identity pose) with one
-// link per simulated joint in `joints` (revolute or prismatic), every other
-// joint frozen at q0 (positions by joint name, 0 where not given) and its
-// child merged into the parent body (mass, centre of mass and inertia
-// combined, principal axes by Bullet's Jacobi diagonalisation). Links sit at
-// the COM in principal axes. Joint positions set to q0, velocities 0,
-// damping 0; everything else at Bullet's defaults. std::invalid_argument if a
-// simulated joint is not in the tree.
+// link per simulated joint in `joints` (prismatic, else revolute: continuous
+// joints too), every other joint frozen at q0 (positions by joint name; a
+// mimic not named at a q_leader + b; 0 otherwise) and its child merged into
+// the parent body (mass, centre of mass and inertia combined, principal axes
+// by Bullet's Jacobi diagonalisation). Links sit at the COM in principal
+// axes; a body without mass gets a 1e-9 speck at its pivot
+// (give_massless_bodies_a_speck in multibody.cpp). Joint positions set to
+// q0, velocities 0, damping 0; everything else at Bullet's defaults.
+// std::invalid_argument if a simulated joint is not in the tree, or no
+// simulated body has mass.
 UrdfMultiBody build_urdf_multibody(const urdf::ModelInterface& model,
                                    const std::vector<std::string>& joints,
                                    const std::map<std::string, double>& q0);

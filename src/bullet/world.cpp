@@ -251,7 +251,7 @@ Plan plan_of(const mech::Model& model, const WorldSettings& s) {
     return p;
   }
   try {
-    p.joint_limits = joint_limits_of(*model.mechanical);
+    p.joint_limits = joint_limits_of(*model.mechanical, model.source);
     p.scene = std::move(setup);
     return p;
   } catch (const std::invalid_argument& not_limits) {
