@@ -10,6 +10,7 @@
 #include <lcsim/sim/sim.hpp>
 #include <random>
 
+#include "io/scene_files.hpp"
 #include "support/same_model.hpp"
 
 namespace lcsim {
@@ -34,18 +35,14 @@ const char* kPendulum =
 
 double e_pendulum(double th) { return std::abs(th - std::sin(th)) / std::abs(th); }
 
-class Linearisation : public ::testing::Test {
+class Linearisation : public test_support::SceneFiles {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("lcsim_lin_" + std::to_string(std::random_device{}()));
-    std::filesystem::create_directories(dir_);
-    std::ofstream(dir_ / "p.urdf") << kPendulum;
-    std::ofstream(dir_ / "s.yaml") << "urdf: p.urdf\njoints: [{name: swing, stops: []}]\n";
-    scene_ = *io::load_scene_details(dir_ / "s.yaml");
+    SceneFiles::SetUp();
+    write("p.urdf", kPendulum);
+    scene_ = *io::load_scene_details(
+        write("s.yaml", "urdf: p.urdf\njoints: [{name: swing, stops: []}]\n"));
   }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-  std::filesystem::path dir_;
   io::Scene scene_;
 };
 

@@ -9,6 +9,7 @@
 #include <lcsim/io/io.hpp>
 #include <random>
 
+#include "io/scene_files.hpp"
 #include "support/same_model.hpp"
 
 namespace lcsim {
@@ -19,30 +20,14 @@ using Eigen::VectorXd;
 
 const std::string kRobots = std::string(LCSIM_SOURCE_DIR) + "/robots/";
 
-// A scene directory in /tmp holding r.urdf and s.yaml.
-class Mimic : public ::testing::Test {
+// A scene directory in /tmp holding r.urdf and s.yaml (SceneFiles' error()
+// loads the same way).
+class Mimic : public test_support::SceneFiles {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("lcsim_mimic_" + std::to_string(std::random_device{}()));
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
   mech::Model load(const std::string& urdf, const std::string& scene) {
-    std::ofstream(dir_ / "r.urdf") << urdf;
-    std::ofstream(dir_ / "s.yaml") << scene;
-    return io::load_model(dir_ / "s.yaml");
+    write("r.urdf", urdf);
+    return io::load_model(write("s.yaml", scene));
   }
-  std::string error(const std::string& urdf, const std::string& scene) {
-    try {
-      load(urdf, scene);
-    } catch (const io::InputError& e) {
-      return e.what();
-    }
-    ADD_FAILURE() << "no error for:\n" << scene;
-    return "";
-  }
-  std::filesystem::path dir_;
 };
 
 const char* kInertia = "<inertia ixx='0.003' ixy='0' ixz='0' iyy='0.002' iyz='0' izz='0.004'/>";
