@@ -16,7 +16,6 @@ namespace lcsim::bullet {
 // release when constraints were only lost, else a contact), max_violation,
 // steps, lcp_solves, energies (of the model at Bullet's states).
 
-
 class RunRecorder {
  public:
   // Records the sample at t = 0.

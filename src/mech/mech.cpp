@@ -95,8 +95,8 @@ VectorXd project_feasible(const MechanicalModel& m, const VectorXd& q) {
     if (!r.ok())
       throw std::invalid_argument(
           "cannot project the initial state onto E q + g >= 0: the constraints " +
-          std::string("admit no configuration (LCP ") + std::string(lcp::to_string(r.status, "solved")) +
-          ")");
+          std::string("admit no configuration (LCP ") +
+          std::string(lcp::to_string(r.status, "solved")) + ")");
     p = q + MinvEt * r.z;
   }
   return p;
