@@ -123,8 +123,11 @@ namespace lcsim::io {
 
 // Parses a URDF file with urdfdom and checks what lcsim relies on: finite
 // numbers in every <origin>, <axis>, <inertial>, <limit> and <dynamics>;
-// masses >= 0; non-zero axes on revolute and prismatic joints; lower <= upper.
-// InputError names the file, the element and the value.
+// masses >= 0; non-zero axes on revolute, continuous and prismatic joints.
+// <visual>, <collision> and <material> are dropped unread (no geometry is
+// used). A <limit> with lower > upper is no limit; a scene refuses it only
+// where it would become a stop. InputError names the file, the element and
+// the value.
 std::shared_ptr<urdf::ModelInterface> load_urdf(const std::filesystem::path& path);
 // The same from URDF text; `source` names it in messages.
 std::shared_ptr<urdf::ModelInterface> parse_urdf(const std::string& xml, const std::string& source);
