@@ -211,7 +211,7 @@ Projection projection(const Lcs& sys, const IndexSet& I) {
 
   // Lemma 3.3.3 (3): autonomous iff V ⊕ T = R^n and Ker [L; N] = {0}.
   MatrixXd LN(n + m, m);
-  LN << q.L, q.N;
+  if (m > 0) LN << q.L, q.N;  // m = 0: no data (a comma initialiser would offset a null pointer)
   const int ker_dim = static_cast<int>(kernel(LN, data_tolerance(q)).cols());
 
   bool direct_sum = V.cols() + T.cols() == n;
