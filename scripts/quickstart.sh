@@ -89,65 +89,61 @@ assert run.ok and run.events[0].type == "impact", run.message
 print("lcsim: the installed Python package imports and runs:", lcsim.__file__)
 ' "$pkg/prefix")
 
-  # 3. The suite under AddressSanitizer + UndefinedBehaviorSanitizer
-  #    (g++, -O1 with line tables: quicker to build than -O2 -g, and ASan's
-  #    reports keep their file:line). Any report fails the run: UBSan is built
-  #    with -fno-sanitize-recover, ASan halts on its first error.
+  # 3. The suite under AddressSanitizer + UndefinedBehaviorSanitizer, and
+  # 4. the libFuzzer targets of fuzz/, from one clang build (`build-san/`,
+  #    -O1 with line tables: quicker to build than -O2 -g, and the reports
+  #    keep their file:line). The libraries are compiled once, instrumented
+  #    for both (ASan + UBSan + libFuzzer's coverage, LCSIM_FUZZ); the test
+  #    executables link the sanitizers, the fuzz programs libFuzzer's main.
+  #    Two builds (g++ for the tests, clang for the fuzzers) compiled the
+  #    libraries and the CLI twice, about half of each build's CPU time (the
+  #    clean-clone CI run took 44 min with two). Any report fails the run:
+  #    UBSan is built with -fno-sanitize-recover, ASan halts on its first
+  #    error.
   #    Built: the test executables of the library layers and of the command
   #    line (its bad-input tests are the sanitizers' best prey); not
   #    test_bullet (Bullet's scenes, checked in step 1; Bullet itself is not
   #    instrumented, and lcsim's Bullet code still runs under ASan through
-  #    test_cli's bullet runs) nor test_extremes (stress runs of the integrators
-  #    whose code the layer tests cover, again run in step 1). Measured
-  #    (CPU user time of one -O1 -g1 ASan+UBSan compile of each file, flags
-  #    from build-asan/compile_commands.json, /usr/bin/time -f %U; the
-  #    libraries are shared by all, so the test files are what a subset saves):
-  #    extremes/test_time_stepping_extremes.cpp 75 s,
-  #    extremes/test_event_driven_extremes.cpp 65 s,
-  #    bullet/test_multibody_world.cpp 45 s, bullet/test_world.cpp 14 s,
-  #    against lcp/solvers_test.cpp 28 s, sim/test_coupled_contacts.cpp 31 s,
-  #    cli/test_bad_input.cpp 13 s: the two extremes files and five bullet
-  #    files are among the heaviest to instrument, plus two ASan links.
+  #    test_cli's bullet runs) nor test_extremes (stress runs of the
+  #    integrators whose code the layer tests cover, again run in step 1):
+  #    they are among the heaviest files to instrument (g++ -O1 ASan, CPU s:
+  #    test_time_stepping_extremes.cpp 75, test_event_driven_extremes.cpp 65,
+  #    test_multibody_world.cpp 45, against 13 to 31 for the layer tests).
   export ASAN_OPTIONS=halt_on_error=1:abort_on_error=1:detect_leaks=1:strict_string_checks=1
   export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
   # Third-party leaks only (urdfdom on cyclic URDFs), each explained there.
   export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp:print_suppressions=0"
-  cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DLCSIM_SANITIZE=ON -DLCSIM_BUILD_BENCH=OFF \
-    -DLCSIM_TESTS="lcp;lcs;mech;impact;sim;io;cli"
-  cmake --build build-asan -j"$jobs"
-  ctest --test-dir build-asan --output-on-failure -j"$jobs"
-
-  # 4. The libFuzzer targets in fuzz/ (clang; ASan + UBSan + coverage), each
-  #    run for LCSIM_FUZZ_SECONDS (default 30) on a copy of its seed corpus
-  #    fuzz/corpus/<target>/, the targets side by side. A crash, a sanitizer
-  #    report, an escaping exception or a broken invariant fails the run; the
-  #    input is kept in build-fuzz/artifacts/.
-  cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  cmake -S . -B build-san -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DLCSIM_FUZZ=ON \
-    -DLCSIM_BUILD_TESTS=OFF -DLCSIM_BUILD_BENCH=OFF
+    -DLCSIM_BUILD_BENCH=OFF -DLCSIM_TESTS="lcp;lcs;mech;impact;sim;io;cli"
+  cmake --build build-san -j"$jobs"
+  ctest --test-dir build-san --output-on-failure -j"$jobs"
+
+  #    The fuzz targets, each run for LCSIM_FUZZ_SECONDS (default 30) on a
+  #    copy of its seed corpus fuzz/corpus/<target>/, side by side. A crash,
+  #    a sanitizer report, an escaping exception or a broken invariant fails
+  #    the run; the input is kept in build-san/artifacts/.
   targets=()
   for src in fuzz/fuzz_*.cpp; do targets+=("$(basename "$src" .cpp)"); done
-  cmake --build build-fuzz -j"$jobs" --target "${targets[@]}"
-  mkdir -p build-fuzz/artifacts
+  mkdir -p build-san/artifacts
   pids=()
   for t in "${targets[@]}"; do
-    rm -rf "build-fuzz/corpus/$t" && mkdir -p "build-fuzz/corpus/$t"
-    cp fuzz/corpus/"$t"/* "build-fuzz/corpus/$t/"
-    "./build-fuzz/fuzz/$t" "build-fuzz/corpus/$t" -max_total_time="${LCSIM_FUZZ_SECONDS:-30}" \
+    rm -rf "build-san/corpus/$t" && mkdir -p "build-san/corpus/$t"
+    cp fuzz/corpus/"$t"/* "build-san/corpus/$t/"
+    "./build-san/fuzz/$t" "build-san/corpus/$t" -max_total_time="${LCSIM_FUZZ_SECONDS:-30}" \
       -rss_limit_mb=2048 -timeout=20 -max_len=4096 -print_final_stats=1 \
-      -artifact_prefix="build-fuzz/artifacts/$t-" >"build-fuzz/$t.log" 2>&1 &
+      -artifact_prefix="build-san/artifacts/$t-" >"build-san/$t.log" 2>&1 &
     pids+=($!)
   done
   failed=0
   for i in "${!targets[@]}"; do
     if wait "${pids[$i]}"; then
       echo "lcsim: ${targets[$i]}: $(grep -m1 -o 'stat::number_of_executed_units: *[0-9]*' \
-        "build-fuzz/${targets[$i]}.log" | grep -o '[0-9]*$') inputs, no failure"
+        "build-san/${targets[$i]}.log" | grep -o '[0-9]*$') inputs, no failure"
     else
       failed=1
-      echo "lcsim: ${targets[$i]} FAILED; the end of build-fuzz/${targets[$i]}.log:" >&2
-      tail -n 60 "build-fuzz/${targets[$i]}.log" >&2
+      echo "lcsim: ${targets[$i]} FAILED; the end of build-san/${targets[$i]}.log:" >&2
+      tail -n 60 "build-san/${targets[$i]}.log" >&2
     fi
   done
   exit "$failed"
