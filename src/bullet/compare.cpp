@@ -5,6 +5,8 @@
 #include <limits>
 #include <tuple>
 
+#include "bullet/paired_samples.hpp"
+
 namespace lcsim::bullet {
 
 namespace {
@@ -49,20 +51,13 @@ Comparison compare_trajectories(const sim::Trajectory& exact, const sim::Traject
   c.deviation_t = other.t_end;
 
   // Both sample lists are sorted by time; pair samples within time_tol.
-  size_t e = 0;
-  for (const auto& s : other.samples) {
-    while (e < exact.samples.size() && exact.samples[e].t < s.t - time_tol) ++e;
-    double best = std::numeric_limits<double>::infinity();
-    for (size_t j = e; j < exact.samples.size() && exact.samples[j].t <= s.t + time_tol; ++j)
-      if (exact.samples[j].x.size() == s.x.size())
-        best = std::min(best, (s.x - exact.samples[j].x).cwiseAbs().maxCoeff());
-    if (!std::isfinite(best)) continue;
-    ++c.samples_compared;
-    if (best > c.deviation_max) {
-      c.deviation_max = best;
-      c.deviation_t = s.t;
-    }
-  }
+  detail::deviation_over(
+      exact.samples, other.samples, time_tol,
+      [](const sim::Sample& s, const sim::Sample& x) {
+        return x.x.size() == s.x.size() ? (s.x - x.x).cwiseAbs().maxCoeff()
+                                        : std::numeric_limits<double>::infinity();
+      },
+      c.deviation_max, c.deviation_t, c.samples_compared);
 
   // Event shifts: each exact switch, in time order, matched with the other
   // run's switch of the same constraint and direction nearest in time and not

@@ -5,6 +5,8 @@
 #include <lcsim/bullet/bullet.hpp>
 #include <limits>
 
+#include "bullet/paired_samples.hpp"
+
 namespace lcsim::bullet {
 
 namespace {
@@ -22,25 +24,16 @@ SlideStop exact_stop(const sim::Trajectory& exact, int it, double v_tol) {
 }
 
 // Deviation along the floor over Bullet's samples paired in time with the
-// exact run's (at a jump of the exact run the nearer state counts).
+// exact run's (detail::deviation_over), and at t_end.
 void deviation(const sim::Trajectory& exact, const FrictionBoxRun& run, int it, double time_tol,
                FrictionComparison& c) {
   const Eigen::Index n = exact.samples.front().x.size() / 2;
-  std::size_t e = 0;
-  for (const FrictionBoxSample& b : run.samples) {
-    while (e < exact.samples.size() && exact.samples[e].t < b.t - time_tol) ++e;
-    double best = std::numeric_limits<double>::infinity();
-    for (std::size_t j = e; j < exact.samples.size() && exact.samples[j].t <= b.t + time_tol; ++j) {
-      const Eigen::VectorXd& x = exact.samples[j].x;
-      best = std::min(best, std::max(std::abs(b.x - x(it)), std::abs(b.v - x(n + it))));
-    }
-    if (!std::isfinite(best)) continue;
-    ++c.samples_compared;
-    if (best > c.deviation_max) {
-      c.deviation_max = best;
-      c.deviation_t = b.t;
-    }
-  }
+  detail::deviation_over(
+      exact.samples, run.samples, time_tol,
+      [&](const FrictionBoxSample& b, const sim::Sample& x) {
+        return std::max(std::abs(b.x - x.x(it)), std::abs(b.v - x.x(n + it)));
+      },
+      c.deviation_max, c.deviation_t, c.samples_compared);
   const Eigen::VectorXd& xf = exact.final_state;
   const FrictionBoxSample& bf = run.samples.back();
   c.error_final = std::max(std::abs(bf.x - xf(it)), std::abs(bf.v - xf(n + it)));
