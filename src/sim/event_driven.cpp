@@ -67,9 +67,8 @@ std::string friction_note(const std::vector<FrictionMode>& before,
 
 }  // namespace
 
-void EventDriven::check_feasible(double t, const VectorXd& xa) const {
+void EventDriven::check_feasible(double t, const VectorXd& xa, const VectorXd& y) const {
   if (!model_.is_mechanical() || k_ == 0 || !infeasible_.empty()) return;
-  const VectorXd y = sys_.C * xa;
   Eigen::Index r = 0;
   if (y.minCoeff(&r) >= -ldcp_.tol_abs) return;
   // The state's scale, not the row's own terms: a held contact's gap drifts
@@ -85,8 +84,11 @@ void EventDriven::check_feasible(double t, const VectorXd& xa) const {
 }
 
 void EventDriven::record(Trajectory& tr, double t, const VectorXd& xa, const Phase& ph) const {
-  tr.max_violation = std::min(tr.max_violation, violation(xa));
-  check_feasible(t, xa);
+  if (k_ > 0) {
+    const VectorXd gaps = sys_.C * xa;  // D u is zero for mechanical models
+    tr.max_violation = std::min(tr.max_violation, std::min(0.0, gaps.minCoeff()));
+    check_feasible(t, xa, gaps);
+  }
   if (!opt_.record_samples) return;
   Sample s;
   s.t = t;
@@ -490,7 +492,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     tr.events.push_back(std::move(e));
     record(tr, t, xa, phase);
   }
-  check_feasible(t, xa);
+  if (k_ > 0) check_feasible(t, xa, sys_.C * xa);
   if (tr.status == RunStatus::kCompleted && !infeasible_.empty()) fail(infeasible_);
   tr.final_state = user(xa);
   tr.energy_final = energy(xa);

@@ -240,15 +240,11 @@ class EventDriven {
     }
     return u;
   }
-  double violation(const VectorXd& xa) const {
-    if (k_ == 0) return 0.0;
-    const VectorXd y = sys_.C * xa;  // D u is zero for mechanical models
-    return std::min(0.0, y.minCoeff());
-  }
   // Keeps the first gap of a mechanical model below -(sqrt(eps) |C_r|_1
   // max|x| + tol_abs) in infeasible_: far beyond the rounding the exact
-  // method leaves (1e-13 relative), far below any missed contact.
-  void check_feasible(double t, const VectorXd& xa) const;
+  // method leaves (1e-13 relative), far below any missed contact. `gaps`:
+  // C xa (k_ > 0).
+  void check_feasible(double t, const VectorXd& xa, const VectorXd& gaps) const;
   double energy(const VectorXd& xa) const {
     if (!model_.is_mechanical()) return 0.0;
     return mech::total_energy(*model_.mechanical, xa.head(N_), xa.segment(N_, N_));
