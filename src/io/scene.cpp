@@ -71,6 +71,15 @@ std::vector<std::string> stop_list(const YAML::Node& s, const std::string& sourc
   return st;
 }
 
+// A <limit> with lower > upper used as a stop: the error, naming the URDF,
+// the joint and both values, with `hint` (where to write what instead).
+[[noreturn]] void refuse_reversed_limit(const std::string& urdf, const urdf::Joint& j,
+                                        const std::string& hint) {
+  throw InputError(urdf + ": joint '" + j.name + "': <limit>: lower > upper (got lower=" +
+                   format_number(j.limits->lower) + ", upper=" + format_number(j.limits->upper) +
+                   "), so it cannot be a stop (" + hint + ")");
+}
+
 // The stops `st` of simulated joint j (entry `key` of joints:). A continuous
 // joint has no limits (URDF ignores lower/upper on it): no stops by
 // default, and asking for one is an error. A limit with lower > upper
@@ -90,10 +99,8 @@ void check_stops(const urdf::Joint& j, bool explicit_stops, std::vector<std::str
   if (!j.limits)
     fail(source, key, "joint '" + j.name + "' has no <limit> in " + urdf + " (write stops: [])");
   if (j.limits->lower > j.limits->upper)
-    throw InputError(urdf + ": joint '" + j.name +
-                     "': <limit>: lower > upper (got lower=" + format_number(j.limits->lower) +
-                     ", upper=" + format_number(j.limits->upper) + "), so it cannot be a stop (" +
-                     source + ": " + key + ": write stops: [] to simulate it without stops)");
+    refuse_reversed_limit(urdf, j,
+                          source + ": " + key + ": write stops: [] to simulate it without stops");
 }
 
 // The limits of each mimic m of simulated joint `leader` (coordinate i) as
@@ -113,11 +120,8 @@ void add_mimic_stops(const urdf::ModelInterface& um, const std::string& urdf,
         mm.multiplier == 0.0 || which.empty())
       continue;
     if (j->limits->lower > j->limits->upper)
-      throw InputError(urdf + ": joint '" + name +
-                       "': <limit>: lower > upper (got lower=" + format_number(j->limits->lower) +
-                       ", upper=" + format_number(j->limits->upper) +
-                       "), so it cannot be a stop (" + key + ": write mimic_stops: [] to follow '" +
-                       leader + "' without them)");
+      refuse_reversed_limit(
+          urdf, *j, key + ": write mimic_stops: [] to follow '" + leader + "' without them");
     for (const auto& s : which) {
       const double sign = s == "lower" ? 1.0 : -1.0;
       VectorXd r = VectorXd::Zero(n);
