@@ -19,7 +19,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-matplotlib
   pybind11-dev python3-pybind11 python3-numpy python3-scipy python3-pytest python3-hypothesis
-  clang libclang-rt-14-dev
+  clang libclang-rt-14-dev clang-format
   libsiconos-kernel-dev libsiconos-numerics-dev python3-siconos
   libopenmpi-dev openmpi-bin
 )
@@ -36,8 +36,12 @@ if ((${#missing[@]})); then
 fi
 
 jobs=$(nproc 2>/dev/null || echo 2)
+# ccache, when installed, serves the objects of an unchanged source from an
+# earlier build (it is not installed here: a fresh machine builds everything).
+launcher=()
+if command -v ccache >/dev/null 2>&1; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DLCSIM_WERROR=ON \
-  -DPython3_EXECUTABLE=/usr/bin/python3
+  -DPython3_EXECUTABLE=/usr/bin/python3 "${launcher[@]}"
 cmake --build build -j"$jobs"
 
 if [ "$what" = demo ]; then
@@ -113,7 +117,7 @@ print("lcsim: the installed Python package imports and runs:", lcsim.__file__)
   export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
   # Third-party leaks only (urdfdom on cyclic URDFs), each explained there.
   export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp:print_suppressions=0"
-  cmake -S . -B build-san -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  cmake -S . -B build-san -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo "${launcher[@]}" \
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DLCSIM_FUZZ=ON \
     -DLCSIM_BUILD_BENCH=OFF -DLCSIM_TESTS="lcp;lcs;mech;impact;sim;io;cli"
   cmake --build build-san -j"$jobs"

@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Snapshot of every output a refactoring must keep byte for byte (the house
+# issue): for each shipped model and scene in robots/, `simulate --json` (less
+# wall_time_s), the CSV of `simulate --out`, `analyze --json` (less timings),
+# for each method that accepts the model, and `impacts --json` at the model's
+# initial state where it is mechanical.
+#
+#   tests/house/snapshot_outputs.sh LCSIM_BINARY OUT_DIR     # one snapshot
+#   diff -r OUT_BEFORE OUT_AFTER                             # compare two
+#
+# A command that refuses a model (exit 2) or fails (exit 3) is recorded with
+# its exit status and its message, so a change in what is refused shows too.
+set -uo pipefail
+bin=$(realpath "$1")
+out=$2
+src=$(cd "$(dirname "$0")/../.." && pwd)
+mkdir -p "$out"
+strip_timing() { /usr/bin/python3 -c '
+import json, sys
+def strip(x):
+    if isinstance(x, dict):
+        return {k: strip(v) for k, v in x.items() if k not in ("wall_time_s", "cpu_time_s")}
+    if isinstance(x, list):
+        return [strip(v) for v in x]
+    return x
+try:
+    print(json.dumps(strip(json.load(sys.stdin)), indent=1, sort_keys=True))
+except ValueError:
+    print("(not JSON)")
+'; }
+run() {  # run NAME CMD...: stdout (timings stripped when JSON), stderr, exit status
+  local name=$1
+  shift
+  "$@" >"$out/$name.raw" 2>"$out/$name.err"
+  echo "exit $?" >>"$out/$name.err"
+  if [[ $name == *.json ]]; then
+    strip_timing <"$out/$name.raw" >"$out/$name"
+  else  # text: the wall time and the output folder differ from run to run
+    sed -E -e 's/wall time [0-9.e+-]+ ?m?s/wall time (timing)/g' -e "s#$out/#OUT/#g" \
+      "$out/$name.raw" >"$out/$name"
+  fi
+  rm -f "$out/$name.raw"
+}
+cd "$src"
+for model in robots/*.yaml; do
+  m=$(basename "$model" .yaml)
+  [ "$m" = lcp_example ] && { run "$m.lcp.json" "$bin" lcp "$model" --json; continue; }
+  run "$m.analyze.json" "$bin" analyze "$model" --json
+  for method in event euler moreau-jean bullet; do
+    run "$m.$method.json" "$bin" simulate "$model" --method "$method" --json --no-progress
+    run "$m.$method.txt" "$bin" simulate "$model" --method "$method" --out "$out/$m.$method.csv" \
+      --no-progress
+  done
+done
+echo "snapshot_outputs: $(ls "$out" | wc -l) files in $out"
