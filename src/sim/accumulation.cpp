@@ -146,8 +146,10 @@ void EventDriven::project_onto(const std::vector<int>& rows, VectorXd& xa, bool 
 }
 
 // The limit of an accumulation at contact r. The contacts that take part
-// are r and those with an impact since the first of r's last impacts that are
-// open by at most 1e-6 of their gap's scale plus twice what their rate
+// are r and those with an impact since the first impact of the evidence
+// (tail.since) that are open by at most 1e-6 of their gap's scale plus
+// tol_abs (a closed gap of 1e-27 at a corner through q = 0 is its own
+// scale: left out, the partner kept bouncing) plus twice what their rate
 // covers in the remaining tail t_star - t: with impacts alternating in a
 // corner the partner is open by its bounce amplitude, ~ tail |rate| (3.2e-6
 // with a tail of 9e-7 s and |rate| 3.9 on golden seed 318: left open, the
@@ -167,7 +169,7 @@ std::string EventDriven::take_accumulation_limit(int r, double t, const Geometri
     const auto& h = impact_times_[s];
     const bool took_part = s == r || (!h.empty() && h.back().t >= since);
     const double bounce = 2.0 * std::abs(rate(s)) * std::max(0.0, t_star - t);
-    if (!took_part || gap(s) > 1e-6 * gap_scale(s) + bounce) continue;
+    if (!took_part || gap(s) > 1e-6 * gap_scale(s) + ldcp_.tol_abs + bounce) continue;
     names += (names.empty() ? "'" : ", '") + model_.mechanical->constraints[s] + "'";
     joined.push_back(s);
   }
