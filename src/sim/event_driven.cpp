@@ -281,7 +281,7 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
         opt_.dt_out > 0 ? k_out * opt_.dt_out : std::numeric_limits<double>::infinity();
     auto advance_out = [&] { next_out = ++k_out * opt_.dt_out; };
     GridSampler sampler(phase, t, xstart, opt_.dt_out,
-                        step_exp(phase, opt_.dt_out > 0 ? opt_.dt_out : 1.0));
+                        [&]() -> StepExp& { return step_exp(phase, opt_.dt_out); });
     auto state_at = [&](double tt) -> VectorXd {
       return phase.D.cwiseProduct(phase.expv(tt - t, xstart));
     };

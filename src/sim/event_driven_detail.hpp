@@ -17,6 +17,7 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
+#include <functional>
 #include <lcsim/sim/sim.hpp>
 #include <limits>
 #include <map>
@@ -118,8 +119,11 @@ struct StepExp {
 // evaluated from the phase start (state_at in event_driven.cpp).
 class GridSampler {
  public:
-  GridSampler(const Phase& ph, double t0, const VectorXd& z0, double dt, StepExp& step)
-      : ph_(ph), t0_(t0), z0_(z0), dt_(dt), step_(step) {}
+  // fetch: the mode's StepExp, asked for at the phase's second sample (a
+  // phase sampled once, or not at all, never copies Ab into the cache).
+  GridSampler(const Phase& ph, double t0, const VectorXd& z0, double dt,
+              std::function<StepExp&()> fetch)
+      : ph_(ph), t0_(t0), z0_(z0), dt_(dt), fetch_(std::move(fetch)) {}
   // The state (unbalanced, augmented) at grid time t: stepped from the last
   // sample when t is the grid point after it, else from the phase start.
   VectorXd at(double t);
@@ -130,7 +134,8 @@ class GridSampler {
   double t0_;
   const VectorXd& z0_;
   double dt_;
-  StepExp& step_;
+  std::function<StepExp&()> fetch_;
+  StepExp* step_ = nullptr;
   VectorXd z_;      // the last sample (balanced); empty before the first
   double t_ = 0.0;  // its time
 };

@@ -40,18 +40,20 @@ StepExp& EventDriven::step_exp(const Phase& phase, double dt) {
 }
 
 VectorXd GridSampler::step(const VectorXd& z) {
-  if (step_.E.size() == 0) {
+  if (!step_) step_ = &fetch_();  // first step of this phase
+  StepExp& step = *step_;
+  if (step.E.size() == 0) {
     const double n = static_cast<double>(ph_.Ab.rows());
     const double action = action_flops(ph_, dt_);
-    const bool form = ph_.dense_exp() || (action > 2.0 * n * n &&
-                                          step_.action_flops + action >= dense_flops(ph_, dt_));
+    const bool form = ph_.dense_exp() ||
+                      (action > 2.0 * n * n && step.action_flops + action >= dense_flops(ph_, dt_));
     if (!form) {
-      step_.action_flops += action;
+      step.action_flops += action;
       return ph_.expv(dt_, z);
     }
-    step_.E = (ph_.Ab * dt_).exp();
+    step.E = (ph_.Ab * dt_).exp();
   }
-  return step_.E * z;
+  return step.E * z;
 }
 
 VectorXd GridSampler::at(double t) {
