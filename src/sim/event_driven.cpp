@@ -275,8 +275,13 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     double t_event = std::numeric_limits<double>::infinity();
     int trigger = -1;  // the constraint whose monitor gave t_event
     bool event_found = false;
-    double next_out = opt_.dt_out > 0 ? (std::floor(t / opt_.dt_out + 1e-9) + 1) * opt_.dt_out
-                                      : std::numeric_limits<double>::infinity();
+    // Output grid k dt_out (not a running sum, whose rounding accumulates).
+    double k_out = opt_.dt_out > 0 ? std::floor(t / opt_.dt_out + 1e-9) + 1 : 0.0;
+    double next_out =
+        opt_.dt_out > 0 ? k_out * opt_.dt_out : std::numeric_limits<double>::infinity();
+    auto advance_out = [&] { next_out = ++k_out * opt_.dt_out; };
+    GridSampler sampler(phase, t, xstart, opt_.dt_out,
+                        [&]() -> StepExp& { return step_exp(phase, opt_.dt_out); });
     auto state_at = [&](double tt) -> VectorXd {
       return phase.D.cwiseProduct(phase.expv(tt - t, xstart));
     };
@@ -383,8 +388,8 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
       } else {
         // Exact output samples inside (ta, tb].
         while (next_out <= tb && next_out < t_end) {
-          record(tr, next_out, state_at(next_out), phase);
-          next_out += opt_.dt_out;
+          record(tr, next_out, sampler.at(next_out), phase);
+          advance_out();
         }
         ta = tb;
         xa_a = xa_b;
@@ -401,8 +406,8 @@ Trajectory EventDriven::run(const VectorXd& x0_user) {
     }
     // Output samples before the event.
     while (next_out < t_event) {
-      record(tr, next_out, state_at(next_out), phase);
-      next_out += opt_.dt_out;
+      record(tr, next_out, sampler.at(next_out), phase);
+      advance_out();
     }
     const VectorXd x_minus = state_at(t_event);
     const long events_seen = static_cast<long>(tr.events.size()) + tr.events_not_recorded;

@@ -7,6 +7,7 @@
 //                         selection (mechanical), LDCP jumps (general LCS)
 //   accumulation.cpp      accumulations of impacts and their limit
 //   livelock.cpp          the guard against events that make no progress
+//   sampler.cpp           output samples on the dt_out grid (GridSampler)
 //   friction_phase.cpp    a phase with closed frictional contacts: stick rows
 //                         and slip columns in the feedback, the cone and
 //                         sliding monitors (issue 17)
@@ -16,6 +17,7 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
+#include <functional>
 #include <lcsim/sim/sim.hpp>
 #include <limits>
 #include <map>
@@ -92,6 +94,65 @@ struct Phase {
   VectorXd exp_apply(double tau, const VectorXd& x) const {
     return D.cwiseProduct(expv(tau, x.cwiseQuotient(D)));
   }
+};
+
+// The step exponential e^{Ab dt} of a mode's balanced closed loop, kept
+// per mode (EventDriven::step_cache_): valid for the Ab and dt it was made
+// for. Above Phase::kDenseExpMax it is formed only once the actions
+// e^{Ab dt} z spent on this mode's samples have cost as much as forming it
+// (`action_flops`, an estimate), and never when a matrix-vector product with
+// it costs more than the action (a sparse chain's closed loop).
+struct StepExp {
+  MatrixXd Ab;
+  double dt = 0.0;
+  MatrixXd E;  // empty until formed
+  double action_flops = 0.0;
+};
+
+// Output samples of one phase on the dt_out grid, in increasing time: the
+// first from the phase start by e^{Ab (t - t0)}, each later one from the one
+// before by the step exponential e^{Ab dt} (one matrix-vector product), so a
+// sample's cost does not grow with the phase's length (issue 24: 15 ms a
+// sample on Talos, each evaluated from the phase start). Grid times k dt
+// differ from the previous one by dt up to an ulp of t, the time resolution
+// of the states evaluated from the start too. Event and end states are still
+// evaluated from the phase start (state_at in event_driven.cpp).
+class GridSampler {
+ public:
+  // fetch: the mode's StepExp, asked for at the phase's second sample (a
+  // phase sampled once, or not at all, never copies Ab into the cache).
+  GridSampler(const Phase& ph, double t0, const VectorXd& z0, double dt,
+              std::function<StepExp&()> fetch)
+      : ph_(ph), t0_(t0), z0_(z0), dt_(dt), fetch_(std::move(fetch)) {}
+  // The state (unbalanced, augmented) at grid time t: stepped from the last
+  // sample when t is the grid point after it, else from the phase start.
+  VectorXd at(double t);
+
+ private:
+  VectorXd step(const VectorXd& z);
+  const Phase& ph_;
+  double t0_;
+  const VectorXd& z0_;
+  double dt_;
+  std::function<StepExp&()> fetch_;
+  StepExp* step_ = nullptr;
+  VectorXd z_;      // the last sample (balanced); empty before the first
+  double t_ = 0.0;  // its time
+};
+
+// An impact of an event-driven run: its time and the resolution of that
+// time (the gap's rounding over the approach rate, plus a few ulp of t).
+struct ImpactTime {
+  double t = 0.0;
+  double noise = 0.0;
+};
+
+// A geometric tail found in a sequence of impacts (accumulation.cpp).
+struct GeometricTail {
+  double t_star = -1.0;  // the limit; < 0: none
+  double ratio = 0.0;    // per period; 0 when the limit is taken without one
+  int period = 1;        // impacts per period
+  double since = 0.0;    // the first impact of the evidence
 };
 
 struct EventResult {
@@ -209,10 +270,15 @@ class EventDriven {
   bool consistent(const Phase& ph, const VectorXd& xa, double t) const;
   // held: the constraints the ending phase kept closed (empty at the start).
   EventResult process_event(double t, const VectorXd& xa, const lcs::IndexSet& held = {});
-  double accumulation_time(int r, double t, double* ratio) const;
+  // The accumulation that an impact of contact r at t (time resolution
+  // `noise`) ends, if any: r's own impacts, or every contact's.
+  GeometricTail accumulation_time(int r, double t, double noise) const;
+  // Records the impacts of `contacts` (impulse > 0) at t.
+  void record_impacts(const std::vector<int>& contacts, const VectorXd& impulse, double t,
+                      const VectorXd& noise);
   void project_onto(const std::vector<int>& rows, VectorXd& xa, bool positions) const;
   EventResult process_mechanical(double t, const VectorXd& xa, const lcs::IndexSet& held);
-  std::string take_accumulation_limit(int r, double t, double ratio, double t_star,
+  std::string take_accumulation_limit(int r, double t, const GeometricTail& tail,
                                       const VectorXd& gap, const VectorXd& gap_scale,
                                       const VectorXd& rate, VectorXd& xa) const;
   EventResult process_lcs(const VectorXd& xa);
@@ -258,7 +324,8 @@ class EventDriven {
   std::unique_ptr<lcp::Solver> solver_;
   std::unique_ptr<impact::ImpactLaw> impact_;
   lcs::LdcpOptions ldcp_;
-  std::vector<std::vector<double>> impact_times_;  // last few impacts per contact
+  std::vector<std::vector<ImpactTime>> impact_times_;  // last few impacts per contact
+  std::vector<ImpactTime> impact_seq_;                 // last few impacts of any contact
   // The first recorded state whose gap is negative beyond rounding (a
   // missed event: the run cannot say "completed"), as a message; "" if none.
   mutable std::string infeasible_;
@@ -267,6 +334,10 @@ class EventDriven {
   double rho_A_ = 0.0;  // bound on the spectral radius of the free dynamics
   mutable std::map<lcs::IndexSet, lcs::ModeFeedback> feedback_cache_;
   mutable std::map<std::pair<lcs::IndexSet, std::vector<FrictionMode>>, double> rho_cache_;
+  std::map<std::pair<lcs::IndexSet, std::vector<FrictionMode>>, StepExp> step_cache_;
+  // The cache entry for `phase`'s samples on a grid of step dt, reset when
+  // its Ab or dt differ (a frictional mode's feedback depends on the state).
+  StepExp& step_exp(const Phase& phase, double dt);
   // Friction (empty for frictionless models): M^{-1} (dense), the row of E
   // of each frictional contact, and the impact law's outcome per constraint
   // at the current event (kNone where no impact).

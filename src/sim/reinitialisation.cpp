@@ -18,8 +18,9 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0,
   out.friction_impulse = VectorXd::Zero(static_cast<Eigen::Index>(friction_contacts_.size()));
   VectorXd xa = xa0;
   const mech::MechanicalModel& m = *model_.mechanical;
-  std::vector<int> closed, resting;  // zero gap; zero gap and zero rate
-  bool limit_taken = false;          // an accumulation's limit is being taken
+  std::vector<int> closed, resting;          // zero gap; zero gap and zero rate
+  VectorXd time_noise = VectorXd::Zero(k_);  // per approaching contact
+  bool limit_taken = false;                  // an accumulation's limit is being taken
   std::fill(outcome_.begin(), outcome_.end(), impact::ContactOutcome::kNone);
   for (int iter = 0; iter < 100; ++iter) {
     closed.clear();
@@ -34,8 +35,8 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0,
     in.q = q;
     in.v = v;
     bool approaching = false;
-    int accumulating = -1;  // a contact whose impacts accumulate at t_star
-    double acc_ratio = 0.0;
+    int accumulating = -1;  // a contact whose impacts accumulate at tail.t_star
+    GeometricTail tail;
     for (int r = 0; r < k_; ++r) {
       // Zero within rounding, or within what the event time's resolution
       // (a few ulp of t times the rate) leaves in the gap.
@@ -71,12 +72,16 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0,
       if (std::abs(rate(r)) <= rate_tol) resting.push_back(r);
       if (rate(r) < -rate_tol) {
         approaching = true;
-        double ratio = 0.0;
-        const double ts = limit_taken ? -1.0 : accumulation_time(r, t, &ratio);
-        if (ts >= t && ts >= out.t_star) {
+        // The resolution of this impact's time: the gap's rounding over the
+        // approach rate, and the event time's few ulp.
+        time_noise(r) =
+            64.0 * kEps * (m.E.row(r).cwiseAbs().dot(q.cwiseAbs()) + std::abs(m.g(r))) / -rate(r) +
+            16.0 * kEps * std::max(1.0, std::abs(t));
+        const GeometricTail g =
+            limit_taken ? GeometricTail{} : accumulation_time(r, t, time_noise(r));
+        if (g.t_star >= t && g.t_star >= tail.t_star) {
           accumulating = r;
-          acc_ratio = ratio;
-          out.t_star = ts;
+          tail = g;
         }
       }
     }
@@ -89,8 +94,8 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0,
       // inelastic impact; the run continues from t_star in the limit mode.
       limit_taken = true;
       out.accumulation = true;
-      out.note =
-          take_accumulation_limit(accumulating, t, acc_ratio, out.t_star, gap, gap_scale, rate, xa);
+      out.t_star = tail.t_star;
+      out.note = take_accumulation_limit(accumulating, t, tail, gap, gap_scale, rate, xa);
       continue;
     }
     if (!approaching) break;
@@ -117,12 +122,7 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0,
         out.friction_impulse(static_cast<Eigen::Index>(f)) +=
             ir.friction_impulse(friction_contacts_[f]);
     out.jumped = true;
-    for (int r : in.closed)
-      if (ir.impulse(r) > 0.0) {
-        auto& h = impact_times_[r];
-        if (h.empty() || h.back() != t) h.push_back(t);
-        if (h.size() > 4) h.erase(h.begin());
-      }
+    record_impacts(in.closed, ir.impulse, t, time_noise);
     if (iter == 99) {
       out.message =
           "impacts at t = " + std::to_string(t) + " did not end after 100 rounds of the impact law";
