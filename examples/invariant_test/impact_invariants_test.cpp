@@ -1,6 +1,7 @@
 // A test a user of lcsim would write: on random mechanical models (seeded,
 // so every run checks the same ones), Moreau's inelastic impact (law
-// "moreau", e = 0) must
+// "inelastic": e = 0 whatever the model's restitution; "moreau" is an alias
+// of "newton", which applies the restitution) must
 //  - never raise the kinetic energy,
 //  - leave no closed contact approaching: E_J v+ >= 0 (feasibility),
 //  - give impulses >= 0 complementary to the post-impact rates:
@@ -38,7 +39,7 @@ TEST(MoreauImpact, InelasticInvariantsOnRandomModels) {
   std::mt19937 rng(20240611);  // fixed seed: the same 500 models each run
   std::uniform_int_distribution<int> dofs(1, 6);
   std::normal_distribution<double> normal(0.0, 1.0);
-  auto law = lcsim::impact::make_impact_law("moreau");
+  auto law = lcsim::impact::make_impact_law("inelastic");
   auto solver = lcsim::lcp::make_solver("pivot");
   int checked = 0;
   for (int trial = 0; trial < 500; ++trial) {

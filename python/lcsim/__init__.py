@@ -66,7 +66,7 @@ def sweep(model, methods, hs, x0=None, t_end=None, impact=None, theta=None, repe
                                           t_end, impact, theta, repeat))
 
 
-def impact_map(model, v1=(-1.0, 1.0), v2=(-1.0, 1.0), n=41, x0=None, law="moreau"):
+def impact_map(model, v1=(-1.0, 1.0), v2=(-1.0, 1.0), n=41, x0=None, law="newton"):
     """The impact map of thesis Figure 3.5 (`lcsim impacts --map`) over pre-impact
     velocities v1 x v2 (n points each) at q = x0's q (default 0). Returns the CSV text
     the CLI prints; lcsim.plot.impact_map draws it."""

@@ -52,8 +52,10 @@ std::map<std::string, impact::ImpactResult> impacts(const ModelHandle& model,
   const auto solver = lcp::make_solver("pivot");
   std::map<std::string, impact::ImpactResult> out;
   py::gil_scoped_release release;
-  for (const auto& name : rules.value_or(impact::impact_law_names()))
-    out[name] = impact::make_impact_law(name)->apply(in, *solver);
+  for (const auto& name : rules.value_or(impact::impact_law_names())) {
+    const auto law = impact::make_impact_law(name);  // an alias: its law, by that law's name
+    out[law->name()] = law->apply(in, *solver);
+  }
   return out;
 }
 
@@ -177,7 +179,8 @@ void bind_tools(py::module_& m) {
         py::arg("rules") = py::none(), py::arg("restitution") = py::none(),
         "Applies each impact rule (default: all, lcsim.impact_law_names()) at the state x0 = "
         "(q, v) (default: the model's initial state); the closed contacts are those with zero "
-        "gap at q. Returns {rule: ImpactResult}. `restitution`: one coefficient per constraint "
+        "gap at q. Returns {rule: ImpactResult}, keyed by each law's own name (the alias "
+        "'moreau' gives 'newton'). `restitution`: one coefficient per constraint "
         "(default: the model's).");
   m.def("solve_lcp", &solve_lcp, py::arg("M"), py::arg("q"), py::arg("solver") = "lemke",
         "Solves 0 <= z _|_ w = M z + q >= 0 with a solver of lcsim.solver_names(). Raises "
@@ -190,7 +193,7 @@ void bind_tools(py::module_& m) {
         py::arg("theta") = py::none(), py::arg("repeat") = 3,
         "The work-precision sweep (io::run_sweep) as the JSON text `lcsim sweep --json` prints.");
   m.def("_impact_map_csv", &impact_map_csv, py::arg("model"), py::arg("v1"), py::arg("v2"),
-        py::arg("n") = 41, py::arg("x0") = py::none(), py::arg("law") = "moreau",
+        py::arg("n") = 41, py::arg("x0") = py::none(), py::arg("law") = "newton",
         "The impact map of thesis Figure 3.5 (io::impact_map) as the CSV `lcsim impacts --map` "
         "prints.");
 }

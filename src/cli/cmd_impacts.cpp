@@ -108,9 +108,18 @@ void run_compare(const ImpactsArgs& a, const mech::Model& model) {
   in.closed = io::closed_constraints(m, in.q, "--x0");
   in.restitution = restitution(a, m);
   const auto solver = lcp::make_solver("pivot");
+  // Rows by the law's own name: an alias ("moreau") gives its law's row
+  // ("newton"), once, and a note saying what the alias means.
   std::vector<std::pair<std::string, impact::ImpactResult>> results;
-  for (const auto& name : rules)
-    results.emplace_back(name, impact::make_impact_law(name)->apply(in, *solver));
+  std::vector<std::string> notes;
+  for (const auto& name : rules) {
+    const auto law = impact::make_impact_law(name);
+    if (const std::string note = impact::laws().alias_note(name); !note.empty())
+      notes.push_back(note);
+    bool seen = false;
+    for (const auto& row : results) seen = seen || row.first == law->name();
+    if (!seen) results.emplace_back(law->name(), law->apply(in, *solver));
+  }
 
   std::string failures;
   for (const auto& [name, r] : results)
@@ -152,12 +161,14 @@ void run_compare(const ImpactsArgs& a, const mech::Model& model) {
       }
     }
     j["rules"] = js;
+    if (!notes.empty()) j["notes"] = notes;
     std::cout << j.dump(2) << "\n";
   } else {
     std::printf("model %s at state %s, closed {", model.name.c_str(), fmt_vec(x0).c_str());
     for (size_t i = 0; i < in.closed.size(); ++i)
       std::printf("%s%s", i ? ", " : "", m.constraints[in.closed[i]].c_str());
     std::printf("}, restitution %s\n", fmt_vec(in.restitution).c_str());
+    for (const auto& note : notes) std::printf("note: %s\n", note.c_str());
     std::printf("%-19s %-28s %-24s %-18s %-12s %-12s %-10s %s\n", "rule", "velocity after",
                 "impulse", "mode", "T before", "T after", "worst Ev+", "note");
     for (const auto& [name, r] : results) {
@@ -241,7 +252,9 @@ void setup(CLI::App& app) {
   cmd->add_flag("--json", a->json, "Print the results as JSON");
   cmd->add_option(
       "--map", a->map,
-      "Impact map of a two-coordinate model: v1lo:v1hi[:n],v2lo:v2hi[:n] (CSV on stdout)");
+      "Impact map of a two-coordinate model over its pre-impact velocities: two ranges "
+      "lo:hi[:n], v1 then v2 (lo < hi, n points from lo to hi, 2..2001, default 41), e.g. "
+      "-2:0:81,-3:1 (CSV on stdout)");
   cmd->add_option("--closed", a->closed,
                   "With --map: the two contacts to close, by name or 0-based index (a,b); the "
                   "map is over their approach velocities");

@@ -2,6 +2,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <lcsim/impact/impact.hpp>
 #include <lcsim/io/io.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <memory>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "cli/command.hpp"
+#include "cli/flag_names.hpp"
 #include "cli/output.hpp"
 #include "cli/run_inputs.hpp"
 
@@ -49,9 +51,14 @@ std::string fmt_vec(const Eigen::VectorXd& v) {
   return s + ")";
 }
 
-std::string fmt_set(const std::vector<int>& s) {
+// "{0 hook, 1 wall}": index and name of each constraint of a mechanical
+// model; "{0,1}" for an LCS (its complementarity pairs have no names).
+std::string fmt_set(const mech::Model& model, const std::vector<int>& s) {
   std::string r = "{";
-  for (size_t i = 0; i < s.size(); ++i) r += (i ? "," : "") + std::to_string(s[i]);
+  for (size_t i = 0; i < s.size(); ++i) {
+    r += (i ? (model.is_mechanical() ? ", " : ",") : "") + std::to_string(s[i]);
+    if (model.is_mechanical()) r += " " + model.mechanical->constraints[s[i]];
+  }
   return r + "}";
 }
 
@@ -76,7 +83,7 @@ void print_summary(const SimulateArgs& a, const mech::Model& model, const sim::T
   for (const auto& e : tr.events) {
     std::printf("  t = %-20.15g %-12s %s -> %s  mode %s\n", e.t,
                 std::string(sim::to_string(e.type)).c_str(), fmt_vec(e.state_before).c_str(),
-                fmt_vec(e.state_after).c_str(), fmt_set(e.mode_after).c_str());
+                fmt_vec(e.state_after).c_str(), fmt_set(model, e.mode_after).c_str());
     if (!e.note.empty()) std::printf("      (%s)\n", e.note.c_str());
   }
   if (tr.events_not_recorded > 0)
@@ -135,11 +142,14 @@ void run_simulate(const SimulateArgs& a) {
                                                   : ProgressLine::Mode::kAuto);
   opt.progress = [&progress](double t) { progress.update(t); };
   const sim::Trajectory tr = integrator->run(model, x0, opt);
+  if (const std::string note = impact::laws().alias_note(opt.impact);
+      !note.empty() && !tr.impact_law.empty())
+    std::cerr << "lcsim: note: " << note << "\n";
   // A refused run integrated nothing: the error line is all there is to say.
   if (tr.status == sim::RunStatus::kInvalidInput) {
     if (!a.project && model.is_mechanical() && !sim::infeasible_start(model, x0).empty())
       std::cerr << "lcsim: hint: --project starts from the nearest feasible positions\n";
-    check_status(tr.status, tr.message);
+    check_status(tr.status, with_flag_names(tr.message));
   }
   if (tr.status == sim::RunStatus::kCompleted) progress.done();
   const bool failed = tr.status != sim::RunStatus::kCompleted;
@@ -159,7 +169,7 @@ void run_simulate(const SimulateArgs& a) {
     if (!w.empty()) std::cerr << "lcsim: warning: " << w << "\n";
   }
   print_warnings(tr);
-  check_status(tr.status, tr.message);
+  check_status(tr.status, with_flag_names(tr.message));
 }
 
 void setup(CLI::App& app) {

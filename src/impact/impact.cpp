@@ -1,5 +1,5 @@
 // Impact rules: shared set-up, Moreau's LCP with Newton restitution
-// ("moreau", "newton") and the registry of rules by name.
+// ("newton", "inelastic") and the registry of rules by name.
 #include <algorithm>
 #include <cmath>
 #include <lcsim/impact/impact.hpp>
@@ -24,7 +24,7 @@ std::optional<Setup> prepare(const ImpactInput& in, ImpactResult& out, bool hand
   if (m.has_friction() && !handles_friction) {
     out.message = "this impact law does not handle friction (the model has " +
                   std::to_string(m.friction.size()) +
-                  " frictional contacts); the laws 'moreau', 'newton' and "
+                  " frictional contacts); the laws 'newton', 'inelastic' and "
                   "'moreau-restitution' do";
     out.status = Status::kInvalidInput;
     return std::nullopt;
@@ -256,8 +256,9 @@ struct Rule {
   bool friction = false;  // handles mechanical.friction
 };
 
-// "moreau" and "newton" are one formula (§8.2.2 with the given restitution;
-// e = 0 is Moreau's inelastic rule): two names, one implementation.
+// "newton" is §8.2.2 with the given restitution; "inelastic" the same
+// formula with e = 0 whatever the restitution (Moreau's inelastic rule,
+// (3.69)-(3.70)). "moreau" is an alias of "newton" (its old name).
 // On a model with friction the three LCP laws are the one friction LCP
 // (moreau_friction: Newton's restitution inside it); the others refuse
 // friction (detail::prepare).
@@ -266,13 +267,23 @@ ImpactResult lcp_law(const ImpactInput& in, const lcp::Solver& solver, RuleFn fr
   return frictionless(in, solver);
 }
 
+ImpactResult inelastic(const ImpactInput& in, const lcp::Solver& solver) {
+  if (in.model == nullptr) return moreau_newton(in, solver);  // its message
+  ImpactInput e0 = in;
+  e0.restitution = VectorXd::Zero(in.model->num_constraints());
+  return lcp_law(e0, solver, &moreau_newton);
+}
+
+constexpr const char* kMoreauAliasNote =
+    "'moreau' is an alias of 'newton': Newton's restitution per contact on Moreau's "
+    "inelastic impulse, with the model's restitution (inelastic only where it is 0); the law "
+    "'inelastic' applies e = 0 whatever the restitution";
+
 const Rule kRules[] = {
-    {"moreau",
-     +[](const ImpactInput& in, const lcp::Solver& s) { return lcp_law(in, s, &moreau_newton); },
-     true},
     {"newton",
      +[](const ImpactInput& in, const lcp::Solver& s) { return lcp_law(in, s, &moreau_newton); },
      true},
+    {"inelastic", &inelastic, true},
     {"moreau-restitution",
      +[](const ImpactInput& in, const lcp::Solver& s) {
        return lcp_law(in, s, &moreau_restitution);
@@ -306,6 +317,7 @@ Registry<ImpactLaw>& laws() {
     auto* reg = new Registry<ImpactLaw>("impact law");  // never destroyed: used at exit
     for (const Rule& rule : kRules)
       reg->add(rule.name, [rule] { return std::make_unique<NamedLaw>(rule); });
+    reg->add_alias("moreau", "newton", kMoreauAliasNote);
     return reg;
   }();
   return r;

@@ -349,7 +349,8 @@ YAML::Node load_model_root(const std::string& yaml_text, const std::string& sour
   YAML::Node root = load(yaml_text, source);
   if (root.IsNull() || !root.IsDefined())
     throw InputError(source +
-                     ": empty file (expected `name` and a `mechanical:` or `lcs:` section)");
+                     ": empty file (expected a model: `name` and a `mechanical:` or `lcs:` "
+                     "section, or a scene: `urdf:` and `joints:`)");
   return root;
 }
 

@@ -1,7 +1,7 @@
 // "moreau-qp": Moreau's inelastic rule as the minimisation 3.8.1,
 // min ½(w - v)'M(w - v) s.t. E_J w >= 0, solved by Ipopt through its TNLP
 // interface, with restitution applied Newton-style to the multipliers as in
-// "moreau" (§8.2.2), so the two rules agree for every e.
+// "newton" (§8.2.2), so the two rules agree for every e.
 #include <IpIpoptApplication.hpp>
 #include <IpSolveStatistics.hpp>
 #include <IpTNLP.hpp>

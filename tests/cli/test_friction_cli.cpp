@@ -31,7 +31,7 @@ TEST(FrictionCli, ImpactsShowTheFrictionImpulseAndOutcome) {
   const auto doc = nlohmann::json::parse(j.out);
   // "all" on a model with friction: the three laws that handle it.
   EXPECT_EQ(doc["rules"].size(), 3u) << j.out;
-  const auto& m = doc["rules"]["moreau"];
+  const auto& m = doc["rules"]["newton"];
   // A 3 x 3 LCP with a diagonal mass matrix: a few ulps (1e-12).
   EXPECT_NEAR(m["friction_impulse"][0].get<double>(), -8.0 / 3, 1e-12);
   EXPECT_NEAR(m["impulse"][0].get<double>(), 9.0, 1e-12);

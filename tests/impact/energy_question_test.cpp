@@ -26,12 +26,8 @@
 namespace lcsim::impact {
 namespace {
 
+using testing::pivot;
 using testing::vec;
-
-const lcp::Solver& pivot() {
-  static const auto s = lcp::make_solver("pivot");
-  return *s;
-}
 
 TEST(Section822, NewtonWithDifferentCoefficientsGainsEnergy) {
   const auto m = testing::three_balls();

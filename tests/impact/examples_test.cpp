@@ -18,27 +18,16 @@
 namespace lcsim::impact {
 namespace {
 
+using testing::expect_near;
 using testing::input;
+using testing::pivot;
+using testing::run;
 using testing::vec;
-
-const lcp::Solver& pivot() {
-  static const auto s = lcp::make_solver("pivot");
-  return *s;
-}
-
-ImpactResult run(const std::string& rule, const ImpactInput& in) {
-  return make_impact_law(rule)->apply(in, pivot());
-}
-
-void expect_near(const Eigen::VectorXd& a, const Eigen::VectorXd& b, double tol) {
-  ASSERT_EQ(a.size(), b.size());
-  for (int i = 0; i < a.size(); ++i) EXPECT_NEAR(a(i), b(i), tol) << "entry " << i;
-}
 
 TEST(ImpactRegistry, ListsAllRulesAndRejectsUnknownNames) {
   const std::vector<std::string> names = impact_law_names();
   for (const char* n :
-       {"moreau", "moreau-qp", "newton", "moreau-restitution", "sequential", "flip"}) {
+       {"inelastic", "moreau-qp", "newton", "moreau-restitution", "sequential", "flip"}) {
     EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
     EXPECT_EQ(make_impact_law(n)->name(), n);
   }

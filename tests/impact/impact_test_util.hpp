@@ -1,10 +1,13 @@
 // Helpers for the impact-rule tests: small exact models and random ones.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <Eigen/Dense>
 #include <lcsim/impact/impact.hpp>
 #include <lcsim/mech/mech.hpp>
 #include <random>
+#include <string>
 
 namespace lcsim::impact::testing {
 
@@ -35,6 +38,22 @@ inline ImpactInput input(const mech::MechanicalModel& m, const Eigen::VectorXd& 
   in.closed = closed;
   in.restitution = e.size() ? e : Eigen::VectorXd::Zero(m.num_constraints());
   return in;
+}
+
+// The pivoting LCP solver, made once.
+inline const lcp::Solver& pivot() {
+  static const auto s = lcp::make_solver("pivot");
+  return *s;
+}
+
+// The impact law `rule` applied with the pivoting solver.
+inline ImpactResult run(const std::string& rule, const ImpactInput& in) {
+  return make_impact_law(rule)->apply(in, pivot());
+}
+
+inline void expect_near(const Eigen::VectorXd& a, const Eigen::VectorXd& b, double tol) {
+  ASSERT_EQ(a.size(), b.size());
+  for (int i = 0; i < a.size(); ++i) EXPECT_NEAR(a(i), b(i), tol) << "entry " << i;
 }
 
 inline Eigen::VectorXd vec(std::initializer_list<double> x) {

@@ -38,20 +38,34 @@ class Registry {
     entries_.emplace_back(std::move(name), std::move(factory));
   }
 
-  bool contains(std::string_view name) const {
+  // `alias` stands for the method `target` in contains() and make() (an old
+  // name kept working); names() does not list it, and alias_note(alias)
+  // says what it now means.
+  void add_alias(std::string alias, std::string target, std::string note) {
     std::lock_guard<std::mutex> lock(mutex_);
-    for (const auto& e : entries_)
-      if (e.first == name) return true;
-    return false;
+    aliases_.push_back({std::move(alias), std::move(target), std::move(note)});
   }
 
-  // A new instance of `name`; nullptr when unknown (unknown_message says why).
+  // The note of an alias ("" for a name that is not one).
+  std::string alias_note(std::string_view name) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& a : aliases_)
+      if (a.alias == name) return a.note;
+    return "";
+  }
+
+  bool contains(std::string_view name) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return find(name) != nullptr;
+  }
+
+  // A new instance of `name` (or of the method an alias stands for); nullptr
+  // when unknown (unknown_message says why).
   std::unique_ptr<Interface> make(std::string_view name) const {
     Factory f;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      for (const auto& e : entries_)
-        if (e.first == name) f = e.second;
+      if (const Factory* p = find(name)) f = *p;
     }
     return f ? f() : nullptr;
   }
@@ -64,10 +78,15 @@ class Registry {
     return out;
   }
 
-  // "unknown <kind> 'x' (known: a, b, c)", plus `hint` when given.
+  // "unknown <kind> 'x' (known: a, b, c; alias d)", plus `hint` when given.
   std::string unknown_message(std::string_view name, std::string_view hint = {}) const {
     std::string known;
     for (const auto& n : names()) known += (known.empty() ? "" : ", ") + n;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (size_t i = 0; i < aliases_.size(); ++i)
+        known += (i ? ", " : (aliases_.size() > 1 ? "; aliases " : "; alias ")) + aliases_[i].alias;
+    }
     std::string msg = "unknown " + kind_ + " '" + std::string(name) + "' (known: " + known + ")";
     if (!hint.empty()) msg += "; " + std::string(hint);
     return msg;
@@ -76,9 +95,24 @@ class Registry {
   const std::string& kind() const { return kind_; }
 
  private:
+  struct Alias {
+    std::string alias, target, note;
+  };
+  // The factory of `name` or of the target of alias `name`; mutex_ held.
+  const Factory* find(std::string_view name) const {
+    for (const auto& e : entries_)
+      if (e.first == name) return &e.second;
+    for (const auto& a : aliases_)
+      if (a.alias == name)
+        for (const auto& e : entries_)
+          if (e.first == a.target) return &e.second;
+    return nullptr;
+  }
+
   std::string kind_;
   mutable std::mutex mutex_;
   std::vector<std::pair<std::string, Factory>> entries_;
+  std::vector<Alias> aliases_;
 };
 
 // Adds a method to `registry` when the program starts: a namespace-scope

@@ -82,7 +82,9 @@ class ImpactLaw {
   virtual bool handles_friction() const { return false; }
 };
 // The laws by name: those below, and "moreau-qp" in programs that link the
-// component lcsim::ipopt (include/lcsim/ipopt/moreau_qp.hpp).
+// component lcsim::ipopt (include/lcsim/ipopt/moreau_qp.hpp). "moreau" is an
+// alias of "newton" (its old name; laws().alias_note("moreau") says so): a
+// law made by it is named "newton".
 Registry<ImpactLaw>& laws();
 // Throws std::invalid_argument naming the unknown law and the known ones.
 std::unique_ptr<ImpactLaw> make_impact_law(std::string_view name);
@@ -93,11 +95,12 @@ std::vector<std::string> impact_law_names();
 // per constraint (N s), energies in J. e_i is ImpactInput::restitution or the
 // model's.
 //
-// "moreau", "newton": Moreau's inelastic impact LCP (3.69)-(3.70) on J, with
-// per-contact Newton restitution applied to the inelastic impulse (§8.2.2):
-// v+ = v + sum_i (1 + e_i) M^{-1} E_i' lambda_i. e = 0 is Moreau's rule.
+// "newton" (alias "moreau"): Moreau's inelastic impact LCP (3.69)-(3.70) on
+// J, with per-contact Newton restitution applied to the inelastic impulse
+// (§8.2.2): v+ = v + sum_i (1 + e_i) M^{-1} E_i' lambda_i. e = 0 is Moreau's
+// rule. "inelastic": the same with e = 0 whatever the restitution.
 ImpactResult moreau_newton(const ImpactInput& in, const lcp::Solver& solver);
-// "moreau", "newton" and "moreau-restitution" on a model with friction: the
+// "newton", "inelastic" and "moreau-restitution" on a model with friction: the
 // planar Coulomb impact as one LCP (thesis §2.5.3, Lemma 2.5.1; Glocker's
 // planar formulation, Siconos's fc2d_tolcp) with unknowns per frictional
 // closed contact (lambda_N, lambda_R, xi): the normal impulse, the split

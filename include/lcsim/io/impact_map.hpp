@@ -51,7 +51,7 @@ struct ImpactMapSpec {
   std::vector<int> closed;  // empty: every constraint, two coordinates
   MapRange axis1, axis2;
   Eigen::VectorXd restitution;  // per constraint (k); empty = the model's
-  std::string law = "moreau";
+  std::string law = "newton";
 };
 
 struct ImpactMapCell {
