@@ -440,10 +440,14 @@ bool same_matrix(const mech::SparseMatrix& a, const mech::SparseMatrix& b) {
 
 bool same_vector(const VectorXd& a, const VectorXd& b) { return a.size() == b.size() && a == b; }
 
+// The same model up to the restitution: a restitution is a parameter of the
+// constraints, not of the scene's bodies (the URDF has none; a study's
+// restitution axis changes it, issue 24), so a scene with another one is
+// still that scene.
 bool same_model(const mech::MechanicalModel& a, const mech::MechanicalModel& b) {
   return same_matrix(a.M, b.M) && same_matrix(a.D, b.D) && same_matrix(a.K, b.K) &&
          same_matrix(a.E, b.E) && same_vector(a.g, b.g) && same_vector(a.f, b.f) &&
-         same_vector(a.restitution, b.restitution) && a.coordinates == b.coordinates &&
+         a.restitution.size() == b.restitution.size() && a.coordinates == b.coordinates &&
          a.constraints == b.constraints;
 }
 
@@ -454,6 +458,7 @@ std::optional<Scene> scene_setup(const mech::Model& model) {
   try {
     std::optional<Scene> scene = load_scene_details(model.source);
     if (!scene || !same_model(*scene->model.mechanical, *model.mechanical)) return std::nullopt;
+    scene->model.mechanical->restitution = model.mechanical->restitution;  // the model's own
     return scene;
   } catch (const std::exception&) {
     return std::nullopt;
