@@ -22,6 +22,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <functional>
 #include <lcsim/io/io.hpp>
@@ -112,14 +113,21 @@ void check_inertia(const urdf::Inertial& in, const std::string& source, const st
   const std::string got = "(got ixx=" + num(in.ixx) + ", ixy=" + num(in.ixy) +
                           ", ixz=" + num(in.ixz) + ", iyy=" + num(in.iyy) + ", iyz=" + num(in.iyz) +
                           ", izz=" + num(in.izz) + ")";
+  // The moments are computed, not read: 6 significant digits (the file's
+  // own values are in `got`, exactly).
+  const auto six = [](double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", x);
+    return std::string(buf);
+  };
   const std::string moments =
-      "principal moments " + num(p(0)) + ", " + num(p(1)) + ", " + num(p(2));
+      "principal moments " + six(p(0)) + ", " + six(p(1)) + ", " + six(p(2));
   if (p(0) < -tol)
     fail(source, el, "not positive semi-definite: " + moments + " (kg m^2), a negative one " + got);
   if (p(0) + p(1) < p(2) - tol)
     fail(source, el,
-         moments + " break the triangle inequality (" + num(p(0)) + " + " + num(p(1)) + " < " +
-             num(p(2)) + "): no rigid body has them " + got);
+         moments + " break the triangle inequality (" + six(p(0)) + " + " + six(p(1)) + " < " +
+             six(p(2)) + "): no rigid body has them " + got);
 }
 
 void check_urdf(const urdf::ModelInterface& m, const std::string& source) {
