@@ -1,4 +1,4 @@
-// `lcsim analyze MODEL [--json]`: what a model is and whether the theory
+// `lcsim analyze MODEL [--json] [--full]`: what a model is and whether the theory
 // applies to it, before simulating: dimensions, M's definiteness, rank of E,
 // the Delassus matrix E M^{-1} E' and its P-property (uniqueness of the impact
 // LCP (3.69)-(3.70)), notes on the model, and the well-posedness report of the
@@ -28,6 +28,7 @@ using Eigen::MatrixXd;
 struct AnalyzeArgs {
   std::string file;
   bool json = false;
+  bool full = false;      // --full: every matrix and set (default: the library's summary)
   std::string model_out;  // --model-out: the linear model as YAML
   double linearisation_threshold = io::kLinearisationThreshold;
 };
@@ -70,10 +71,19 @@ nlohmann::json indices_json(const std::vector<int>& v) {
   return a;
 }
 
-// Sets of constraints that can be active together and the verdicts on them
-// (mech::coactive_sets): enumerated for at most this many constraints (pairs
-// are k^2 / 2 small LCPs; a 7-joint arm has 14 rows).
-constexpr int kMaxCoactiveConstraints = 64;
+// What a summary leaves out (lcs::summary_left_out, mech::kSummarySets):
+// the JSON names, listed in the output with how to get them.
+using LeftOut = std::vector<std::string>;
+
+// `m` as text, or, when a summary leaves it out (`name` added to `left`),
+// its size only.
+std::string matrix_or_size(const MatrixXd& m, const std::string& indent, bool full,
+                           const std::string& name, LeftOut& left) {
+  if (full || lcs::summary_shows(m.size())) return matrix_text(m, indent);
+  left.push_back(name);
+  return indent + "(" + std::to_string(m.rows()) + " x " + std::to_string(m.cols()) +
+         ": left out of the summary; --full prints it)\n";
+}
 
 struct Coactive {
   mech::CoactiveSets sets;
@@ -106,19 +116,29 @@ nlohmann::json names_json(const mech::MechanicalModel& m, const std::vector<int>
   return a;
 }
 
-nlohmann::json coactive_json(const mech::MechanicalModel& m, const Coactive& c) {
+nlohmann::json coactive_json(const mech::MechanicalModel& m, const Coactive& c, bool full,
+                             LeftOut& left) {
   nlohmann::json j;
   nlohmann::json sets = nlohmann::json::array();
-  for (const auto& s : c.wp.sets)
+  const std::size_t shown = full ? c.wp.sets.size() : mech::kSummarySets;
+  if (c.wp.sets.size() > shown) left.push_back("coactive.maximal_sets");
+  if (c.sets.exclusive_pairs.size() > shown) left.push_back("coactive.exclusive_pairs");
+  j["maximal_sets_count"] = c.wp.sets.size();
+  j["exclusive_pairs_count"] = c.sets.exclusive_pairs.size();
+  for (const auto& s : c.wp.sets) {
+    if (sets.size() == shown) break;
     sets.push_back({{"constraints", names_json(m, s.indices)},
                     {"rank", s.rank},
                     {"delassus_p_matrix", s.delassus_p_matrix},
                     {"row_p_matrix", s.row_p_matrix},
                     {"column_p_matrix", s.column_p_matrix}});
+  }
   j["maximal_sets"] = std::move(sets);
   nlohmann::json pairs = nlohmann::json::array();
-  for (const auto& [a, b] : c.sets.exclusive_pairs)
+  for (const auto& [a, b] : c.sets.exclusive_pairs) {
+    if (pairs.size() == shown) break;
     pairs.push_back({m.constraints[a], m.constraints[b]});
+  }
   j["exclusive_pairs"] = std::move(pairs);
   j["never_active"] = names_json(m, c.sets.never_active);
   j["complete"] = c.sets.complete;
@@ -134,18 +154,19 @@ nlohmann::json coactive_json(const mech::MechanicalModel& m, const Coactive& c) 
   return j;
 }
 
-std::string coactive_text(const mech::MechanicalModel& m, const Coactive& c) {
+std::string coactive_text(const mech::MechanicalModel& m, const Coactive& c, bool full) {
   std::ostringstream out;
   out << "  sets active together (some admissible q closes them all): " << c.wp.sets.size()
       << " maximal" << (c.sets.complete ? "" : " (enumeration cut short)") << "\n";
-  constexpr std::size_t kShown = 8;
+  const std::size_t kShown = full ? c.wp.sets.size() : mech::kSummarySets;
   for (std::size_t i = 0; i < c.wp.sets.size() && i < kShown; ++i) {
     const auto& s = c.wp.sets[i];
     out << "    " << names_text(m, s.indices) << "  rank " << s.rank
         << ", Delassus P: " << (s.delassus_p_matrix ? "yes" : "no") << ", Theorem 3.6.3: "
         << (s.row_p_matrix && s.column_p_matrix ? "applies" : "does not apply") << "\n";
   }
-  if (c.wp.sets.size() > kShown) out << "    ... (" << c.wp.sets.size() - kShown << " more)\n";
+  if (c.wp.sets.size() > kShown)
+    out << "    ... (" << c.wp.sets.size() - kShown << " more; --full lists them)\n";
   if (!c.sets.exclusive_pairs.empty())
     out << "  never active together: " << c.sets.exclusive_pairs.size() << " pairs, e.g. "
         << m.constraints[c.sets.exclusive_pairs[0].first] << " and "
@@ -191,6 +212,8 @@ void run_analyze(const AnalyzeArgs& args) {
 
   nlohmann::json j;
   std::ostringstream out;
+  LeftOut left;
+  std::vector<std::string> not_judged;
   j["name"] = model.name;
   j["source"] = model.source;
   j["kind"] = model.is_mechanical() ? "mechanical" : "lcs";
@@ -217,9 +240,13 @@ void run_analyze(const AnalyzeArgs& args) {
         << ", largest " << num(ev.maxCoeff()) << "\n"
         << "rank E:      " << rank_e << " of " << m.num_constraints();
     std::optional<Coactive> co;
-    if (m.num_constraints() > 0 && m.num_constraints() <= kMaxCoactiveConstraints) co = coactive(m);
+    if (m.num_constraints() > 0 && m.num_constraints() <= mech::kMaxCoactiveConstraints)
+      co = coactive(m);
+    not_judged = mech::coactive_not_judged(m, co ? &co->sets : nullptr, static_cast<int>(rank_e));
     if (rank_e < m.num_constraints())
-      out << (!co || co->wp.dependent ? "  (dependent constraints)"
+      out << (!co ? "  (not judged: dependent constraints or rows that cannot be active "
+                    "together; see \"not judged\" below)"
+              : co->wp.dependent ? "  (dependent constraints)"
               : co->sets.complete
                   ? "  (rows that cannot be active together, not dependent constraints)"
                   : "  (rows that cannot be active together; dependent constraints in "
@@ -228,20 +255,22 @@ void run_analyze(const AnalyzeArgs& args) {
     if (m.num_constraints() > 0) {
       const MatrixXd W = mech::delassus(m);
       const bool p = lcp::is_p_matrix(W);
-      j["delassus"] = io::to_json(W);
-      j["delassus_p_matrix"] = p;
+      const std::size_t before = left.size();
       out << "Delassus matrix E M^-1 E' (impact LCP (3.69)-(3.70)):\n"
-          << matrix_text(W, "    ") << "  P-matrix: " << (p ? "yes" : "no")
+          << matrix_or_size(W, "    ", args.full, "delassus", left) << "  P-matrix: ";
+      j["delassus"] = left.size() == before ? io::to_json(W) : nlohmann::json();
+      j["delassus_p_matrix"] = p;
+      out << (p ? "yes" : "no")
           << (p ? "  (unique impulse)"
                 : "  (impulses may be non-unique; post-impact velocities still are, §4.6.1)")
           << "\n";
       if (co) {
-        j["coactive"] = coactive_json(m, *co);
-        out << coactive_text(m, *co);
+        j["coactive"] = coactive_json(m, *co, args.full, left);
+        out << coactive_text(m, *co, args.full);
       } else {
         j["coactive"] = nullptr;
-        out << "  sets active together: not enumerated (k > " << kMaxCoactiveConstraints
-            << "); the verdicts below are on all k rows at once\n";
+        out << "  sets active together: not enumerated (k = " << m.num_constraints() << " > "
+            << mech::kMaxCoactiveConstraints << "); the verdicts below are on all k rows at once\n";
       }
     } else {
       j["delassus"] = nlohmann::json::array();
@@ -267,13 +296,19 @@ void run_analyze(const AnalyzeArgs& args) {
   nlohmann::json w;
   w["n"] = wp.n;
   w["k"] = wp.k;
+  const LeftOut wp_left = args.full ? LeftOut{} : lcs::summary_left_out(wp);
+  const auto shown = [&](const char* name) {
+    return std::find(wp_left.begin(), wp_left.end(), name) == wp_left.end();
+  };
   nlohmann::json markov = nlohmann::json::array();
   for (const auto& H : wp.markov) markov.push_back(io::to_json(H));
-  w["markov"] = std::move(markov);
+  w["markov"] = shown("markov") ? std::move(markov) : nlohmann::json();
   w["rho"] = indices_json(wp.rho);
   w["eta"] = indices_json(wp.eta);
-  w["row_coefficients"] = io::to_json(wp.row_coefficients);
-  w["column_coefficients"] = io::to_json(wp.column_coefficients);
+  w["row_coefficients"] =
+      shown("row_coefficients") ? io::to_json(wp.row_coefficients) : nlohmann::json();
+  w["column_coefficients"] =
+      shown("column_coefficients") ? io::to_json(wp.column_coefficients) : nlohmann::json();
   w["row_p_matrix"] = wp.row_p_matrix;
   w["column_p_matrix"] = wp.column_p_matrix;
   w["locally_well_posed"] = wp.locally_well_posed;
@@ -285,16 +320,24 @@ void run_analyze(const AnalyzeArgs& args) {
   out << "well-posedness of the LCS (n = " << wp.n << ", k = " << wp.k << "):\n"
       << "  Markov parameters H^0..H^" << (wp.markov.empty() ? 0 : wp.markov.size() - 1)
       << " (3.32):\n";
-  for (std::size_t i = 0; i < wp.markov.size(); ++i) {
-    out << "    H^" << i << ":\n" << matrix_text(wp.markov[i], "      ");
-  }
+  if (shown("markov"))
+    for (std::size_t i = 0; i < wp.markov.size(); ++i)
+      out << "    H^" << i << ":\n" << matrix_text(wp.markov[i], "      ");
+  else
+    out << "    (" << wp.markov.size() << " matrices of " << wp.k << " x " << wp.k
+        << ": left out of the summary; --full prints them)\n";
+  const auto coefficients = [&](const MatrixXd& X, const char* name) {
+    if (shown(name)) return matrix_text(X, "    ");
+    return "    (" + std::to_string(X.rows()) + " x " + std::to_string(X.cols()) +
+           ": left out of the summary; --full prints it)\n";
+  };
   out << "  leading row indices rho:    " << indices_text(wp.rho) << "\n"
       << "  leading column indices eta: " << indices_text(wp.eta) << "\n"
       << "  leading row coefficients (script M, (3.39)):\n"
-      << matrix_text(wp.row_coefficients, "    ")
+      << coefficients(wp.row_coefficients, "row_coefficients")
       << "    P-matrix: " << (wp.row_p_matrix ? "yes" : "no") << "\n"
       << "  leading column coefficients (script N, (3.39)):\n"
-      << matrix_text(wp.column_coefficients, "    ")
+      << coefficients(wp.column_coefficients, "column_coefficients")
       << "    P-matrix: " << (wp.column_p_matrix ? "yes" : "no") << "\n"
       << "  Theorem 3.6.3 (local well-posedness), all k rows at once: "
       << (wp.locally_well_posed ? "applies" : "does not apply")
@@ -306,7 +349,7 @@ void run_analyze(const AnalyzeArgs& args) {
                                                                        : "does not apply")
               : std::string())
       << "\n"
-      << "  passive (§7.2): " << wp.passive
+      << "  passive (§7.2, of the LCS; D there is its feedthrough in y = C x + D u): " << wp.passive
       << (wp.passivity_reason.empty() ? "" : " (" + wp.passivity_reason + ")") << "\n"
       << "  backward Euler (§7.3): "
       << (wp.backward_euler_risky
@@ -315,6 +358,17 @@ void run_analyze(const AnalyzeArgs& args) {
       << "\n";
 
   linear_ranges_section(scene, args.linearisation_threshold, j, out);
+  for (const auto& n : wp_left) left.push_back("well_posedness." + n);
+  j["not_judged"] = not_judged;
+  if (!not_judged.empty()) out << "not judged:\n";
+  for (const auto& n : not_judged) out << "  - " << n << "\n";
+  j["full"] = args.full;
+  j["left_out"] = left;
+  if (!left.empty()) {
+    out << "left out of this summary (--full prints them): ";
+    for (std::size_t i = 0; i < left.size(); ++i) out << (i ? ", " : "") << left[i];
+    out << "\n";
+  }
   if (!args.model_out.empty()) {
     io::write_file_atomic(args.model_out,
                           io::model_yaml(model, "The linear model of " + model.source +
@@ -336,6 +390,8 @@ LCSIM_REGISTER_COMMAND([](CLI::App& app) {
       "analyze", "Describe a model and check the well-posedness conditions before simulating");
   cmd->add_option("model", args->file, "model file (YAML)")->required();
   cmd->add_flag("--json", args->json, "print one JSON object");
+  cmd->add_flag("--full", args->full,
+                "print every matrix and set (default: a summary, which names what it leaves out)");
   cmd->add_option("--model-out", args->model_out,
                   "write the model (a scene: its linearisation) as a YAML model file");
   cmd->add_option("--linearisation-threshold", args->linearisation_threshold,

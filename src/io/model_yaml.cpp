@@ -409,24 +409,39 @@ std::vector<std::string> model_notes(const mech::Model& model) {
       // Rows that can never be active together (the two limits of one joint)
       // lower the rank of E without being dependent constraints: checked on
       // the sets that can be active together when there are few rows.
-      bool dependent = rank < k;
-      if (dependent && k <= 64) {
+      const bool deficit = rank < k;
+      // Beyond the enumeration bound (or an enumeration cut short without a
+      // dependent set found) the two causes are not told apart: said so,
+      // not called dependent.
+      bool judged = k <= mech::kMaxCoactiveConstraints, dependent = false;
+      if (deficit && judged) {
         const mech::CoactiveSets sets = mech::coactive_sets(m);
         const Eigen::MatrixXd E(m.E);
-        dependent = !sets.complete ||
-                    std::any_of(sets.maximal.begin(), sets.maximal.end(), [&](const auto& J) {
-                      Eigen::MatrixXd EJ(J.size(), E.cols());
-                      for (size_t i = 0; i < J.size(); ++i) EJ.row(i) = E.row(J[i]);
-                      return lcs::numerical_rank(EJ) < static_cast<int>(J.size());
-                    });
-        if (!dependent)
+        dependent = std::any_of(sets.maximal.begin(), sets.maximal.end(), [&](const auto& J) {
+          Eigen::MatrixXd EJ(J.size(), E.cols());
+          for (size_t i = 0; i < J.size(); ++i) EJ.row(i) = E.row(J[i]);
+          return lcs::numerical_rank(EJ) < static_cast<int>(J.size());
+        });
+        judged = sets.complete || dependent;
+        if (!dependent && judged)
           notes.push_back("E (" + std::to_string(k) + " x " + std::to_string(m.dofs()) +
                           ") has rank " + std::to_string(rank) + " < " + std::to_string(k) +
                           " only through rows that cannot be active together (e.g. both limits "
                           "of one joint): every set that can be active together has "
                           "independent rows, so no constraints are dependent");
       }
-      if (dependent)
+      if (deficit && !judged)
+        notes.push_back("E (" + std::to_string(k) + " x " + std::to_string(m.dofs()) +
+                        ") has rank " + std::to_string(rank) + " < " + std::to_string(k) +
+                        ": dependent constraints or rows that cannot be active together (e.g. "
+                        "both limits of one joint), not told apart (" +
+                        (k > mech::kMaxCoactiveConstraints
+                             ? "the sets that can be active together are enumerated for k <= " +
+                                   std::to_string(mech::kMaxCoactiveConstraints) + " only"
+                             : std::string("their enumeration was cut short")) +
+                        "); dependent constraints are legal (thesis §4.6.1): post-impact "
+                        "velocities are unique, impulses need not be");
+      else if (dependent)
         notes.push_back("dependent constraints: E (" + std::to_string(k) + " x " +
                         std::to_string(m.dofs()) + ") has rank " + std::to_string(rank) + " < " +
                         std::to_string(k) +

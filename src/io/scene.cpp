@@ -86,8 +86,28 @@ std::vector<std::string> stop_list(const YAML::Node& s, const std::string& sourc
 // (Bullet's data files use it for "no limit") cannot be a stop; it is only
 // refused when used, so such a joint can still be frozen or simulated with
 // stops: [].
+// A <limit> without lower or upper (`missing`, limits_without_bounds) used
+// as a stop: URDF's default 0 and 0 would lock the joint at 0, silently.
+// Refused (an input error, not a warning: the run would otherwise show a
+// joint that never moves), with `hint`.
+[[noreturn]] void refuse_unbounded_limit(const std::string& urdf, const urdf::Joint& j,
+                                         const std::string& missing, const std::string& hint) {
+  throw InputError(urdf + ": joint '" + j.name + "': <limit>: no " + missing +
+                   " (URDF reads a missing bound as 0, so as stops lower = upper = 0 would lock "
+                   "the joint at 0; " +
+                   hint + ", or give lower and upper in the URDF)");
+}
+
+// The joint's missing bounds ("" when both are given).
+std::string missing_bounds(const std::map<std::string, std::string>& unbounded,
+                           const std::string& joint) {
+  const auto it = unbounded.find(joint);
+  return it == unbounded.end() ? std::string() : it->second;
+}
+
 void check_stops(const urdf::Joint& j, bool explicit_stops, std::vector<std::string>& st,
-                 const std::string& source, const std::string& key, const std::string& urdf) {
+                 const std::string& source, const std::string& key, const std::string& urdf,
+                 const std::map<std::string, std::string>& unbounded) {
   if (j.type == urdf::Joint::CONTINUOUS) {
     if (explicit_stops && !st.empty())
       fail(source, key + ".stops",
@@ -98,9 +118,10 @@ void check_stops(const urdf::Joint& j, bool explicit_stops, std::vector<std::str
   if (st.empty()) return;
   if (!j.limits)
     fail(source, key, "joint '" + j.name + "' has no <limit> in " + urdf + " (write stops: [])");
-  if (j.limits->lower > j.limits->upper)
-    refuse_reversed_limit(urdf, j,
-                          source + ": " + key + ": write stops: [] to simulate it without stops");
+  const std::string hint = source + ": " + key + ": write stops: [] to simulate it without stops";
+  if (const std::string missing = missing_bounds(unbounded, j.name); !missing.empty())
+    refuse_unbounded_limit(urdf, j, missing, hint);
+  if (j.limits->lower > j.limits->upper) refuse_reversed_limit(urdf, j, hint);
 }
 
 // The limits of each mimic m of simulated joint `leader` (coordinate i) as
@@ -113,15 +134,18 @@ void add_mimic_stops(const urdf::ModelInterface& um, const std::string& urdf,
                      const std::string& key, const std::map<std::string, Mimic>& mimics,
                      const std::string& leader, Eigen::Index i, Eigen::Index n,
                      const std::vector<std::string>& which, std::vector<VectorXd>& rows,
-                     std::vector<double>& gaps, std::vector<std::string>& names) {
+                     std::vector<double>& gaps, std::vector<std::string>& names,
+                     const std::map<std::string, std::string>& unbounded) {
   for (const auto& [name, mm] : mimics) {
     const auto j = um.getJoint(name);
     if (mm.leader != leader || !j->limits || j->type == urdf::Joint::CONTINUOUS ||
         mm.multiplier == 0.0 || which.empty())
       continue;
-    if (j->limits->lower > j->limits->upper)
-      refuse_reversed_limit(
-          urdf, *j, key + ": write mimic_stops: [] to follow '" + leader + "' without them");
+    const std::string hint =
+        key + ": write mimic_stops: [] to follow '" + leader + "' without them";
+    if (const std::string missing = missing_bounds(unbounded, name); !missing.empty())
+      refuse_unbounded_limit(urdf, *j, missing, hint);
+    if (j->limits->lower > j->limits->upper) refuse_reversed_limit(urdf, *j, hint);
     for (const auto& s : which) {
       const double sign = s == "lower" ? 1.0 : -1.0;
       VectorXd r = VectorXd::Zero(n);
@@ -136,6 +160,35 @@ void add_mimic_stops(const urdf::ModelInterface& um, const std::string& urdf,
     }
   }
 }
+// Tolerance of a mimic's q0 against its leader's (rad or m, relative to
+// max(1, |value|)): published reference poses (SRDF, robot descriptions)
+// list every joint with 4 to 6 decimals, so a consistent value is off by
+// up to 5e-5 of a unit from rounding; an inconsistent one by a real angle.
+constexpr double kMimicQ0Tolerance = 1e-4;
+
+// q0 may name a mimic joint m (robots' reference poses list every joint)
+// when it agrees with its leader J: q_m = a q_J + b (J's q0, 0 if not
+// named). The value then says nothing new and is dropped (m follows J);
+// another value is an error naming both joints.
+void check_mimic_q0(std::map<std::string, double>& q0, const std::map<std::string, Mimic>& mimics,
+                    const std::string& source) {
+  for (const auto& [name, mm] : mimics) {
+    const auto it = q0.find(name);
+    if (it == q0.end()) continue;
+    const auto lead = q0.find(mm.leader);
+    const double q_leader = lead == q0.end() ? 0.0 : lead->second;
+    const double follows = mm.multiplier * q_leader + mm.offset;
+    if (std::abs(it->second - follows) > kMimicQ0Tolerance * std::max(1.0, std::abs(follows)))
+      fail(source, "q0." + name,
+           "joint '" + name + "' mimics '" + mm.leader + "' (q = " + format_number(mm.multiplier) +
+               " q_" + mm.leader + " + " + format_number(mm.offset) + " = " +
+               format_number(follows) + " at q0." + mm.leader + " = " + format_number(q_leader) +
+               "), got " + format_number(it->second) + "; give q0 for '" + mm.leader +
+               "' only, or a value that follows it");
+    q0.erase(it);
+  }
+}
+
 }  // namespace
 
 Scene read_scene(const std::string& yaml_text, const std::string& source) {
@@ -154,12 +207,15 @@ Scene read_scene(const std::string& yaml_text, const std::string& source) {
   const std::filesystem::path urdf_path =
       std::filesystem::path(source).parent_path() / std::filesystem::path(urdf_name);
   std::shared_ptr<urdf::ModelInterface> urdf_model;
+  std::map<std::string, std::string> unbounded;  // joints whose <limit> lacks a bound
   {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(urdf_path, ec))
       fail(source, "urdf",
            "no such file (got '" + urdf_name + "', looked for '" + urdf_path.string() + "')");
-    urdf_model = load_urdf(urdf_path);
+    const std::string xml = read_file(urdf_path);
+    urdf_model = parse_urdf(xml, urdf_path.string());
+    unbounded = limits_without_bounds(xml);
   }
   const urdf::ModelInterface& um = *urdf_model;
   const std::string us = urdf_path.string();
@@ -197,7 +253,7 @@ Scene read_scene(const std::string& yaml_text, const std::string& source) {
                "it out to freeze it)");
     if (std::count(joints.begin(), joints.end(), name))
       fail(source, k, "duplicate joint '" + name + "'");
-    check_stops(*j, explicit_stops, st, source, k, us);
+    check_stops(*j, explicit_stops, st, source, k, us, unbounded);
     joints.push_back(name);
     stops.push_back(st);
     mimic_stops.push_back(mst);
@@ -227,11 +283,9 @@ Scene read_scene(const std::string& yaml_text, const std::string& source) {
       if (j->type != urdf::Joint::REVOLUTE && j->type != urdf::Joint::PRISMATIC &&
           j->type != urdf::Joint::CONTINUOUS)
         return "joint '" + n + "' has no position (not revolute, continuous or prismatic)";
-      if (mimics.count(n))
-        return "joint '" + n + "' mimics '" + mimics.at(n).leader +
-               "': its position follows the leader's; give q0 for '" + mimics.at(n).leader + "'";
       return "";
     });
+  check_mimic_q0(q0, mimics, source);
 
   Eigen::Vector3d gravity(0.0, 0.0, -9.81);
   if (keys.count("gravity")) {
@@ -308,7 +362,8 @@ Scene read_scene(const std::string& yaml_text, const std::string& source) {
       m.constraints.push_back(joints[i] + "_" + s);
     }
     add_mimic_stops(um, us, source + ": joints[" + std::to_string(i) + "]", mimics, joints[i],
-                    static_cast<Eigen::Index>(i), N, mimic_stops[i], rows, gaps, m.constraints);
+                    static_cast<Eigen::Index>(i), N, mimic_stops[i], rows, gaps, m.constraints,
+                    unbounded);
   }
   if (keys.count("constraints")) {
     const YAML::Node& cn = keys.at("constraints");
@@ -440,10 +495,14 @@ bool same_matrix(const mech::SparseMatrix& a, const mech::SparseMatrix& b) {
 
 bool same_vector(const VectorXd& a, const VectorXd& b) { return a.size() == b.size() && a == b; }
 
+// The same model up to the restitution: a restitution is a parameter of the
+// constraints, not of the scene's bodies (the URDF has none; a study's
+// restitution axis changes it, issue 24), so a scene with another one is
+// still that scene.
 bool same_model(const mech::MechanicalModel& a, const mech::MechanicalModel& b) {
   return same_matrix(a.M, b.M) && same_matrix(a.D, b.D) && same_matrix(a.K, b.K) &&
          same_matrix(a.E, b.E) && same_vector(a.g, b.g) && same_vector(a.f, b.f) &&
-         same_vector(a.restitution, b.restitution) && a.coordinates == b.coordinates &&
+         a.restitution.size() == b.restitution.size() && a.coordinates == b.coordinates &&
          a.constraints == b.constraints;
 }
 
@@ -454,6 +513,7 @@ std::optional<Scene> scene_setup(const mech::Model& model) {
   try {
     std::optional<Scene> scene = load_scene_details(model.source);
     if (!scene || !same_model(*scene->model.mechanical, *model.mechanical)) return std::nullopt;
+    scene->model.mechanical->restitution = model.mechanical->restitution;  // the model's own
     return scene;
   } catch (const std::exception&) {
     return std::nullopt;

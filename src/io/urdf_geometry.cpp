@@ -11,6 +11,8 @@
 // recognise is copied unchanged and left to urdfdom.
 #include <array>
 #include <cstring>
+#include <map>
+#include <regex>
 #include <string>
 
 #include "io/detail.hpp"
@@ -72,7 +74,44 @@ std::size_t verbatim_end(const std::string& xml, std::size_t pos) {
   return std::string::npos;
 }
 
+// The value of attribute `name` in the start tag `tag` ("" if absent), and
+// whether it is there at all.
+bool has_attribute(const std::string& tag, const std::string& name, std::string* value = nullptr) {
+  const std::regex re("[\\s]" + name + "\\s*=\\s*(\"([^\"]*)\"|'([^']*)')");
+  std::smatch m;
+  if (!std::regex_search(tag, m, re)) return false;
+  if (value) *value = m[2].matched ? m[2].str() : m[3].str();
+  return true;
+}
+
 }  // namespace
+
+std::map<std::string, std::string> limits_without_bounds(const std::string& xml) {
+  std::map<std::string, std::string> out;
+  std::string joint;  // the <joint> element the scan is in ("" outside)
+  std::size_t pos = 0;
+  while ((pos = xml.find('<', pos)) != std::string::npos) {
+    if (const std::size_t v = verbatim_end(xml, pos); v != std::string::npos) {
+      pos = v;
+      continue;
+    }
+    const std::size_t e = tag_end(xml, pos);
+    if (e == std::string::npos) break;  // unclosed: urdfdom reports it
+    const std::string tag = xml.substr(pos, e - pos);
+    if (starts_tag(xml, pos, "joint")) {
+      joint.clear();
+      if (tag[tag.size() - 2] != '/') has_attribute(tag, "name", &joint);
+    } else if (tag.compare(0, 7, "</joint") == 0) {
+      joint.clear();
+    } else if (!joint.empty() && starts_tag(xml, pos, "limit")) {
+      const bool lower = has_attribute(tag, "lower"), upper = has_attribute(tag, "upper");
+      if (!lower || !upper)
+        out[joint] = !lower && !upper ? "lower and upper" : !lower ? "lower" : "upper";
+    }
+    pos = e;
+  }
+  return out;
+}
 
 std::string without_geometry(const std::string& xml) {
   std::string out;

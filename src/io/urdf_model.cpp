@@ -18,9 +18,11 @@
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <functional>
 #include <lcsim/io/io.hpp>
@@ -86,6 +88,48 @@ bool finite_pose(const urdf::Pose& p) {
          std::isfinite(p.rotation.y) && std::isfinite(p.rotation.z) && std::isfinite(p.rotation.w);
 }
 
+// Relative tolerance of the inertia checks, against the largest principal
+// moment. URDF files write inertias with 6 or so significant digits
+// (CAD exports, xacro arithmetic): each entry then carries a rounding error
+// up to 5e-6 of the largest, and the principal moments move by at most the
+// 2-norm of that 3 x 3 error, <= 3 * 5e-6 = 1.5e-5 of the largest; a sum of
+// two of them (the triangle inequality) up to 3e-5. 1e-4 leaves a margin of
+// 3 over that while anything physical is refused: a negative moment or a
+// violated triangle of a real body is off by a sizeable fraction.
+constexpr double kInertiaTolerance = 1e-4;
+
+// An <inertia> (about the centre of mass) of a rigid body: its principal
+// moments I1 <= I2 <= I3 are >= 0 (positive semi-definite) and satisfy the
+// triangle inequality I1 + I2 >= I3 (I1 + I2 - I3 = 2 sum m z^2 over the
+// body along the third axis), both to kInertiaTolerance * I3. Every link
+// is checked, simulated or not, as masses are: a frozen or fixed link's
+// inertia enters the composite body of the joint that carries it.
+void check_inertia(const urdf::Inertial& in, const std::string& source, const std::string& el) {
+  Matrix3d I;
+  I << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
+  const Vector3d p =
+      Eigen::SelfAdjointEigenSolver<Matrix3d>(I, Eigen::EigenvaluesOnly).eigenvalues();
+  const double tol = kInertiaTolerance * std::max(std::abs(p(0)), std::abs(p(2)));
+  const std::string got = "(got ixx=" + num(in.ixx) + ", ixy=" + num(in.ixy) +
+                          ", ixz=" + num(in.ixz) + ", iyy=" + num(in.iyy) + ", iyz=" + num(in.iyz) +
+                          ", izz=" + num(in.izz) + ")";
+  // The moments are computed, not read: 6 significant digits (the file's
+  // own values are in `got`, exactly).
+  const auto six = [](double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", x);
+    return std::string(buf);
+  };
+  const std::string moments =
+      "principal moments " + six(p(0)) + ", " + six(p(1)) + ", " + six(p(2));
+  if (p(0) < -tol)
+    fail(source, el, "not positive semi-definite: " + moments + " (kg m^2), a negative one " + got);
+  if (p(0) + p(1) < p(2) - tol)
+    fail(source, el,
+         moments + " break the triangle inequality (" + six(p(0)) + " + " + six(p(1)) + " < " +
+             six(p(2)) + "): no rigid body has them " + got);
+}
+
 void check_urdf(const urdf::ModelInterface& m, const std::string& source) {
   // urdfdom accepts a joint whose parent is its own child (it only looks for
   // a root): the link then lists itself among its children and every walk
@@ -116,6 +160,7 @@ void check_urdf(const urdf::ModelInterface& m, const std::string& source) {
       fail(source, el + " <mass value>", "must be finite and >= 0 (got " + num(in.mass) + ")");
     for (double x : {in.ixx, in.ixy, in.ixz, in.iyy, in.iyz, in.izz})
       if (!std::isfinite(x)) fail(source, el + " <inertia>", "not finite (got " + num(x) + ")");
+    check_inertia(in, source, el + " <inertia>");
   }
   for (const auto& [name, joint] : m.joints_) {
     const std::string el = "joint '" + name + "'";

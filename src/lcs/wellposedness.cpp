@@ -34,7 +34,9 @@ Verdict check_feedthrough(const Lcs& sys) {
   const double lmin = Eigen::SelfAdjointEigenSolver<MatrixXd>(S).eigenvalues()(0);
   if (lmin < -1e-12 * std::max(spectral_norm(S), spectral_norm(sys.D))) {
     std::ostringstream os;
-    os << "not passive: D + D' has eigenvalue " << lmin << " < 0 (necessary: D + D' >= 0)";
+    os << "not passive: D + D' has eigenvalue " << lmin
+       << " < 0 (necessary: D + D' >= 0; D is "
+          "the LCS's feedthrough in y = C x + D u, not a mechanical damping)";
     v.failed = true;
     v.reason = os.str();
   }
@@ -64,14 +66,15 @@ Verdict check_first_markov(const Lcs& sys) {
   const double tol = 1e-10 * std::max(scale, 1e-300);
   std::ostringstream os;
   if ((H1 - H1.transpose()).cwiseAbs().maxCoeff() > tol) {
-    os << "not passive: on Ker(D + D') the first Markov parameter CB is not symmetric "
-          "(necessary: KB = C' there, so CB = B'KB)";
+    os << "not passive: on Ker(D + D') (D the LCS's feedthrough in y = C x + D u) the first "
+          "Markov parameter CB is not symmetric (necessary: KB = C' there, so CB = B'KB)";
     v.failed = true;
   } else {
     const MatrixXd Hs = 0.5 * (H1 + H1.transpose());
     Eigen::SelfAdjointEigenSolver<MatrixXd> es(Hs, Eigen::ComputeEigenvectors);
     if (es.eigenvalues()(0) < -tol) {
-      os << "not passive: on Ker(D + D') the first Markov parameter CB has eigenvalue "
+      os << "not passive: on Ker(D + D') (D the LCS's feedthrough in y = C x + D u) the first "
+            "Markov parameter CB has eigenvalue "
          << es.eigenvalues()(0) << " < 0 (necessary: CB = B'KB >= 0 there)";
       v.failed = true;
     } else {
@@ -81,7 +84,8 @@ Verdict check_first_markov(const Lcs& sys) {
         if (es.eigenvalues()(i) > tol) break;
         const double bw = (BZ * es.eigenvectors().col(i)).norm();
         if (bw > 1e-8 * bscale) {
-          os << "not passive: D + D' is singular and CB vanishes on an input direction w "
+          os << "not passive: the feedthrough D + D' (y = C x + D u) is singular and CB "
+                "vanishes on an input direction w "
                 "with B w != 0 (necessary: KB = C' there, so w'CBw = |K^{1/2} B w|^2 > 0); "
                 "e.g. relative degree >= 2 such as a position output";
           v.failed = true;
@@ -215,7 +219,7 @@ WellPosednessReport analyze_well_posedness(const Lcs& sys) {
       return r;
     }
   }
-  passed.push_back("D + D' >= 0");
+  passed.push_back("feedthrough D + D' >= 0 (D of y = C x + D u, not a mechanical damping)");
   passed.push_back("CB symmetric PSD on Ker(D + D') with Ker = Ker(B)");
   int points = 0;
   const Verdict f = check_frequency(sys, &points);
@@ -242,6 +246,16 @@ WellPosednessReport analyze_well_posedness(const Lcs& sys) {
        "velocity-output mechanical model) can check one with verify_passivity_certificate";
   r.passivity_reason = s;
   return r;
+}
+
+std::vector<std::string> summary_left_out(const WellPosednessReport& r) {
+  std::vector<std::string> out;
+  Eigen::Index markov = 0;
+  for (const auto& H : r.markov) markov += H.size();
+  if (!summary_shows(markov)) out.push_back("markov");
+  if (!summary_shows(r.row_coefficients.size())) out.push_back("row_coefficients");
+  if (!summary_shows(r.column_coefficients.size())) out.push_back("column_coefficients");
+  return out;
 }
 
 }  // namespace lcsim::lcs

@@ -6,6 +6,7 @@
 #include <lcsim/mech/mech.hpp>
 #include <map>
 #include <set>
+#include <string>
 
 namespace lcsim::mech {
 
@@ -253,6 +254,33 @@ CoactiveWellPosedness coactive_well_posedness(const MechanicalModel& m, const Co
   out.dependent = std::any_of(out.sets.begin(), out.sets.end(), [](const auto& r) {
     return r.rank < static_cast<int>(r.indices.size());
   });
+  return out;
+}
+
+std::vector<std::string> coactive_not_judged(const MechanicalModel& m, const CoactiveSets* sets,
+                                             int rank_E) {
+  const int k = m.num_constraints();
+  const std::string rank = "rank E = " + std::to_string(rank_E) + " < k = " + std::to_string(k);
+  std::vector<std::string> out;
+  if (!sets) {
+    if (k == 0) return out;
+    out.push_back("the sets of constraints that can be active together were not enumerated (k = " +
+                  std::to_string(k) + " > " + std::to_string(kMaxCoactiveConstraints) +
+                  "): Theorem 3.6.3 and the Delassus P-property are judged on all k rows at "
+                  "once only, which asks more than an admissible state reaches (e.g. both "
+                  "limits of a joint closed), not on the sets an admissible state can reach");
+    if (rank_E < k)
+      out.push_back(rank +
+                    " was not explained: dependent constraints (§4.6.1) and rows that "
+                    "merely cannot be active together (the two limits of a joint) were "
+                    "not told apart");
+    return out;
+  }
+  if (sets->complete) return out;
+  out.push_back("the enumeration of the sets that can be active together was cut short after " +
+                std::to_string(sets->maximal.size()) +
+                " maximal sets: the sets not enumerated were not judged (Theorem 3.6.3, the "
+                "Delassus P-property, dependent rows)");
   return out;
 }
 

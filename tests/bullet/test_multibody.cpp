@@ -76,7 +76,7 @@ const char* kSpatial = R"(<robot name="spatial">
   <link name="d"><inertial><origin xyz="0 0 0.05" rpy="0 0 0.7"/><mass value="0.3"/>
     <inertia ixx="0.003" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.001"/></inertial></link>
   <link name="e"><inertial><origin xyz="0.02 0.03 0"/><mass value="0.2"/>
-    <inertia ixx="0.001" ixy="0.0002" ixz="0" iyy="0.002" iyz="0" izz="0.001"/></inertial></link>
+    <inertia ixx="0.001" ixy="0.0002" ixz="0" iyy="0.0018" iyz="0" izz="0.001"/></inertial></link>
   <link name="f"><inertial><origin xyz="0 0.04 0.02"/><mass value="0.4"/>
     <inertia ixx="0.002" ixy="0" ixz="0" iyy="0.003" iyz="0.0005" izz="0.002"/></inertial></link>
   <joint name="yaw" type="revolute"><parent link="base"/><child link="a"/>

@@ -42,7 +42,7 @@ std::string gripper(double multiplier, double offset, const std::string& right_l
   return std::string(
              "<robot name='g'><link name='base'/>"
              "<link name='hand'><inertial><origin xyz='0 0 0.05'/><mass value='1'/>"
-             "<inertia ixx='0.01' ixy='0' ixz='0' iyy='0.01' iyz='0' izz='0.05'/></inertial></link>"
+             "<inertia ixx='0.03' ixy='0' ixz='0' iyy='0.03' iyz='0' izz='0.05'/></inertial></link>"
              "<link name='left'><inertial><origin xyz='0 0 0.02'/><mass value='0.2'/>") +
          kInertia +
          "</inertial></link><link name='right'><inertial><origin xyz='0 0 0.02'/><mass "

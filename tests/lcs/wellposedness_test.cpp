@@ -1,6 +1,6 @@
 // The well-posedness report: Markov parameters (3.32), leading indices and
 // coefficient matrices (3.39), Theorem 3.6.3, the backward Euler guard of
-// Example 7.3.3 and the passivity checks of §7.2.
+// Example 7.3.3, the passivity checks of §7.2 and the summary of a report.
 //
 // Tolerances: the data are small integers and the Markov parameters are
 // products of at most n + 1 = 7 such matrices, exact in floating point; the
@@ -173,6 +173,34 @@ TEST(Passivity, ReasonIsAlwaysStated) {
     const auto r = analyze_well_posedness(s);
     EXPECT_FALSE(r.passivity_reason.empty());
   }
+}
+
+// Issue 24 (items 7 and 8): the passivity reasons speak of the LCS's
+// feedthrough D (y = C x + D u), which `analyze` prints beside a mechanical
+// model's damping D; the two carts' position output has relative degree 2,
+// so the check fails at N2 (CB = 0 with B != 0).
+TEST(ReportWords, PassivityReasonNamesTheFeedthrough) {
+  const WellPosednessReport r = analyze_well_posedness(two_carts());
+  EXPECT_EQ(r.passive, "no");
+  EXPECT_NE(r.passivity_reason.find("feedthrough"), std::string::npos) << r.passivity_reason;
+  EXPECT_NE(r.passivity_reason.find("y = C x + D u"), std::string::npos) << r.passivity_reason;
+  // D + D' < 0: the first necessary condition, same words.
+  Lcs s = two_carts();
+  s.D(0, 0) = -1.0;
+  const WellPosednessReport n = analyze_well_posedness(s);
+  EXPECT_NE(n.passivity_reason.find("not a mechanical damping"), std::string::npos)
+      << n.passivity_reason;
+}
+
+// Sizes: the two carts' report (5 Markov parameters of 1 x 1) is shown
+// whole; a report whose matrices exceed 400 numbers is summarised by name.
+TEST(ReportWords, SummaryLeavesOutOnlyLargeMatrices) {
+  WellPosednessReport r = analyze_well_posedness(two_carts());
+  EXPECT_TRUE(summary_left_out(r).empty());
+  r.markov.assign(5, MatrixXd::Zero(9, 9));     // 405 numbers together
+  r.row_coefficients = MatrixXd::Zero(20, 20);  // 400: shown
+  r.column_coefficients = MatrixXd::Zero(21, 20);
+  EXPECT_EQ(summary_left_out(r), (std::vector<std::string>{"markov", "column_coefficients"}));
 }
 
 }  // namespace

@@ -304,7 +304,9 @@ nlohmann::json to_json(const std::vector<LinearRange>& ranges);
 // The scene `model` was loaded from (model.source, read again), for building
 // it again from its URDF (src/bullet); std::nullopt when model.source is not
 // a readable, valid scene file or when `model` is not what that file gives
-// (changed after loading: M, D, K, E, g, f, restitution or the names differ).
+// (changed after loading: M, D, K, E, g, f or the names differ). The
+// restitution may differ: the returned scene's model carries `model`'s (a
+// study's restitution axis changes a parameter, not the kind of model).
 std::optional<Scene> scene_setup(const mech::Model& model);
 
 }  // namespace lcsim::io

@@ -107,6 +107,18 @@ struct WellPosednessReport {
 };
 WellPosednessReport analyze_well_posedness(const Lcs& sys);
 
+// A summary of a report (what `lcsim analyze` prints unless asked for the
+// full report): the verdicts, and of the matrices only those of at most
+// kSummaryEntries numbers. The report's matrices grow as k^2 n: 66 stops on
+// a 33-cart chain give 135 Markov parameters of 66 x 66, 3.7 MB of text.
+// 400 numbers (a 20 x 20 matrix, a screen) keep every matrix of the thesis's
+// examples and of a 7-joint arm's Delassus matrix (14 x 14).
+inline constexpr Eigen::Index kSummaryEntries = 400;
+inline bool summary_shows(Eigen::Index entries) { return entries <= kSummaryEntries; }
+// The parts of `r` a summary leaves out, by their JSON names: "markov" (all
+// of H^0..H^n, counted together), "row_coefficients", "column_coefficients".
+std::vector<std::string> summary_left_out(const WellPosednessReport& r);
+
 // Mode selection by LDCP (§3.5.2) solved level by level as a series of LCPs
 // with Schur complements of the leading row coefficient matrix (proof of
 // Theorem 3.6.7, extended to the impulsive levels -n+1..0). Requires script M

@@ -248,4 +248,17 @@ struct CoactiveWellPosedness {
 };
 CoactiveWellPosedness coactive_well_posedness(const MechanicalModel& m, const CoactiveSets& s);
 
+// `analyze` enumerates the sets only up to this many constraints (pairs are
+// k^2 / 2 small LCPs; a 7-joint arm has 14 rows) and a summary lists at most
+// kSummarySets maximal sets and exclusive pairs (their counts are given).
+inline constexpr int kMaxCoactiveConstraints = 64;
+inline constexpr std::size_t kSummarySets = 8;
+
+// What was not judged, in plain sentences: `sets` null when the enumeration
+// was skipped (k > kMaxCoactiveConstraints), else what its being cut short
+// (sets->complete false) leaves open. `rank_E` (constraint_rank) says
+// whether a rank deficit is left unexplained. Empty when all was judged.
+std::vector<std::string> coactive_not_judged(const MechanicalModel& m, const CoactiveSets* sets,
+                                             int rank_E);
+
 }  // namespace lcsim::mech
