@@ -109,12 +109,16 @@ EventDriven::MonitorStart EventDriven::monitor_start(const Phase& phase, const V
   double& h_first = st.h_first;
   h_first = h_max;
   // Noise level of each monitor at the phase start: rounding of its terms
-  // plus the time quantisation of the event time (ulp(t) times its rate).
+  // |w| |x| plus the time quantisation of the event time (ulp(t) times its
+  // rate). Its own terms, not |w|_1 max|x|: balancing can scale a coordinate
+  // the monitor does not involve far above the others (a clamped joint of
+  // Talos at 2.7e5), and that band (2.5e-9) hid a gap of 1.2e-9 closing,
+  // wider than re-initialisation's zero test (1e-9 of the gap's terms).
   std::vector<double>& noise = st.noise;
   noise.resize(phase.monitors.size());
   for (size_t j = 0; j < phase.monitors.size(); ++j) {
     const Monitor& mon = phase.monitors[j];
-    noise[j] = 64.0 * kEps * mon.w.cwiseAbs().sum() * xstart.cwiseAbs().maxCoeff() +
+    noise[j] = 64.0 * kEps * mon.w.cwiseAbs().dot(xstart.cwiseAbs()) +
                (16.0 * kEps * std::max(1.0, std::abs(t)) + opt_.event_time_tol) *
                    std::abs(mon.wA.dot(xstart));
   }
