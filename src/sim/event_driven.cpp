@@ -74,7 +74,9 @@ void EventDriven::check_feasible(double t, const VectorXd& xa, const VectorXd& y
   // The state's scale, not the row's own terms: a held contact's gap drifts
   // with the rounding of the whole state (reinitialisation.cpp).
   const double terms = sys_.C.row(r).cwiseAbs().sum() * xa.cwiseAbs().maxCoeff();
-  if (y(r) >= -(kSqrtEps * terms + ldcp_.tol_abs)) return;
+  // An event state lies within the event time's resolution of the crossing.
+  const double rate = model_.mechanical->E.row(r).dot(xa.segment(N_, N_));
+  if (y(r) >= -(kSqrtEps * terms + ldcp_.tol_abs + time_resolution(t) * std::abs(rate))) return;
   std::ostringstream msg;
   msg.precision(6);
   msg << "constraint '" << model_.mechanical->constraints[static_cast<size_t>(r)]
@@ -119,8 +121,7 @@ EventDriven::MonitorStart EventDriven::monitor_start(const Phase& phase, const V
   for (size_t j = 0; j < phase.monitors.size(); ++j) {
     const Monitor& mon = phase.monitors[j];
     noise[j] = 64.0 * kEps * mon.w.cwiseAbs().dot(xstart.cwiseAbs()) +
-               (16.0 * kEps * std::max(1.0, std::abs(t)) + opt_.event_time_tol) *
-                   std::abs(mon.wA.dot(xstart));
+               time_resolution(t) * std::abs(mon.wA.dot(xstart));
   }
   // Per monitor: the order m0 of its first nonzero derivative at the phase
   // start (0 = the value itself; -1 = none up to n) and that derivative d0.

@@ -68,5 +68,54 @@ TEST(MonitorNoise, SmallGapApproachingIsFoundNextToALargeCoordinate) {
   }
 }
 
+// The bouncing ball of robots/ball.yaml (unit mass, g = 9.81, e = 0.5,
+// dropped from 1 m at rest) with a root tolerance in time: impacts at
+// t1 = sqrt(2/g) and then every 2 e^i t1, accumulating at t* = 3 t1.
+// Brent returns an event within event_time_tol of the crossing, on either
+// side, so the gap there is down to -tol |rate|; re-initialisation tested a
+// gap for zero with the time's resolution 16 ulp(t) only, so every run with
+// event_time_tol > 0 failed at the first impact ("the state is infeasible",
+// gap -1e-6 for tol = 1e-6), and the accumulation's limit left the ball out
+// of its own closure (gap +1e-10) and took a second limit 2e-6 s later.
+TEST(MonitorNoise, EventTimeToleranceIsPartOfTheZeroTests) {
+  mech::MechanicalModel m;
+  m.M = MatrixXd::Identity(1, 1).sparseView();
+  m.E = MatrixXd::Identity(1, 1).sparseView();
+  m.g = VectorXd::Zero(1);
+  const double g = 9.81;
+  m.f = VectorXd::Constant(1, -g);
+  m.restitution = VectorXd::Constant(1, 0.5);
+  const mech::Model model = mech::model_of(m, "ball");
+  const double t1 = std::sqrt(2.0 / g), v1 = std::sqrt(2.0 * g);  // first impact, its speed
+  for (const double tol : {1e-9, 1e-6, 1e-4}) {
+    SCOPED_TRACE(tol);
+    sim::Options opt;
+    opt.t_end = 3.0;
+    opt.event_time_tol = tol;
+    const sim::Trajectory tr = sim::simulate_event_driven(model, Eigen::Vector2d(1.0, 0.0), opt);
+    ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
+    ASSERT_GE(tr.events.size(), 2u);
+    // Brent's bracket ends within tol + 4 ulp(t) of the root.
+    EXPECT_EQ(tr.events[0].type, sim::EventType::kImpact);
+    EXPECT_NEAR(tr.events[0].t, t1, tol + 1e-15);
+    // One limit, the last event, with the ball closed and at rest after it.
+    for (size_t i = 0; i + 1 < tr.events.size(); ++i)
+      EXPECT_EQ(tr.events[i].type, sim::EventType::kImpact) << i;
+    EXPECT_EQ(tr.events.back().type, sim::EventType::kAccumulation);
+    EXPECT_EQ(tr.events.back().mode_after, lcs::IndexSet{0});
+    // The limit is taken, without extrapolation, once an interval is below
+    // 16 times the sum of its two impacts' resolutions (each >= tol): the
+    // tail left, d r/(1 - r) = d for r = 0.5, is below 32 tol. The impacts'
+    // own errors (each <= tol) come on top; measured in total: 1.3 tol
+    // (extrapolated), 27 tol, 18.5 tol.
+    EXPECT_NEAR(tr.events.back().t, 3.0 * t1, 32.0 * tol);
+    EXPECT_EQ(tr.final_state(0), 0.0);
+    EXPECT_EQ(tr.final_state(1), 0.0);
+    // An event state lies within tol + 4 ulp(t) of the crossing, at a rate
+    // below the first impact's speed.
+    EXPECT_GE(tr.max_violation, -(tol + 1e-15) * v1);
+  }
+}
+
 }  // namespace
 }  // namespace lcsim
