@@ -133,6 +133,9 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
     // xi and the scale of its terms.
     VectorXd xi = VectorXd::Zero(k), scale = VectorXd::Zero(k);
     for (int r = 0; r < k; ++r) {
+      // A row decided inactive keeps its state: its coefficients are not
+      // used again (a robot's 64 stops, most open, at up to n levels each).
+      if (state[r] == RowState::kInactive) continue;
       const int order = rho[r] + p;
       if (order >= 1) {
         const int m = free_response(order - 1);

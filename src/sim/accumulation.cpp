@@ -168,7 +168,11 @@ std::string EventDriven::take_accumulation_limit(int r, double t, const Geometri
   for (int s = 0; s < k_; ++s) {
     const auto& h = impact_times_[s];
     const bool took_part = s == r || (!h.empty() && h.back().t >= since);
-    const double bounce = 2.0 * std::abs(rate(s)) * std::max(0.0, t_star - t);
+    // Plus what the event time's resolution leaves in the gap, as in the
+    // closed test of re-initialisation (an event_time_tol of 1e-6 s left r
+    // itself open by 1e-10 and out of its own limit: it bounced on).
+    const double bounce =
+        std::abs(rate(s)) * (2.0 * std::max(0.0, t_star - t) + time_resolution(t));
     if (!took_part || gap(s) > 1e-6 * gap_scale(s) + ldcp_.tol_abs + bounce) continue;
     names += (names.empty() ? "'" : ", '") + model_.mechanical->constraints[s] + "'";
     joined.push_back(s);

@@ -243,6 +243,12 @@ class EventDriven {
   VectorXd user(const VectorXd& xa) const {
     return model_.is_mechanical() ? VectorXd(xa.head(2 * N_)) : xa;
   }
+  // The resolution of an event time t: a few ulp of t, plus the root
+  // tolerance the user allows (Options::event_time_tol). A monitor crossing
+  // zero at rate r is located within r times this of zero, on either side.
+  double time_resolution(double t) const {
+    return 16.0 * kEps * std::max(1.0, std::abs(t)) + opt_.event_time_tol;
+  }
   bool is_zero(double value, double scale) const {
     return std::abs(value) <= ldcp_.tol_rel * scale + ldcp_.tol_abs;
   }

@@ -40,8 +40,8 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0,
     for (int r = 0; r < k_; ++r) {
       // Zero within rounding, or within what the event time's resolution
       // (a few ulp of t times the rate) leaves in the gap.
-      double gap_tol = ldcp_.tol_rel * gap_scale(r) + ldcp_.tol_abs +
-                       16.0 * kEps * std::max(1.0, std::abs(t)) * std::abs(rate(r));
+      double gap_tol =
+          ldcp_.tol_rel * gap_scale(r) + ldcp_.tol_abs + time_resolution(t) * std::abs(rate(r));
       // A constraint the ending phase held closed has a zero gap by
       // construction; what it shows is the phase's drift, the rounding of
       // the whole state carried through the coupling (its own entries may be
@@ -76,7 +76,7 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0,
         // approach rate, and the event time's few ulp.
         time_noise(r) =
             64.0 * kEps * (m.E.row(r).cwiseAbs().dot(q.cwiseAbs()) + std::abs(m.g(r))) / -rate(r) +
-            16.0 * kEps * std::max(1.0, std::abs(t));
+            time_resolution(t);
         const GeometricTail g =
             limit_taken ? GeometricTail{} : accumulation_time(r, t, time_noise(r));
         if (g.t_star >= t && g.t_star >= tail.t_star) {
