@@ -17,7 +17,10 @@
 #include <algorithm>
 #include <cmath>
 #include <lcsim/lcs/lcs.hpp>
+#include <memory>
 #include <sstream>
+#include <string>
+#include <vector>
 
 namespace lcsim::lcs {
 
@@ -45,6 +48,242 @@ VectorXd sub(const VectorXd& v, const std::vector<int>& r) {
   return s;
 }
 
+// Free response coefficients C A^m x0 and their term scales |C| |A|^m |x0|,
+// computed on demand (a selection rarely needs more than a few orders).
+class FreeResponse {
+ public:
+  FreeResponse(const Lcs& sys, const VectorXd& x0) : sys_(sys), Amx_(x0), Amx_abs_(x0.cwiseAbs()) {}
+  // Makes order m available; returns m.
+  int reach(int m) {
+    if (CAx.empty()) {
+      Aabs_ = sys_.A.cwiseAbs();
+      Cabs_ = sys_.C.cwiseAbs();
+    }
+    while (static_cast<int>(CAx.size()) <= m) {
+      CAx.push_back(sys_.C * Amx_);
+      CAx_scale.push_back(Cabs_ * Amx_abs_);
+      Amx_ = sys_.A * Amx_;
+      Amx_abs_ = Aabs_ * Amx_abs_;
+    }
+    return m;
+  }
+  std::vector<VectorXd> CAx, CAx_scale;  // index m: C A^m x0 and its scale
+
+ private:
+  const Lcs& sys_;
+  VectorXd Amx_, Amx_abs_;  // A^m x0 and |A|^m |x0| for the next order
+  MatrixXd Aabs_, Cabs_;
+};
+
+// LDCP_kappa(x0) being solved: the system, its data, the options, and what the
+// levels solved so far have found.
+struct Ldcp {
+  const Lcs& sys;
+  const LdcpData& data;
+  const LdcpOptions& opt;
+  const lcp::Solver& solver;
+  const int first;  // the level of delta^{(n-1)}: -n + 1
+  FreeResponse free;
+  std::vector<RowState> state;
+  std::vector<VectorXd> u;          // u^p for p = first..current, index p - first
+  std::vector<int> nonzero_levels;  // the j with u^j != 0 (most levels are zero)
+};
+
+// Level p: the known part xi_p of the new coefficients y^{rho_r + p} (3.42),
+// the scale of its terms, and the rows active (I) and undecided (K) on entry.
+struct Level {
+  int p = 0;
+  VectorXd xi, scale;
+  IndexSet I, K;
+  double tol_y(int r, const LdcpOptions& opt) const { return opt.tol_rel * scale(r) + opt.tol_abs; }
+};
+
+std::string infinite_index_refusal(const std::vector<int>& rho) {
+  for (int r = 0; r < static_cast<int>(rho.size()); ++r) {
+    if (rho[r] == kInfiniteIndex)
+      return "constraint " + std::to_string(r) +
+             " has an infinite leading row index: its modes are not autonomous "
+             "(Lemma 3.6.5), the LDCP does not select a mode";
+  }
+  return "";
+}
+
+// xi_{p,r} = [rho_r + p >= 1] C_r A^{rho_r + p - 1} x0
+//            + sum_{j < p} H_r^{rho_r + p - j} u^j                      (3.42)
+Level level_coefficients(Ldcp& s, int p) {
+  const int k = s.sys.k();
+  const int n = s.sys.n();
+  Level l;
+  l.p = p;
+  l.xi = VectorXd::Zero(k);
+  l.scale = VectorXd::Zero(k);
+  for (int r = 0; r < k; ++r) {
+    // A row decided inactive keeps its state: its coefficients are not
+    // used again (a robot's 64 stops, most open, at up to n levels each).
+    if (s.state[r] == RowState::kInactive) continue;
+    const int order = s.data.rho[r] + p;
+    if (order >= 1) {
+      const int m = s.free.reach(order - 1);
+      l.xi(r) += s.free.CAx[m](r);
+      l.scale(r) += s.free.CAx_scale[m](r);
+    }
+    for (int j : s.nonzero_levels) {
+      const VectorXd& uj = s.u[j - s.first];
+      const int h = order - j;
+      if (h < 0 || h > 3 * n) continue;
+      const MatrixXd& Hh = s.data.markov(h);
+      l.xi(r) += Hh.row(r).dot(uj);
+      l.scale(r) += Hh.row(r).cwiseAbs().dot(uj.cwiseAbs());
+    }
+  }
+  return l;
+}
+
+// Below the first level solved, u^p = 0: the coefficients are the free
+// response, and an undecided row must not start negative (regularity,
+// Theorem 3.6.7, (3.40)). "" or why the state is refused.
+std::string free_level(Ldcp& s, const Level& l) {
+  if (!l.I.empty()) return "internal: active rows below the first LCP level";
+  for (int r : l.K) {
+    if (l.xi(r) > l.tol_y(r, s.opt)) {
+      s.state[r] = RowState::kInactive;
+    } else if (l.xi(r) < -l.tol_y(r, s.opt)) {
+      std::ostringstream msg;
+      msg.precision(6);
+      msg << "state is not regular: constraint " << r << " has coefficient y^"
+          << s.data.rho[r] + l.p << " = " << l.xi(r)
+          << " < 0 with no impulse allowed (Theorem 3.6.7, (3.40))";
+      return msg.str();
+    }
+  }
+  return "";
+}
+
+// Rows whose constant term is zero up to rounding of its terms stay exactly
+// zero: dependent constraints make the Schur complement singular, and a
+// -1e-17 there would make the LCP infeasible.
+void zero_cancelled(const Ldcp& s, const Level& l, const Eigen::FullPivLU<MatrixXd>& luI,
+                    VectorXd& qK) {
+  const MatrixXd& Mlead = s.data.Mlead;
+  const VectorXd cancelled =
+      l.I.empty() ? VectorXd::Zero(l.K.size())
+                  : VectorXd((sub(Mlead, l.K, l.I) * luI.solve(sub(l.xi, l.I))).cwiseAbs());
+  for (size_t i = 0; i < l.K.size(); ++i)
+    if (std::abs(qK(i)) <= s.opt.tol_rel * (l.scale(l.K[i]) + cancelled(i)) + s.opt.tol_abs)
+      qK(i) = 0.0;
+}
+
+// u_K from the LCP of the Schur complement of script M_II (3.49)-(3.50).
+// "" or why the LCP failed.
+std::string schur_lcp(const Ldcp& s, const Level& l, const Eigen::FullPivLU<MatrixXd>& luI,
+                      VectorXd& uK, int& lcp_solves) {
+  const MatrixXd& Mlead = s.data.Mlead;
+  MatrixXd S = sub(Mlead, l.K, l.K);
+  VectorXd qK = sub(l.xi, l.K);
+  if (!l.I.empty()) {
+    const MatrixXd MKI = sub(Mlead, l.K, l.I);
+    S -= MKI * luI.solve(sub(Mlead, l.I, l.K));
+    qK -= MKI * luI.solve(sub(l.xi, l.I));
+  }
+  zero_cancelled(s, l, luI, qK);
+  // Dependent constraints give a PSD, not P, matrix whose LCP Lemke still
+  // solves (q in its range, Lemma 4.6.1); the motion is unique even where the
+  // multipliers are not (Theorem 4.6.5).
+  int attempts = 0;
+  const lcp::Result res = lcp::solve_with_fallbacks(s.solver, S, qK, lcp::Options{}, &attempts);
+  lcp_solves += attempts;
+  if (!res.ok())
+    return "LCP at LDCP level " + std::to_string(l.p) +
+           " failed: " + std::string(lcp::to_string(res.status, "solved")) +
+           (res.message.empty() ? "" : " (" + res.message + ")");
+  uK = res.z;
+  return "";
+}
+
+// u^p: the active rows eliminated, u_I = -M_II^{-1} (xi_I + M_IK u_K), and
+// u_K from the Schur complement LCP (§3.5.2). "" or why u^p does not exist.
+std::string solve_level(const Ldcp& s, const Level& l, VectorXd& up, int& lcp_solves) {
+  const MatrixXd& Mlead = s.data.Mlead;
+  Eigen::FullPivLU<MatrixXd> luI;
+  if (!l.I.empty()) {
+    luI.compute(sub(Mlead, l.I, l.I));
+    if (!luI.isInvertible())
+      return "leading row coefficient block of the active set is singular "
+             "(script M is not a P-matrix); the mode is not autonomous";
+  }
+  VectorXd uK = VectorXd::Zero(l.K.size());
+  if (!l.K.empty()) {
+    std::string failed = schur_lcp(s, l, luI, uK, lcp_solves);
+    if (!failed.empty()) return failed;
+  }
+  for (size_t i = 0; i < l.K.size(); ++i) up(l.K[i]) = uK(i);
+  if (!l.I.empty()) {
+    VectorXd rhs = sub(l.xi, l.I);
+    if (!l.K.empty()) rhs += sub(Mlead, l.I, l.K) * uK;
+    const VectorXd uI = -luI.solve(rhs);
+    for (size_t i = 0; i < l.I.size(); ++i) up(l.I[i]) = uI(i);
+  }
+  return "";
+}
+
+// An undecided row becomes active when u_r^p > 0, inactive when y_r^p > 0
+// (the lexicographic signs of §3.5.2); u_r^p within rounding is set to 0.
+void classify_undecided(Ldcp& s, const Level& l, VectorXd& up) {
+  const MatrixXd& Mlead = s.data.Mlead;
+  const VectorXd y = l.xi + Mlead * up;
+  for (int r : l.K) {
+    const double d = std::max(std::abs(Mlead(r, r)), 1e-300);
+    if (up(r) > l.tol_y(r, s.opt) / d) {
+      s.state[r] = RowState::kActive;
+    } else {
+      up(r) = 0.0;  // rounding noise, not an impulse or force
+      if (y(r) > l.tol_y(r, s.opt)) s.state[r] = RowState::kInactive;
+    }
+  }
+}
+
+// Levels -n+1 .. n, as in the proof of Theorem 3.6.7, until the mode is
+// fixed. "" or why the LDCP has no (autonomous) solution.
+std::string solve_levels(Ldcp& s, int& lcp_solves) {
+  const int start_lcp = s.opt.regular_only ? 1 : s.first;
+  for (int p = s.first; p <= s.sys.n(); ++p) {
+    if (p > s.first && !s.u.back().isZero(0.0)) s.nonzero_levels.push_back(p - 1);
+    Level l = level_coefficients(s, p);
+    l.I = rows_in(s.state, RowState::kActive);
+    l.K = rows_in(s.state, RowState::kUndecided);
+    VectorXd& up = s.u.emplace_back(VectorXd::Zero(s.sys.k()));  // u^p, 0 until solved
+    if (p < start_lcp) {
+      const std::string refused = free_level(s, l);
+      if (!refused.empty()) return refused;
+      continue;
+    }
+    if (l.K.empty() && l.I.empty()) break;  // every row decided inactive
+    const std::string failed = solve_level(s, l, up, lcp_solves);
+    if (!failed.empty()) return failed;
+    classify_undecided(s, l, up);
+    // Once no row is undecided the mode is fixed; the impulsive levels (p <= 0)
+    // are still needed for the jump, later levels are not.
+    if (p >= 0 && rows_in(s.state, RowState::kUndecided).empty()) break;
+  }
+  return "";
+}
+
+// The impulsive part: level p <= 0 multiplies delta^{(-p)}; fills impulse and
+// returns the jump sum_j A^j B u^{-j} of the state (eq. (3.10)).
+VectorXd impulsive_jump(const Ldcp& s, std::vector<VectorXd>& impulse) {
+  VectorXd jump = VectorXd::Zero(s.sys.n());
+  VectorXd AjBu;
+  for (int p = s.first; p <= 0 && p - s.first < static_cast<int>(s.u.size()); ++p) {
+    const int j = -p;
+    impulse[j] = s.u[p - s.first];
+    if (impulse[j].isZero(0.0)) continue;
+    AjBu = s.sys.B * impulse[j];
+    for (int i = 0; i < j; ++i) AjBu = s.sys.A * AjBu;
+    jump += AjBu;
+  }
+  return jump;
+}
+
 }  // namespace
 
 LdcpData ldcp_data(const Lcs& sys) {
@@ -67,203 +306,34 @@ const MatrixXd& LdcpData::markov(int i) const {
   return H[i];
 }
 
+// The driver: refusals, then the levels, then the mode and the jump.
 ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions& opt) {
   ModeSelection out;
   const int n = sys.n();
-  const int k = sys.k();
   if (x0.size() != n) {
     out.message = "select_mode: state has size " + std::to_string(x0.size()) + ", expected " +
                   std::to_string(n);
     return out;
   }
   out.x_plus = x0;
-  out.impulse.assign(n, VectorXd::Zero(k));
-  if (k == 0) {
+  out.impulse.assign(n, VectorXd::Zero(sys.k()));
+  if (sys.k() == 0) {
     out.status = Status::kOk;
     return out;
   }
-
   LdcpData own_data;
-  if (!opt.data) own_data = ldcp_data(sys);
-  const LdcpData& data = opt.data ? *opt.data : own_data;
-  const std::vector<int>& rho = data.rho;
-  for (int r = 0; r < k; ++r) {
-    if (rho[r] == kInfiniteIndex) {
-      out.message = "constraint " + std::to_string(r) +
-                    " has an infinite leading row index: its modes are not autonomous "
-                    "(Lemma 3.6.5), the LDCP does not select a mode";
-      return out;
-    }
-  }
-  const MatrixXd& Mlead = data.Mlead;
-  const int first = -n + 1;
-  const int last = n;
-  // Free response coefficients C A^m x0 and their term scales, on demand.
-  std::vector<VectorXd> CAx, CAx_scale;
-  VectorXd Amx = x0, Amx_abs = x0.cwiseAbs();
-  MatrixXd Aabs, Cabs;
-  auto free_response = [&](int m) -> int {
-    if (CAx.empty()) {
-      Aabs = sys.A.cwiseAbs();
-      Cabs = sys.C.cwiseAbs();
-    }
-    while (static_cast<int>(CAx.size()) <= m) {
-      CAx.push_back(sys.C * Amx);
-      CAx_scale.push_back(Cabs * Amx_abs);
-      Amx = sys.A * Amx;
-      Amx_abs = Aabs * Amx_abs;
-    }
-    return m;
-  };
-
+  const LdcpData& data = opt.data ? *opt.data : (own_data = ldcp_data(sys));
+  out.message = infinite_index_refusal(data.rho);
+  if (!out.message.empty()) return out;
   std::unique_ptr<lcp::Solver> own_solver;
-  const lcp::Solver* solver = opt.solver;
-  if (!solver) {
-    own_solver = lcp::make_solver("pivot");
-    solver = own_solver.get();
-  }
-
-  std::vector<RowState> state(k, RowState::kUndecided);
-  std::vector<VectorXd> u;          // u^p for p = first..current, index p - first
-  std::vector<int> nonzero_levels;  // the j with u^j != 0 (most levels are zero)
-  const int start_lcp = opt.regular_only ? 1 : first;
-
-  for (int p = first; p <= last; ++p) {
-    if (p > first && !u.back().isZero(0.0)) nonzero_levels.push_back(p - 1);
-    // xi and the scale of its terms.
-    VectorXd xi = VectorXd::Zero(k), scale = VectorXd::Zero(k);
-    for (int r = 0; r < k; ++r) {
-      // A row decided inactive keeps its state: its coefficients are not
-      // used again (a robot's 64 stops, most open, at up to n levels each).
-      if (state[r] == RowState::kInactive) continue;
-      const int order = rho[r] + p;
-      if (order >= 1) {
-        const int m = free_response(order - 1);
-        xi(r) += CAx[m](r);
-        scale(r) += CAx_scale[m](r);
-      }
-      for (int j : nonzero_levels) {
-        const VectorXd& uj = u[j - first];
-        const int h = order - j;
-        if (h < 0 || h > 3 * n) continue;
-        const MatrixXd& Hh = data.markov(h);
-        xi(r) += Hh.row(r).dot(uj);
-        scale(r) += Hh.row(r).cwiseAbs().dot(uj.cwiseAbs());
-      }
-    }
-    auto tol_y = [&](int r) { return opt.tol_rel * scale(r) + opt.tol_abs; };
-
-    VectorXd up = VectorXd::Zero(k);
-    const auto I = rows_in(state, RowState::kActive);
-    const auto K = rows_in(state, RowState::kUndecided);
-    if (p < start_lcp) {
-      // Below the first level solved, u^p = 0: the coefficients are the free
-      // response, and an undecided row must not start negative (regularity).
-      if (!I.empty()) {
-        out.message = "internal: active rows below the first LCP level";
-        return out;
-      }
-      for (int r : K) {
-        if (xi(r) > tol_y(r)) {
-          state[r] = RowState::kInactive;
-        } else if (xi(r) < -tol_y(r)) {
-          std::ostringstream msg;
-          msg.precision(6);
-          msg << "state is not regular: constraint " << r << " has coefficient y^" << rho[r] + p
-              << " = " << xi(r) << " < 0 with no impulse allowed (Theorem 3.6.7, (3.40))";
-          out.message = msg.str();
-          return out;
-        }
-      }
-      u.push_back(up);
-      continue;
-    }
-    if (K.empty() && I.empty()) {
-      u.push_back(up);
-      break;  // every row decided inactive: nothing left to compute
-    }
-    // Eliminate the active rows: u_I = -M_II^{-1} (xi_I + M_IK u_K).
-    const MatrixXd MII = sub(Mlead, I, I);
-    Eigen::FullPivLU<MatrixXd> luI;
-    if (!I.empty()) {
-      luI.compute(MII);
-      if (!luI.isInvertible()) {
-        out.message =
-            "leading row coefficient block of the active set is singular "
-            "(script M is not a P-matrix); the mode is not autonomous";
-        return out;
-      }
-    }
-    VectorXd uK = VectorXd::Zero(K.size());
-    if (!K.empty()) {
-      MatrixXd S = sub(Mlead, K, K);
-      VectorXd qK = sub(xi, K);
-      if (!I.empty()) {
-        const MatrixXd MKI = sub(Mlead, K, I);
-        S -= MKI * luI.solve(sub(Mlead, I, K));
-        qK -= MKI * luI.solve(sub(xi, I));
-      }
-      // Rows whose constant term is zero up to rounding of its terms stay
-      // exactly zero: dependent constraints make the Schur complement
-      // singular, and a -1e-17 there would make the LCP infeasible.
-      const VectorXd cancelled =
-          I.empty() ? VectorXd::Zero(K.size())
-                    : VectorXd((sub(Mlead, K, I) * luI.solve(sub(xi, I))).cwiseAbs());
-      for (size_t i = 0; i < K.size(); ++i)
-        if (std::abs(qK(i)) <= opt.tol_rel * (scale(K[i]) + cancelled(i)) + opt.tol_abs)
-          qK(i) = 0.0;
-      // Dependent constraints give a PSD, not P, matrix whose LCP Lemke
-      // still solves (q in its range, Lemma 4.6.1); the motion is unique
-      // even where the multipliers are not (Theorem 4.6.5).
-      int attempts = 0;
-      const lcp::Result res = lcp::solve_with_fallbacks(*solver, S, qK, lcp::Options{}, &attempts);
-      out.lcp_solves += attempts;
-      if (!res.ok()) {
-        out.message = "LCP at LDCP level " + std::to_string(p) +
-                      " failed: " + std::string(lcp::to_string(res.status, "solved")) +
-                      (res.message.empty() ? "" : " (" + res.message + ")");
-        return out;
-      }
-      uK = res.z;
-    }
-    for (size_t i = 0; i < K.size(); ++i) up(K[i]) = uK(i);
-    if (!I.empty()) {
-      VectorXd rhs = sub(xi, I);
-      if (!K.empty()) rhs += sub(Mlead, I, K) * uK;
-      const VectorXd uI = -luI.solve(rhs);
-      for (size_t i = 0; i < I.size(); ++i) up(I[i]) = uI(i);
-    }
-    // Classify the undecided rows on this level's coefficients.
-    const VectorXd y = xi + Mlead * up;
-    for (int r : K) {
-      const double d = std::max(std::abs(Mlead(r, r)), 1e-300);
-      if (up(r) > tol_y(r) / d) {
-        state[r] = RowState::kActive;
-      } else {
-        up(r) = 0.0;  // rounding noise, not an impulse or force
-        if (y(r) > tol_y(r)) state[r] = RowState::kInactive;
-      }
-    }
-    u.push_back(up);
-    // Once no row is undecided the mode is fixed; the impulsive levels (p <= 0)
-    // are still needed for the jump, later levels are not.
-    if (p >= 0 && rows_in(state, RowState::kUndecided).empty()) break;
-  }
-
-  out.mode = rows_in(state, RowState::kActive);
-  out.undetermined = rows_in(state, RowState::kUndecided);
-  // Impulsive part: level p <= 0 multiplies delta^{(-p)}.
-  VectorXd jump = VectorXd::Zero(n);
-  VectorXd AjBu;
-  for (int p = first; p <= 0 && p - first < static_cast<int>(u.size()); ++p) {
-    const int j = -p;
-    out.impulse[j] = u[p - first];
-    if (out.impulse[j].isZero(0.0)) continue;
-    AjBu = sys.B * out.impulse[j];
-    for (int i = 0; i < j; ++i) AjBu = sys.A * AjBu;
-    jump += AjBu;
-  }
-  out.x_plus = x0 + jump;
+  const lcp::Solver& solver = opt.solver ? *opt.solver : *(own_solver = lcp::make_solver("pivot"));
+  Ldcp s{sys, data, opt, solver, -n + 1, FreeResponse(sys, x0), {}, {}, {}};
+  s.state.assign(sys.k(), RowState::kUndecided);
+  out.message = solve_levels(s, out.lcp_solves);
+  if (!out.message.empty()) return out;
+  out.mode = rows_in(s.state, RowState::kActive);
+  out.undetermined = rows_in(s.state, RowState::kUndecided);
+  out.x_plus = x0 + impulsive_jump(s, out.impulse);
   out.status = Status::kOk;
   return out;
 }
