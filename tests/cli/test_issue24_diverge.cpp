@@ -27,7 +27,8 @@ bool has(const std::string& text, const std::string& part) {
 // Explicit dampers in Bullet's rb6 scene: 2 / lambda_max(M^-1 D) = 6.28e-3 s
 // (tests/bullet/test_divergence.cpp derives it), so h = 1e-2 diverges.
 fs::path damped_model() {
-  const fs::path dir = fs::path(::testing::TempDir()) / "lcsim_i24";
+  // A folder private to this test process (ctest runs tests in parallel).
+  const fs::path dir = lcsim::cli_test::private_temp("lcsim_i24", "");
   fs::create_directories(dir);
   const fs::path p = dir / "damped_pair.yaml";
   std::ofstream(p) << "name: damped_pair\nmechanical:\n  M: [[1, 0], [0, 2]]\n"
@@ -80,6 +81,7 @@ TEST(Issue24Cli, AStudyRowThatDivergedIsANumericalFailure) {
   std::ofstream(study) << "model: damped_pair.yaml\nmethod: bullet\nreference: none\n"
                           "axes:\n  - h: [1e-2, 1e-3]\n";
   fs::remove(out);
+  fs::remove(out.string() + ".journal");
   const CliRun r = lcsim("study '" + study.string() + "' --out '" + out.string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;  // failed runs are rows, not an exit code
   std::ifstream in(out);
@@ -95,7 +97,7 @@ TEST(Issue24Cli, AStudyRowThatDivergedIsANumericalFailure) {
 // Item 4 through the CLI: a method that refuses the model is a refused row
 // and the table, JSON and exit 0 remain (it exited 2 after nine runs).
 TEST(Issue24Cli, SweepKeepsItsTableWhenAMethodRefuses) {
-  const fs::path p = fs::path(::testing::TempDir()) / "lcsim_i24_nondiagonal.yaml";
+  const fs::path p = lcsim::cli_test::private_temp("lcsim_i24_nondiagonal", ".yaml");
   std::ofstream(p) << "name: nondiagonal\nmechanical:\n  M: [[1, 0.1], [0.1, 1]]\n"
                       "  K: [[1, 0], [0, 1]]\n  E: [[1, 0]]\n  g: [0.5]\n"
                       "initial: [0.2, 0, 0, 0]\nt_end: 1\n";
