@@ -159,8 +159,10 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
     } else {
       x_next = xb;
     }
-    if (std::string why = guard.check(last ? *opt.t_end : j * grid.h, x_next, last); !why.empty())
+    if (std::string why = guard.check(last ? *opt.t_end : j * grid.h, x_next, last); !why.empty()) {
+      tr.t_end = (j - 1) * grid.h;  // the time reached: the last sane state's
       return fail("euler: " + why, x);
+    }
     x = x_next;
     ++tr.steps;
     const double t = last ? *opt.t_end : j * grid.h;

@@ -334,8 +334,10 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
     }
     q_next = q + h * ((1.0 - theta) * v + theta * v_next);
     if (std::string why = guard.check(last ? *opt.t_end : j * grid.h, q_next, v_next, last);
-        !why.empty())
+        !why.empty()) {
+      tr.t_end = (j - 1) * grid.h;  // the time reached: the last sane state's
       return fail("moreau-jean: " + why);
+    }
     q.swap(q_next);
     v.swap(v_next);
     ++tr.steps;

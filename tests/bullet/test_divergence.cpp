@@ -48,7 +48,8 @@ TEST(BulletDivergence, ExplicitDampersAboveTheStatedStepStopTheRun) {
   EXPECT_EQ(tr.status, sim::RunStatus::kNumericalFailure) << tr.message;
   EXPECT_EQ(tr.message.rfind("bullet: diverged at t = ", 0), 0u) << tr.message;
   EXPECT_TRUE(has(tr.message, "energy")) << tr.message;
-  EXPECT_LT(tr.steps, 200);  // stopped early, not at t_end = 2 s
+  EXPECT_LT(tr.steps, 200);                       // stopped early, not at t_end = 2 s
+  EXPECT_NEAR(tr.t_end, tr.steps * 1e-2, 1e-12);  // the time reached
   EXPECT_TRUE(tr.final_state.allFinite());
   ASSERT_EQ(tr.warning_count("bullet-explicit-damping"), 1);
   const std::string w = tr.warnings.front().message;

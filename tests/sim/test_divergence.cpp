@@ -40,7 +40,8 @@ TEST(Divergence, MoreauJeanBelowHalfThetaStopsWithTheEnergyNamed) {
   EXPECT_EQ(tr.message.rfind("moreau-jean: diverged at t = ", 0), 0u) << tr.message;
   EXPECT_TRUE(has(tr.message, "energy")) << tr.message;
   EXPECT_TRUE(has(tr.message, "energy scale 50 J")) << tr.message;
-  EXPECT_LT(tr.steps, 5000);  // stopped early, not at t_end
+  EXPECT_LT(tr.steps, 5000);                    // stopped early, not at t_end
+  EXPECT_DOUBLE_EQ(tr.t_end, tr.steps * 1e-2);  // the time reached: the last sane step's
   EXPECT_TRUE(tr.final_state.allFinite());
   // The state kept is the one before the diverged step; the energy test runs
   // every DivergenceGuard::kStride = 16 steps, so it is at most 16 steps of
