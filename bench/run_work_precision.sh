@@ -196,6 +196,6 @@ json.dump({"model": scene, "model_file": model, "t_end": 3, "load_average": load
           open(f"{out}/{scene}.json", "w"), indent=1)
 PY
   /usr/bin/python3 python/lcsim/plot.py work-precision "$out/$scene.json" "$out/$scene.png" \
-    --title "$scene (lcsim solid, Siconos dashed)"
+    --error final --title "$scene (lcsim solid, Siconos dashed)"
   echo "   written: $out/$scene.json, $out/$scene.png" >&2
 done

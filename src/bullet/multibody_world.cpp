@@ -216,10 +216,7 @@ std::unique_ptr<MbWorld> build(const io::Scene& setup, const mech::MechanicalMod
 // beyond the step error.
 void warn(sim::Trajectory& tr, const mech::MechanicalModel& m, const MatrixXd& K_s,
           const sim::Options& opt) {
-  if (m.D.norm() > 0.0)
-    tr.warn(
-        "bullet-explicit-damping", 0.0,
-        "bullet: dampers are explicit joint torques -D v (stable only for h small against M/D)");
+  warn_explicit_damping(tr, m, opt.h, "joint torques");
   // Springs are explicit torques (symplectic Euler): stable for omega h <= 2,
   // omega^2 the largest eigenvalue of K_s x = omega^2 M(q0) x.
   if (K_s.norm() > 0.0) {
@@ -282,6 +279,7 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const io::Scene& se
                                    const sim::Options& opt, const WorldSettings& s) {
   sim::Trajectory tr;
   tr.method = "bullet " + multibody_description(s);
+  tr.dynamics = "the URDF's nonlinear multibody (Bullet)";
   tr.t_end = *opt.t_end;
   tr.final_state = x0;
   auto fail = [&](const std::string& msg) {
@@ -312,7 +310,7 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const io::Scene& se
     return fail(std::string("bullet: ") + e.what());
   }
   btMultiBody& b = *w->mb.body;
-  RunRecorder rec(m, opt, tr, q, v);
+  RunRecorder rec(model, opt, tr, q, v);
   const sim::StepGrid grid = sim::StepGrid::of(*opt.t_end, opt.h);
   VectorXd tau(N), q_next(N), v_next(N), impulse(k);
   for (long j = 1; j <= grid.n; ++j) {
@@ -333,8 +331,6 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const io::Scene& se
       q_next(c) = b.getJointPos(w->mb.link[static_cast<std::size_t>(c)]);
       v_next(c) = b.getJointVel(w->mb.link[static_cast<std::size_t>(c)]);
     }
-    if (!q_next.allFinite() || !v_next.allFinite())
-      return fail("bullet: non-finite state at t = " + fmt(j * opt.h));
     // Row 0 of a limit pushes +q (the lower bound), row 1 -q; lcsim's row is
     // c e_j, so the impulse P on the joint is |c| h u.
     for (std::size_t i = 0; i < limits.size(); ++i)
@@ -343,7 +339,13 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const io::Scene& se
     // Round-off in an impulse is ~1e-16 of the momentum; real ones are O(h).
     const double tiny =
         1e-10 * (1.0 + (m.M * v).cwiseAbs().maxCoeff() + h * tau.cwiseAbs().maxCoeff());
-    rec.step(last ? *opt.t_end : j * opt.h, h, last, q_next, v_next, impulse, tiny);
+    if (std::string why =
+            rec.step(last ? *opt.t_end : j * opt.h, h, last, q_next, v_next, impulse, tiny);
+        !why.empty()) {
+      rec.finish();  // the last sane state, and the time reached
+      tr.t_end = (j - 1) * grid.h;
+      return fail("bullet: " + why);
+    }
     q = q_next;
     v = v_next;
   }

@@ -1,15 +1,73 @@
 #include "bullet/run_recorder.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 namespace lcsim::bullet {
 
 using Eigen::VectorXd;
 
-RunRecorder::RunRecorder(const mech::MechanicalModel& m, const sim::Options& opt,
-                         sim::Trajectory& tr, const VectorXd& q0, const VectorXd& v0)
-    : m_(m), opt_(opt), tr_(tr), sampler_(opt.dt_out), q_(q0), v_(v0) {
+namespace {
+
+using Eigen::MatrixXd;
+
+VectorXd join(const VectorXd& q, const VectorXd& v) {
+  VectorXd x(q.size() + v.size());
+  x << q, v;
+  return x;
+}
+
+// The largest eigenvalue of M^{-1} D (1/s), real and >= 0 for M symmetric
+// positive definite and D symmetric positive semi-definite: of the pencil
+// D x = lambda M x. Dense up to kDenseMax coordinates (a URDF scene, a small
+// matrix model); above, rb6's diagonal M (world.cpp) with Gershgorin's bound
+// on M^{-1} D, which can only lower the h stated (`exact` false).
+double damping_rate(const mech::MechanicalModel& m, bool& exact) {
+  constexpr int kDenseMax = 200;
+  exact = m.dofs() <= kDenseMax;
+  if (exact) {
+    const Eigen::GeneralizedSelfAdjointEigenSolver<MatrixXd> es(MatrixXd(m.D), MatrixXd(m.M),
+                                                                Eigen::EigenvaluesOnly);
+    return es.info() == Eigen::Success ? std::max(0.0, es.eigenvalues().maxCoeff()) : 0.0;
+  }
+  double rate = 0.0;
+  for (int j = 0; j < m.dofs(); ++j) {
+    double row = 0.0;
+    for (mech::SparseMatrix::InnerIterator it(m.D, j); it; ++it) row += std::abs(it.value());
+    rate = std::max(rate, row / m.M.coeff(j, j));  // D symmetric: column sums = row sums
+  }
+  return rate;
+}
+
+}  // namespace
+
+void warn_explicit_damping(sim::Trajectory& tr, const mech::MechanicalModel& m, double h,
+                           const char* what) {
+  if (m.D.norm() == 0.0) return;
+  bool exact = true;
+  const double rate = damping_rate(m, exact);
+  if (!(rate > 0.0)) return;
+  const double h_max = 2.0 / rate;
+  tr.warn("bullet-explicit-damping", 0.0,
+          std::string("bullet: dampers are explicit ") + what +
+              " -D v, stable only for h <= 2 / lambda_max(M^-1 D) = " + sim::short_number(h_max) +
+              " s" + (exact ? "" : " or more (Gershgorin)") +
+              " (lambda_max = " + sim::short_number(rate) +
+              " 1/s from the model's M and D); h = " + sim::short_number(h) +
+              (h > h_max ? " is above it: expect divergence, or reduce h" : " is within it"));
+}
+
+RunRecorder::RunRecorder(const mech::Model& model, const sim::Options& opt, sim::Trajectory& tr,
+                         const VectorXd& q0, const VectorXd& v0)
+    : m_(*model.mechanical),
+      opt_(opt),
+      tr_(tr),
+      sampler_(opt.dt_out),
+      guard_(model, join(q0, v0), *opt.t_end),
+      q_(q0),
+      v_(v0) {
   tr_.energy_initial = mech::total_energy(m_, q_, v_);
   y_ = m_.E * q_ + m_.g;
   if (m_.num_constraints() > 0) tr_.max_violation = std::min(0.0, y_.minCoeff());
@@ -28,8 +86,9 @@ void RunRecorder::record(double t, const VectorXd& u) {
   tr_.record_sample(std::move(smp), opt_);
 }
 
-void RunRecorder::step(double t, double h, bool last, const VectorXd& q, const VectorXd& v,
-                       const VectorXd& impulse, double tiny) {
+std::string RunRecorder::step(double t, double h, bool last, const VectorXd& q, const VectorXd& v,
+                              const VectorXd& impulse, double tiny) {
+  if (std::string why = guard_.check(t, q, v, last); !why.empty()) return why;
   const int N = m_.dofs(), k = m_.num_constraints();
   sim::IndexSet mode;
   for (int i = 0; i < k; ++i)
@@ -64,6 +123,7 @@ void RunRecorder::step(double t, double h, bool last, const VectorXd& q, const V
   y_ = m_.E * q_ + m_.g;
   if (k > 0) tr_.max_violation = std::min(tr_.max_violation, std::min(0.0, y_.minCoeff()));
   if (sampler_.want(t, opt_.h, last)) record(t, k > 0 ? VectorXd(impulse / h) : VectorXd());
+  return "";
 }
 
 void RunRecorder::finish() {

@@ -16,15 +16,28 @@ namespace lcsim::bullet {
 // release when constraints were only lost, else a contact), max_violation,
 // steps, lcp_solves, energies (of the model at Bullet's states).
 
+// Bullet applies dampers as explicit forces (-D v before the step, then
+// v+ = v + h M^{-1} F: btRigidBody::integrateVelocities, and for the
+// multibody btMultiBody::computeAccelerationsArticulatedBodyAlgorithmMultiDof
+// then applyDeltaVeeMultiDof), so the damping term alone multiplies v by
+// I - h M^{-1} D each step: stable only for h <= 2 / lambda_max(M^{-1} D).
+// Counts the warning "bullet-explicit-damping" when D != 0, stating that
+// bound from the model's own M and D (`what`: "forces" or "joint torques")
+// and whether opt.h is above it.
+void warn_explicit_damping(sim::Trajectory& tr, const mech::MechanicalModel& m, double h,
+                           const char* what);
+
 class RunRecorder {
  public:
   // Records the sample at t = 0.
-  RunRecorder(const mech::MechanicalModel& m, const sim::Options& opt, sim::Trajectory& tr,
+  RunRecorder(const mech::Model& model, const sim::Options& opt, sim::Trajectory& tr,
               const Eigen::VectorXd& q0, const Eigen::VectorXd& v0);
   // One step of length h ending at t (the last one when `last`), from the
   // state held to (q, v), with constraint impulses `impulse` (h u, size k).
-  void step(double t, double h, bool last, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
-            const Eigen::VectorXd& impulse, double tiny);
+  // "" when recorded; else the state diverged (sim::DivergenceGuard), nothing
+  // is recorded and the message says what.
+  std::string step(double t, double h, bool last, const Eigen::VectorXd& q,
+                   const Eigen::VectorXd& v, const Eigen::VectorXd& impulse, double tiny);
   // Final state and energy.
   void finish();
 
@@ -34,6 +47,7 @@ class RunRecorder {
   const sim::Options& opt_;
   sim::Trajectory& tr_;
   sim::OutputSampler sampler_;
+  sim::DivergenceGuard guard_;
   Eigen::VectorXd q_, v_, y_;
   sim::IndexSet mode_;
 };

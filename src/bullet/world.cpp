@@ -296,9 +296,7 @@ sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>&
   const mech::MechanicalModel& m = *model.mechanical;
   const int N = m.dofs(), k = m.num_constraints();
   VectorXd q = x0.head(N), v = x0.tail(N);
-  if (m.D.norm() > 0.0)
-    tr.warn("bullet-explicit-damping", 0.0,
-            "bullet: dampers are explicit forces -D v (stable only for h small against M/D)");
+  warn_explicit_damping(tr, m, opt.h, "forces");
   // Springs are explicit forces too (symplectic Euler): stable for omega h <= 2
   // with omega the fastest frequency, bounded here by Gershgorin on M^-1 K
   // (M is diagonal in this scene).
@@ -348,7 +346,7 @@ sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>&
     if (Et.info() != Eigen::Success) return fail("bullet: cannot factor E' for the multipliers");
   }
 
-  RunRecorder rec(m, opt, tr, q, v);
+  RunRecorder rec(model, opt, tr, q, v);
   VectorXd F(N), q_next(N), v_next(N);
   for (long j = 1; j <= grid.n; ++j) {
     const bool last = j == grid.n;
@@ -362,15 +360,19 @@ sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>&
       q_next(i) = w->bodies[i]->getCenterOfMassPosition().x();
       v_next(i) = w->bodies[i]->getLinearVelocity().x();
     }
-    if (!q_next.allFinite() || !v_next.allFinite())
-      return fail("bullet: non-finite state at t = " + fmt(j * opt.h));
     VectorXd impulse = VectorXd::Zero(k);
     if (k > 0) impulse = Et.solve(VectorXd(m.M * (v_next - v) - h * F));
     // Round-off in the momentum balance is ~1e-16 |M v|; impulses of real
     // contacts are O(h).
     const double tiny =
         1e-10 * (1.0 + (m.M * v).cwiseAbs().maxCoeff() + h * F.cwiseAbs().maxCoeff());
-    rec.step(last ? *opt.t_end : j * opt.h, h, last, q_next, v_next, impulse, tiny);
+    if (std::string why =
+            rec.step(last ? *opt.t_end : j * opt.h, h, last, q_next, v_next, impulse, tiny);
+        !why.empty()) {
+      rec.finish();  // the last sane state, and the time reached
+      tr.t_end = (j - 1) * grid.h;
+      return fail("bullet: " + why);
+    }
     q = q_next;
     v = v_next;
   }
@@ -423,6 +425,7 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
   sim::Trajectory tr = p.scene ? simulate_multibody(model, *p.scene, p.joint_limits, x0, opt, s)
                                : simulate_rb6(model, p.rb6_limits, x0, opt, s);
   if (!p.warning.empty()) tr.warn("bullet-scene", 0.0, p.warning);
+  sim::check_diverged(model, x0, tr);  // what the scenes report at their end, as run() checks it
   tr.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return tr;
 }
@@ -433,6 +436,19 @@ class BulletIntegrator : public sim::Integrator {
  public:
   std::string name() const override { return "bullet"; }
   sim::OptionsUsed options_used() const override { return bullet_options_used(); }
+
+ protected:
+  // A model Bullet cannot express is refused before anything runs (a sweep
+  // keeps the other methods' rows), with check_expressible's message.
+  std::string refusal(const mech::Model& model) const override {
+    try {
+      check_expressible(model);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "";
+  }
+
   sim::Trajectory integrate(const mech::Model& model, const VectorXd& x0,
                             const sim::Options& opt) const override {
     return simulate_bullet(model, x0, opt);

@@ -72,12 +72,14 @@ void print_text(const io::SweepResult& s, const std::string& x0_from) {
                 r.method.c_str(), hbuf, r.reference.label().c_str(), r.error_final, r.error_max,
                 r.max_violation, r.energy_drift, r.steps, r.lcp_solves, r.wall_time_s,
                 r.status == "completed" ? "" : ("  " + r.status).c_str());
+    if (!r.error_floor.empty()) std::printf("    error floor: %s\n", r.error_floor.c_str());
     if (r.warnings > 0)
       std::printf("    warnings: %s\n", warning_text(r.warnings, r.first_warning).c_str());
     if (r.method != "event" && r.reference_warnings > 0)
       std::printf("    reference warnings: %s\n",
                   warning_text(r.reference_warnings, r.reference_first_warning).c_str());
   }
+  std::printf("errors: %s\n", io::kErrorMeasures);
   std::printf("reference laws:\n");
   std::vector<std::string> seen;
   for (const auto& r : s.rows) {

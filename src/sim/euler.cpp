@@ -122,6 +122,7 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
   }
 
   OutputSampler sampler(opt.dt_out);
+  DivergenceGuard guard(model, x0_user, *opt.t_end);
   VectorXd u = VectorXd::Zero(k);
   auto record = [&](double t, const VectorXd& xa, const VectorXd& uu) {
     const VectorXd y = sys.C * xa + sys.D * uu;
@@ -158,8 +159,10 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
     } else {
       x_next = xb;
     }
-    if (!x_next.allFinite())
-      return fail("euler: non-finite state at t = " + short_number(j * grid.h), x);
+    if (std::string why = guard.check(last ? *opt.t_end : j * grid.h, x_next, last); !why.empty()) {
+      tr.t_end = (j - 1) * grid.h;  // the time reached: the last sane state's
+      return fail("euler: " + why, x);
+    }
     x = x_next;
     ++tr.steps;
     const double t = last ? *opt.t_end : j * grid.h;

@@ -148,6 +148,7 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
   // step's end is zero to rounding, else slip along its sign.
   std::vector<FrictionMode> fmode(m.friction.size(), FrictionMode::kOpen);
   OutputSampler sampler(opt.dt_out);
+  DivergenceGuard guard(model, x0, *opt.t_end);
   auto record = [&](double t, const VectorXd& y, const VectorXd& uu, const IndexSet& mode) {
     if (!opt.record_samples) return;
     Sample s;
@@ -332,8 +333,11 @@ Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const O
       }
     }
     q_next = q + h * ((1.0 - theta) * v + theta * v_next);
-    if (!all_finite(q_next) || !all_finite(v_next))
-      return fail("moreau-jean: non-finite state at t = " + short_number(j * grid.h));
+    if (std::string why = guard.check(last ? *opt.t_end : j * grid.h, q_next, v_next, last);
+        !why.empty()) {
+      tr.t_end = (j - 1) * grid.h;  // the time reached: the last sane state's
+      return fail("moreau-jean: " + why);
+    }
     q.swap(q_next);
     v.swap(v_next);
     ++tr.steps;

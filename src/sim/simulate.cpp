@@ -24,14 +24,38 @@ std::optional<Trajectory> refuse_invalid_run(const mech::Model& model, const Vec
   return std::nullopt;
 }
 
+std::optional<Trajectory> Integrator::refuse_resolved(const mech::Model& model, const VectorXd& x0,
+                                                      Options& opt) const {
+  if (auto refused_run = refuse_invalid_run(model, x0, opt, name(), options_used()))
+    return refused_run;
+  if (std::string why = refusal(model); !why.empty()) return refused(name(), std::move(why));
+  return std::nullopt;
+}
+
+std::optional<Trajectory> Integrator::refuse(const mech::Model& model, const VectorXd& x0,
+                                             const Options& opt) const {
+  Options resolved = opt;
+  return refuse_resolved(model, x0, resolved);
+}
+
 Trajectory Integrator::run(const mech::Model& model, const VectorXd& x0, const Options& opt) const {
   Options resolved = opt;
-  if (auto refused_run = refuse_invalid_run(model, x0, resolved, name(), options_used()))
-    return std::move(*refused_run);
+  if (auto refused_run = refuse_resolved(model, x0, resolved)) return std::move(*refused_run);
   const auto wall0 = std::chrono::steady_clock::now();
   Trajectory tr = integrate(model, x0, resolved);
+  check_diverged(model, x0, tr);
   tr.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return tr;
+}
+
+void check_diverged(const mech::Model& model, const VectorXd& x0, Trajectory& tr) {
+  if (tr.status != RunStatus::kCompleted) return;
+  DivergenceGuard guard(model, x0, tr.t_end);
+  std::string why = guard.check(tr.t_end, tr.final_state, true);
+  if (why.empty()) why = guard.check_worst_gap(tr.max_violation);
+  if (why.empty()) return;
+  tr.status = RunStatus::kNumericalFailure;
+  tr.message = tr.method + ": " + why;
 }
 
 Trajectory simulate(const mech::Model& model, const VectorXd& x0, const Options& opt,

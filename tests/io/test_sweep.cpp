@@ -3,10 +3,12 @@
 // their warnings, and first-order convergence of Moreau–Jean against its law.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <lcsim/io/io.hpp>
 #include <lcsim/io/sweep.hpp>
 #include <lcsim/sim/sim.hpp>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -203,6 +205,104 @@ TEST(Sweep, BadOptionsNameTheOption) {
   o.base.impact = "moreau";
   o.hs = {3.0};
   EXPECT_THROW(run_sweep(m, m.initial, o), InputError);
+}
+
+// ---- Issue 24 ----------------------------------------------------------------
+
+// Moreau-Jean under another name, recording the options of every run the
+// sweep makes with it.
+struct SeenRun {
+  bool record_samples = false, sink = false;
+  double dt_out = 0.0;
+};
+std::vector<SeenRun>& seen_runs() {
+  static std::vector<SeenRun> runs;
+  return runs;
+}
+class ProbeIntegrator : public sim::Integrator {
+ public:
+  std::string name() const override { return "probe-mj"; }
+  sim::OptionsUsed options_used() const override {
+    return sim::make_integrator("moreau-jean")->options_used();
+  }
+
+ protected:
+  sim::Trajectory integrate(const mech::Model& model, const Eigen::VectorXd& x0,
+                            const sim::Options& opt) const override {
+    seen_runs().push_back({opt.record_samples, static_cast<bool>(opt.sample_sink), opt.dt_out});
+    return sim::make_integrator("moreau-jean")->run(model, x0, opt);
+  }
+};
+
+// Item 2: a row's wall time is of runs made as a user makes them, with their
+// samples (on the comparison grid): a sweep showed 0.09 s for a run whose
+// samples took 16 s, since its timing runs recorded nothing. Here: the one
+// compared run (every step through the comparison sink) and `repeat` timing
+// runs, each recording its samples on the grid dt_cmp = h = 0.01 (t_end / h
+// = 200 points, under the ~2000 cap).
+TEST(Sweep, RowsAreTimedWithTheirOutput) {
+  if (!sim::integrators().contains("probe-mj"))
+    sim::integrators().add("probe-mj", [] { return std::make_unique<ProbeIntegrator>(); });
+  seen_runs().clear();
+  const mech::Model m = coupled();
+  SweepOptions o;
+  o.methods = {"probe-mj"};
+  o.hs = {1e-2};
+  o.repeat = 3;
+  o.base.t_end = 2.0;
+  const SweepResult s = run_sweep(m, m.initial, o);
+  ASSERT_EQ(s.rows.size(), 1u);
+  ASSERT_EQ(s.rows[0].status, "completed");
+  ASSERT_EQ(seen_runs().size(), 4u);
+  EXPECT_TRUE(seen_runs()[0].sink);  // the compared run
+  for (std::size_t i = 1; i < 4; ++i) {
+    EXPECT_TRUE(seen_runs()[i].record_samples) << i;
+    EXPECT_FALSE(seen_runs()[i].sink) << i;
+    EXPECT_DOUBLE_EQ(seen_runs()[i].dt_out, 1e-2) << i;
+  }
+  EXPECT_GT(s.rows[0].wall_time_s, 0.0);
+}
+
+// Item 9: the error at the exact run's events. The ball of robots/ball.yaml
+// (e = 0.5, 3 s: impacts at 0.45 s, 1.35 s, ... accumulating at 1.35 s + 0.9 s)
+// at h = 1e-4: the comparison grid is 1.5e-3 (2000 points), coarser than the
+// steps, so the error where the impacts happen is measured apart: at each
+// exact event, the run's state at the end of the step holding it against
+// the exact state before or after (the nearer). Recomputed here from two
+// direct runs: the exact run of Moreau-Jean's law and Moreau-Jean sampled at
+// every step.
+TEST(Sweep, ErrorAtTheExactEventsIsPartOfTheErrorOverTheRun) {
+  const mech::Model m = load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/ball.yaml");
+  SweepOptions o;
+  o.methods = {"moreau-jean"};
+  o.hs = {1e-4};
+  o.repeat = 1;
+  o.base.t_end = m.t_end;
+  const SweepResult s = run_sweep(m, m.initial, o);
+  ASSERT_EQ(s.rows.size(), 1u);
+  const SweepRow& r = s.rows[0];
+  ASSERT_EQ(r.status, "completed");
+  sim::Options ev = o.base;
+  ev.impact = "moreau-restitution";
+  const sim::Trajectory exact = sim::make_integrator("event")->run(m, m.initial, ev);
+  sim::Options step = o.base;
+  step.h = 1e-4;
+  const sim::Trajectory mj = run_keeping_used("moreau-jean", m, step);
+  ASSERT_GT(exact.events.size(), 1u);
+  double at_events = 0.0;
+  std::size_t i = 0;
+  for (const sim::Event& e : exact.events) {
+    while (mj.samples[i].t < e.t) ++i;
+    at_events = std::max(at_events, std::min(max_abs_diff(mj.samples[i].x, e.state_before),
+                                             max_abs_diff(mj.samples[i].x, e.state_after)));
+  }
+  EXPECT_DOUBLE_EQ(r.error_events, at_events);
+  EXPECT_GT(r.error_events, 0.0);
+  EXPECT_GE(r.error_max, r.error_events);
+  EXPECT_GE(r.error_max, r.error_final);
+  const auto j = sweep_json(s);
+  EXPECT_EQ(j["rows"][0]["error_events"].get<double>(), r.error_events);
+  EXPECT_EQ(j["error_measures"].get<std::string>(), kErrorMeasures);
 }
 
 }  // namespace

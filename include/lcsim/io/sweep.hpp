@@ -67,23 +67,42 @@ struct ReferenceRun {
 
 // A row: one method at one h (the event method has one row, h = 0).
 //   error_final    max-abs difference of the final states,
-//   error_max      largest max-abs state difference over the comparison grid
-//                  (the run's samples at multiples of dt_cmp, a multiple of h
-//                  with at most ~2000 points, against the reference sampled
-//                  on the same grid; at a jump the reference has two samples
-//                  and the nearer one counts), at least error_final,
+//   error_events   at each event of the exact run, the max-abs difference of
+//                  the run's state at the end of the step holding it and the
+//                  exact state just before or after it (the nearer): the
+//                  error where it is made, which a damped run at rest by
+//                  t_end no longer shows,
+//   error_max      the error over the whole run: the largest max-abs state
+//                  difference over the comparison grid (the run's samples at
+//                  multiples of dt_cmp, a multiple of h with at most ~2000
+//                  points, against the reference sampled on the same grid; at
+//                  a jump the reference has two samples and the nearer one
+//                  counts), at least error_final and error_events,
+//   error_floor    "" when the run integrates the model; else why its error
+//                  stops falling with h (Bullet's multibody integrates the
+//                  URDF's nonlinear dynamics, the exact run the model's
+//                  linearisation: "the linearisation gap: ..."),
 //   max_violation  the run's most negative gap,
 //   energy_drift   (E_final - E_initial) of the run minus the reference's (J).
-// Errors are +inf when the run or its reference failed.
+// Errors are +inf when the run or its reference failed or was refused.
+// kErrorMeasures says the same in one sentence (the JSON's "error_measures").
+inline constexpr const char* kErrorMeasures =
+    "max-abs state difference to the exact run of each row's reference law: error_max over the "
+    "whole run (every sample of the comparison grid and every exact event), error_events at "
+    "the exact events, error_final at t_end";
 struct SweepRow {
   std::string method;
   double h = 0.0;  // 0 for event
   ReferenceLaw reference;
   std::string status = "completed";  // "completed", "failed: ..." or "refused: ..."
   double error_final = 0.0, error_max = 0.0, max_violation = 0.0, energy_drift = 0.0;
+  double error_events = 0.0;
+  std::string error_floor;
   long steps = 0, lcp_solves = 0;
-  double wall_time_s = 0.0;  // median of `repeat` runs without samples; 0 if not completed
-  long warnings = 0;         // the run's
+  // Median of `repeat` runs with their output (samples on the comparison
+  // grid; the event row on the finest grid of the sweep); 0 if not completed.
+  double wall_time_s = 0.0;
+  long warnings = 0;  // the run's
   std::string first_warning;
   long reference_warnings = 0;  // the reference run's
   std::string reference_first_warning;
@@ -101,8 +120,12 @@ struct SweepResult {
 };
 
 // Checks the options (io::InputError naming the option: --methods, --h,
-// --repeat, --theta, --impact, --lcp), then runs the sweep. Runs that fail
-// give rows with their status; nothing throws for numerical trouble.
+// --repeat, --theta, --impact, --lcp), then every row with its method
+// (sim::Integrator::refuse) before any runs: a refused row keeps its
+// status ("refused: <why>") and the others run; when every row is refused,
+// io::InputError with the first refusal. Runs that fail (a diverged run
+// included) give rows with their status; nothing throws for numerical
+// trouble.
 SweepResult run_sweep(const mech::Model& model, const Eigen::VectorXd& x0, const SweepOptions& opt);
 
 // {"model", "t_end", "impact", "references": [...], "rows": [...]}; rows as

@@ -94,6 +94,10 @@ struct Trajectory {
   // a run that warns a million times stays small and still says what and when.
   std::vector<WarningCount> warnings;
   double wall_time_s = 0.0;  // of the whole call, set by the checked entry (Integrator::run)
+  // "" when the method integrates the model; else what it integrates instead
+  // ("the URDF's nonlinear multibody (Bullet)"): its error against an exact
+  // run of the model has that difference as a floor.
+  std::string dynamics;
   // Hands a recorded sample to opt.sample_sink when set (it is then not
   // kept), else appends it to samples.
   void record_sample(Sample s, const Options& opt);
@@ -206,11 +210,28 @@ class Integrator {
   // and a message naming the field and the value. An unset opt.t_end is the
   // model's.
   Trajectory run(const mech::Model& model, const VectorXd& x0, const Options& opt) const;
+  // What run() would refuse, without running: the refused trajectory
+  // (kInvalidInput, the message) from check_run or from the method's own
+  // refusal(), else nullopt. A sweep checks every row with it before it runs
+  // any.
+  std::optional<Trajectory> refuse(const mech::Model& model, const VectorXd& x0,
+                                   const Options& opt) const;
 
  protected:
+  // What this method cannot take beyond check_run (Bullet: a model it
+  // cannot express): "" or one line naming the part of the model.
+  virtual std::string refusal(const mech::Model& model) const {
+    (void)model;
+    return "";
+  }
   // The method itself, on input that run() has checked.
   virtual Trajectory integrate(const mech::Model& model, const VectorXd& x0,
                                const Options& opt) const = 0;
+
+ private:
+  // refuse() with `opt` resolved for the method (t_end filled in).
+  std::optional<Trajectory> refuse_resolved(const mech::Model& model, const VectorXd& x0,
+                                            Options& opt) const;
 };
 // The integrators by name: "event", "euler", "moreau-jean", and "bullet" in
 // programs that link the component lcsim::bullet.
@@ -280,6 +301,51 @@ class OutputSampler {
   double dt_out_;
   double next_;
 };
+
+// Divergence (src/sim/divergence.cpp): a run is never "completed" once its
+// numbers have left the model's scales. Every time-stepping method (and
+// Bullet's scenes) passes each step's state here and ends with
+// kNumericalFailure and the message on the first "" it does not get back;
+// Integrator::run checks every method's final state and worst gap the same
+// way. Diverged means: a non-finite entry of the state (named); the model's
+// total energy risen above its start by more than kAmplitude^2 times the
+// energy scale of the model and the start (the model has no input but a
+// moving belt, which the scale counts); a gap below -kAmplitude times the
+// length scale the energy scale allows over the horizon (far past any
+// stop). LCS models (no energy): non-finite entries only.
+class DivergenceGuard {
+ public:
+  static constexpr double kAmplitude =
+      1e3;                             // three orders of magnitude in amplitude, six in energy
+  static constexpr long kStride = 16;  // steps between energy and gap tests
+  // x0: the start (q then v, or the LCS state); t_end: the horizon (s).
+  DivergenceGuard(const mech::Model& model, const VectorXd& x0, double t_end);
+  // The state x (q then v; extra trailing entries are tested for finiteness
+  // only) at time t: "" when sane, else "diverged at t = ...: <what>". The
+  // finiteness test runs on every call, the energy and gap tests every
+  // kStride calls and whenever `full`.
+  std::string check(double t, const VectorXd& x, bool full = false);
+  // The same for a mechanical state given as q and v.
+  std::string check(double t, Eigen::Ref<const VectorXd> q, Eigen::Ref<const VectorXd> v,
+                    bool full = false);
+  // The run's most negative gap (Trajectory::max_violation): "" or the message.
+  std::string check_worst_gap(double worst_gap) const;
+  double energy_scale() const { return energy_scale_; }  // J (0 for LCS models)
+  double length_scale() const { return length_scale_; }  // model units of the gaps
+
+ private:
+  std::string violation_message(const std::string& where, double gap) const;
+  std::string non_finite(double t, Eigen::Ref<const VectorXd> x, Eigen::Index offset) const;
+  const mech::Model* model_;
+  bool mechanical_ = false;
+  double e0_ = 0.0, energy_scale_ = 0.0, length_scale_ = 0.0;
+  long calls_ = 0;
+};
+
+// What Integrator::run does after every method (and bullet::simulate_bullet
+// after its scenes): a completed run whose final state or worst gap the
+// guard finds diverged becomes kNumericalFailure, "<method>: <why>".
+void check_diverged(const mech::Model& model, const VectorXd& x0, Trajectory& tr);
 
 // A number with six significant digits, as the integrators' messages print it
 // ("0.001", "3.16228e+04").
