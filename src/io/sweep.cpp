@@ -317,7 +317,9 @@ nlohmann::json text_or_null(const std::string& s) {
 
 std::string ReferenceLaw::label() const {
   if (lcs) return "exact (LCS)";
-  return inelastic ? law + ", e = 0" : law;
+  // "inelastic" says e = 0 itself; another law run on the model with e = 0
+  // says so after its name.
+  return inelastic && law != "inelastic" ? law + ", e = 0" : law;
 }
 
 ReferenceLaw reference_law(const std::string& method, const std::string& impact,
@@ -342,12 +344,12 @@ ReferenceLaw reference_law(const std::string& method, const std::string& impact,
     r.reason = "Moreau-Jean's own law: restitution inside its step LCP";
     if (impact != r.law) r.reason += " (impact law " + impact + " does not apply to it)";
   } else if (method == "euler") {
-    r.law = "moreau";
+    r.law = "inelastic";
     r.inelastic = e;
     r.reason =
         "backward Euler ignores restitution: nearest exact law is inelastic" + inelastic_note;
   } else if (method == "bullet") {
-    r.law = "moreau";
+    r.law = "inelastic";
     r.inelastic = e;
     r.reason =
         "Bullet 3.24's limits do not bounce (rigid-body limits at stop ERP 0.2, multibody "

@@ -52,7 +52,7 @@ Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Op
   tr.method = "euler";
   tr.t_end = *opt.t_end;
   // Backward Euler's step LCP acts on positions: every impact is inelastic.
-  if (model.is_mechanical()) tr.impact_law = "moreau (e = 0: restitution ignored)";
+  if (model.is_mechanical()) tr.impact_law = "inelastic (restitution ignored)";
   const bool mech = model.is_mechanical();
   const int N = mech ? model.mechanical->dofs() : 0;
   auto user = [&](const VectorXd& xa) -> VectorXd { return mech ? VectorXd(xa.head(2 * N)) : xa; };

@@ -20,7 +20,7 @@ namespace lcsim::io {
 //   event        the run's own law (sim::Options::impact): it is the reference;
 //   moreau-jean  "moreau-restitution": restitution inside its step LCP is that
 //                law (src/sim/time_stepping.cpp), whatever Options::impact says;
-//   euler        "moreau" with every restitution set to zero: backward Euler
+//   euler        "inelastic" (every restitution zero): backward Euler
 //                ignores restitution (every impact inelastic), so the nearest
 //                exact law is the inelastic one;
 //   bullet       the same inelastic law: Bullet 3.24 applies a limit's bounce
@@ -35,7 +35,8 @@ struct ReferenceLaw {
   bool inelastic = false;  // the exact run uses a copy of the model with e = 0
   std::string reason;      // one sentence: why this law
   bool lcs = false;        // an LCS model: no impact law, the label is "exact (LCS)"
-  // "moreau-restitution", or "moreau, e = 0" when inelastic: the row's label.
+  // The law's name ("moreau-restitution", "inelastic"), or "<law>, e = 0" when
+  // another law runs on the model with e = 0: the row's label.
   std::string label() const;
   bool operator==(const ReferenceLaw& o) const { return law == o.law && inelastic == o.inelastic; }
 };

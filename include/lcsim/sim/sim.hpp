@@ -119,7 +119,7 @@ struct Options {
   // Impact law name (src/impact). The default is Moreau–Jean's law,
   // restitution inside the impact LCP: admissible by construction with several
   // closed contacts (a resting contact never rebounds), and the same as
-  // "moreau" (Newton's (1+e) per contact) with one contact or e = 0
+  // "newton" (Newton's (1+e) per contact) with one contact or e = 0
   // (docs/impact-rules.md gives the evidence).
   std::string impact = "moreau-restitution";
   std::string lcp_solver = "pivot";
