@@ -76,7 +76,7 @@ py::dict analyze(const ModelHandle& model) {
   d["name"] = mm.name;
   d["state_size"] = mm.state_size();
   d["constraints"] = mm.num_constraints();
-  d["notes"] = io::model_notes(mm);
+  d["notes"] = io::model_notes(*model);
   if (mm.is_mechanical()) {
     const mech::MechanicalModel& m = *mm.mechanical;
     const MatrixXd W = mech::delassus(m);

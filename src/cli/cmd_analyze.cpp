@@ -206,7 +206,7 @@ void run_analyze(const AnalyzeArgs& args) {
   const io::LoadedModel loaded = io::load_model_and_scene(args.file);
   const std::optional<io::Scene>& scene = loaded.scene;
   const mech::Model& model = loaded.model;
-  const std::vector<std::string> notes = io::model_notes(model);
+  const std::vector<std::string> notes = io::model_notes(loaded);
   const lcs::Lcs sys = model.as_lcs();
   const lcs::WellPosednessReport wp = lcs::analyze_well_posedness(sys);
 

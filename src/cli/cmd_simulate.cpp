@@ -104,6 +104,8 @@ void run_simulate(const SimulateArgs& a) {
   const io::LoadedModel loaded = io::load_model_and_scene(a.model);
   const std::optional<io::Scene>& scene = loaded.scene;
   const mech::Model& model = loaded.model;
+  if (scene)  // what loading repaired (balance_inertia)
+    for (const auto& n : scene->notes) std::cerr << "lcsim: note: " << n << "\n";
   auto integrator = sim::make_integrator(a.method);
 
   Eigen::VectorXd x0 = resolve_initial_state(model, a.model, a.x0);

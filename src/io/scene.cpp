@@ -42,6 +42,13 @@ std::string name_of(const YAML::Node& n, const std::string& source, const std::s
   return n.Scalar();
 }
 
+// true or false (YAML 1.2's booleans only: yaml-cpp would also read yes,
+// on, y, which a typo can produce).
+bool boolean(const YAML::Node& n, const std::string& source, const std::string& key) {
+  if (n.IsScalar() && (n.Scalar() == "true" || n.Scalar() == "false")) return n.Scalar() == "true";
+  fail(source, key, "expected true or false (got " + describe(n) + ")");
+}
+
 // {joint: value} with every joint named in `allowed_joints` (a joint of the URDF
 // for q0, a simulated joint otherwise); `what` explains the restriction.
 std::map<std::string, double> by_joint(
@@ -195,7 +202,7 @@ Scene read_scene(const std::string& yaml_text, const std::string& source) {
   const YAML::Node root = load(yaml_text, source);
   const Keys keys = mapping(root, source, "",
                             {"name", "urdf", "joints", "q0", "gravity", "springs", "constraints",
-                             "restitution", "initial", "t_end"});
+                             "restitution", "initial", "t_end", "balance_inertia"});
   mech::Model model;
   model.source = source;
   model.name = std::filesystem::path(source).stem().string();
@@ -208,13 +215,16 @@ Scene read_scene(const std::string& yaml_text, const std::string& source) {
       std::filesystem::path(source).parent_path() / std::filesystem::path(urdf_name);
   std::shared_ptr<urdf::ModelInterface> urdf_model;
   std::map<std::string, std::string> unbounded;  // joints whose <limit> lacks a bound
+  UrdfRepairs repairs;
+  if (keys.count("balance_inertia"))
+    repairs.balance_inertia = boolean(keys.at("balance_inertia"), source, "balance_inertia");
   {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(urdf_path, ec))
       fail(source, "urdf",
            "no such file (got '" + urdf_name + "', looked for '" + urdf_path.string() + "')");
     const std::string xml = read_file(urdf_path);
-    urdf_model = parse_urdf(xml, urdf_path.string());
+    urdf_model = parse_urdf(xml, urdf_path.string(), repairs);
     unbounded = limits_without_bounds(xml);
   }
   const urdf::ModelInterface& um = *urdf_model;
@@ -462,7 +472,7 @@ Scene read_scene(const std::string& yaml_text, const std::string& source) {
   }
   mech::fill_defaults(m);
   model.mechanical = m;
-  Scene scene{std::move(model), urdf_model, us, q0, gravity, lin};
+  Scene scene{std::move(model), urdf_model, us, q0, gravity, lin, std::move(repairs.notes)};
   return scene;
 }
 
@@ -481,6 +491,12 @@ LoadedModel load_model_and_scene(const std::filesystem::path& path) {
   } catch (const InputError& e) {
     throw InputError(one_line(e.what()));  // as load_model: URDF names may hold newlines
   }
+}
+
+std::vector<std::string> model_notes(const LoadedModel& loaded) {
+  std::vector<std::string> notes = loaded.scene ? loaded.scene->notes : std::vector<std::string>{};
+  for (std::string& n : model_notes(loaded.model)) notes.push_back(std::move(n));
+  return notes;
 }
 
 std::optional<Scene> load_scene_details(const std::filesystem::path& path) {

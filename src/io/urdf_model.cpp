@@ -98,21 +98,45 @@ bool finite_pose(const urdf::Pose& p) {
 // violated triangle of a real body is off by a sizeable fraction.
 constexpr double kInertiaTolerance = 1e-4;
 
+// The principal moments (ascending) after balance_inertia's repair: each
+// negative moment set to 0, then, if I1 + I2 < I3, I1 and I2 each raised by
+// half the deficit d = I3 - I1 - I2. Why that change: a body's principal
+// moments are I1 = s2 + s3, I2 = s1 + s3, I3 = s1 + s2 with s_k = sum m x_k^2
+// its second moments of mass along the principal axes, all >= 0 for a real
+// body. The triangle inequality is s3 = (I1 + I2 - I3) / 2 >= 0; the repair
+// sets the negative s3 to 0 (a body flat across the third axis) and keeps
+// s1 and s2, so I3 = s1 + s2 is kept and I1, I2 rise by -s3 = d / 2 each.
+// MuJoCo's balanceinertia sets all three to their mean instead (a sphere), a
+// change of order I3 however small the violation. Moments that are equal
+// stay equal, so the result does not depend on the axes chosen in a
+// degenerate eigenspace.
+Vector3d balanced_moments(Vector3d p) {
+  p = p.cwiseMax(0.0);
+  const double d = p(2) - p(0) - p(1);
+  if (d > 0.0) {
+    p(0) += 0.5 * d;
+    p(1) += 0.5 * d;
+  }
+  return p;
+}
+
 // An <inertia> (about the centre of mass) of a rigid body: its principal
 // moments I1 <= I2 <= I3 are >= 0 (positive semi-definite) and satisfy the
 // triangle inequality I1 + I2 >= I3 (I1 + I2 - I3 = 2 sum m z^2 over the
 // body along the third axis), both to kInertiaTolerance * I3. Every link
 // is checked, simulated or not, as masses are: a frozen or fixed link's
 // inertia enters the composite body of the joint that carries it.
-void check_inertia(const urdf::Inertial& in, const std::string& source, const std::string& el) {
+// A tensor that fails is refused, or with `balance` repaired in place
+// (balanced_moments; principal axes and mass kept): the note on the repair
+// is returned ("" when the tensor was valid). This is the one place
+// inertias are checked and repaired.
+std::string check_inertia(urdf::Inertial& in, bool balance, const std::string& source,
+                          const std::string& el) {
   Matrix3d I;
   I << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
-  const Vector3d p =
-      Eigen::SelfAdjointEigenSolver<Matrix3d>(I, Eigen::EigenvaluesOnly).eigenvalues();
+  const Eigen::SelfAdjointEigenSolver<Matrix3d> es(I);
+  const Vector3d p = es.eigenvalues();
   const double tol = kInertiaTolerance * std::max(std::abs(p(0)), std::abs(p(2)));
-  const std::string got = "(got ixx=" + num(in.ixx) + ", ixy=" + num(in.ixy) +
-                          ", ixz=" + num(in.ixz) + ", iyy=" + num(in.iyy) + ", iyz=" + num(in.iyz) +
-                          ", izz=" + num(in.izz) + ")";
   // The moments are computed, not read: 6 significant digits (the file's
   // own values are in `got`, exactly).
   const auto six = [](double x) {
@@ -120,17 +144,44 @@ void check_inertia(const urdf::Inertial& in, const std::string& source, const st
     std::snprintf(buf, sizeof buf, "%.6g", x);
     return std::string(buf);
   };
-  const std::string moments =
-      "principal moments " + six(p(0)) + ", " + six(p(1)) + ", " + six(p(2));
-  if (p(0) < -tol)
-    fail(source, el, "not positive semi-definite: " + moments + " (kg m^2), a negative one " + got);
-  if (p(0) + p(1) < p(2) - tol)
+  const auto three = [&](const Vector3d& v) {
+    return six(v(0)) + ", " + six(v(1)) + ", " + six(v(2));
+  };
+  std::string problem, why;
+  if (p(0) < -tol) {
+    problem =
+        "not positive semi-definite: principal moments " + three(p) + " (kg m^2), a negative one";
+    why = "a negative moment";
+  } else if (p(0) + p(1) < p(2) - tol) {
+    problem = "principal moments " + three(p) + " break the triangle inequality (" + six(p(0)) +
+              " + " + six(p(1)) + " < " + six(p(2)) + "): no rigid body has them";
+    why = "the triangle inequality broken";
+  }
+  if (problem.empty()) return "";
+  const std::string got = "(got ixx=" + num(in.ixx) + ", ixy=" + num(in.ixy) +
+                          ", ixz=" + num(in.ixz) + ", iyy=" + num(in.iyy) + ", iyz=" + num(in.iyz) +
+                          ", izz=" + num(in.izz) + ")";
+  if (!balance)
     fail(source, el,
-         moments + " break the triangle inequality (" + six(p(0)) + " + " + six(p(1)) + " < " +
-             six(p(2)) + "): no rigid body has them " + got);
+         problem + " " + got +
+             "; write balance_inertia: true in the scene to repair it (like MuJoCo's "
+             "balanceinertia, by a smaller change: docs/model-format.md)");
+  const Vector3d q = balanced_moments(p);
+  const Matrix3d& R = es.eigenvectors();
+  const Matrix3d J = R * q.asDiagonal() * R.transpose();
+  in.ixx = J(0, 0);
+  in.iyy = J(1, 1);
+  in.izz = J(2, 2);
+  in.ixy = 0.5 * (J(0, 1) + J(1, 0));
+  in.ixz = 0.5 * (J(0, 2) + J(2, 0));
+  in.iyz = 0.5 * (J(1, 2) + J(2, 1));
+  return source + ": " + el + ": repaired (balance_inertia: " + why + "): principal moments " +
+         three(p) + " -> " + three(q) + " kg m^2 (principal axes and mass kept)";
 }
 
-void check_urdf(const urdf::ModelInterface& m, const std::string& source) {
+// Checks what lcsim relies on (parse_urdf); inertias are repaired in `m`
+// instead of refused when repairs.balance_inertia, noted in repairs.notes.
+void check_urdf(urdf::ModelInterface& m, const std::string& source, UrdfRepairs& repairs) {
   // urdfdom accepts a joint whose parent is its own child (it only looks for
   // a root): the link then lists itself among its children and every walk
   // down the tree recurses for ever. Refuse it, and any link reached twice.
@@ -153,14 +204,16 @@ void check_urdf(const urdf::ModelInterface& m, const std::string& source) {
   }
   for (const auto& [name, link] : m.links_) {
     if (!link->inertial) continue;
-    const urdf::Inertial& in = *link->inertial;
+    urdf::Inertial& in = *link->inertial;
     const std::string el = "link '" + name + "': <inertial>";
     if (!finite_pose(in.origin)) fail(source, el + " <origin>", "not finite");
     if (!std::isfinite(in.mass) || in.mass < 0.0)
       fail(source, el + " <mass value>", "must be finite and >= 0 (got " + num(in.mass) + ")");
     for (double x : {in.ixx, in.ixy, in.ixz, in.iyy, in.iyz, in.izz})
       if (!std::isfinite(x)) fail(source, el + " <inertia>", "not finite (got " + num(x) + ")");
-    check_inertia(in, source, el + " <inertia>");
+    if (std::string note = check_inertia(in, repairs.balance_inertia, source, el + " <inertia>");
+        !note.empty())
+      repairs.notes.push_back(one_line(note));
   }
   for (const auto& [name, joint] : m.joints_) {
     const std::string el = "joint '" + name + "'";
@@ -412,7 +465,8 @@ auto one_line_errors(F&& f) {
 }  // namespace
 
 static std::shared_ptr<urdf::ModelInterface> parse_urdf_unfolded(const std::string& xml,
-                                                                 const std::string& source) {
+                                                                 const std::string& source,
+                                                                 UrdfRepairs& repairs) {
   urdf::ModelInterfaceSharedPtr m;
   std::string log;
   try {
@@ -431,7 +485,7 @@ static std::shared_ptr<urdf::ModelInterface> parse_urdf_unfolded(const std::stri
   if (!m || !log.empty())
     throw InputError(source + ": not a valid URDF: " +
                      one_line(log.empty() ? std::string("urdfdom refused it") : log));
-  check_urdf(*m, source);
+  check_urdf(*m, source, repairs);
   return m;
 }
 
@@ -448,7 +502,13 @@ std::shared_ptr<urdf::ModelInterface> load_urdf(const std::filesystem::path& pat
 
 std::shared_ptr<urdf::ModelInterface> parse_urdf(const std::string& xml,
                                                  const std::string& source) {
-  return one_line_errors([&] { return parse_urdf_unfolded(xml, source); });
+  UrdfRepairs none;
+  return parse_urdf(xml, source, none);
+}
+
+std::shared_ptr<urdf::ModelInterface> parse_urdf(const std::string& xml, const std::string& source,
+                                                 UrdfRepairs& repairs) {
+  return one_line_errors([&] { return parse_urdf_unfolded(xml, source, repairs); });
 }
 
 std::map<std::string, Mimic> mimic_joints(const urdf::ModelInterface& model,

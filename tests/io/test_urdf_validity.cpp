@@ -2,7 +2,11 @@
 // a <limit> without lower or upper used as a stop, and q0 given to a mimic
 // joint (robots' reference poses list every joint).
 #include <gtest/gtest.h>
+#include <urdf_model/model.h>
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <cstdio>
 #include <lcsim/io/io.hpp>
 #include <string>
 
@@ -12,7 +16,9 @@
 namespace lcsim {
 namespace {
 
+using Eigen::Matrix3d;
 using Eigen::MatrixXd;
+using Eigen::Vector3d;
 using UrdfValidity = test_support::SceneFiles;
 
 // A base, a link 'arm' on revolute joint 'j' (about y; `limit` its <limit>
@@ -146,6 +152,147 @@ TEST_F(UrdfValidity, MimicQ0ConsistentWithItsLeaderIsAccepted) {
             std::string::npos)
       << e;
   EXPECT_NE(e.find("at q0.j = 0.2), got 0.3; give q0 for 'j' only"), std::string::npos) << e;
+}
+
+// ---- balance_inertia: repairing what the checks above refuse ----
+
+// <inertia> with the entries of the symmetric I, written to 17 digits (they
+// read back exactly).
+std::string inertia_element(const Matrix3d& I) {
+  char buf[256];
+  std::snprintf(
+      buf, sizeof buf,
+      "<inertia ixx='%.17g' ixy='%.17g' ixz='%.17g' iyy='%.17g' iyz='%.17g' izz='%.17g'/>", I(0, 0),
+      I(0, 1), I(0, 2), I(1, 1), I(1, 2), I(2, 2));
+  return buf;
+}
+
+// A rotation with no axis along x, y or z, so that the principal axes are
+// not the URDF's and their being kept is a real check.
+Matrix3d tilt() {
+  return Eigen::AngleAxisd(0.7, Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+}
+
+// What loading robot(inertia) as a scene with `balance_inertia: true` gives.
+struct Loaded {
+  Matrix3d I;                      // the arm's tensor after loading
+  double mass;                     // the arm's mass after loading
+  MatrixXd M;                      // the scene's mass matrix
+  std::vector<std::string> notes;  // the scene's notes as analyze gets them
+};
+class BalanceInertia : public UrdfValidity {
+ protected:
+  Loaded load(const std::string& inertia, const std::string& key = "balance_inertia: true\n") {
+    write("r.urdf", robot(inertia, kLimit));
+    const io::LoadedModel l =
+        io::load_model_and_scene(write("s.yaml", "urdf: r.urdf\njoints: [j]\n" + key));
+    const urdf::Inertial& in = *l.scene->urdf->getLink("arm")->inertial;
+    Matrix3d I;
+    I << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
+    return {I, in.mass, MatrixXd(l.model.mechanical->M), io::model_notes(l)};
+  }
+  // The repaired tensor has the principal moments `want` (ascending) on the
+  // axes R of the file's tensor R diag(p) R', is positive semi-definite and
+  // meets the triangle inequality, the mass is kept, and the dynamics use it:
+  // M is that of the same scene with R diag(want) R' written in the file.
+  // Tolerances: the file's entries are exact to 17 digits and the repair is
+  // an eigen-decomposition and a product of 3 x 3 matrices, each with
+  // rounding errors of a few eps * |I| ~ 1e-17 kg m^2 here; 1e-14 * I3
+  // leaves a margin of 100 and is far below the changes tested (>= 3.5e-8).
+  void expect_repaired(const Loaded& r, const Matrix3d& R, const Vector3d& want) {
+    const double tol = 1e-14 * want(2);
+    const Vector3d got = Eigen::SelfAdjointEigenSolver<Matrix3d>(r.I).eigenvalues();
+    EXPECT_LT((got - want).cwiseAbs().maxCoeff(), tol) << got.transpose();
+    EXPECT_GE(got(0), -tol);
+    EXPECT_GE(got(0) + got(1), got(2) - tol);
+    // Principal axes kept: R' I R is diagonal, with the moments in R's order.
+    const Matrix3d D = R.transpose() * r.I * R;
+    EXPECT_LT((D - Matrix3d(want.asDiagonal())).cwiseAbs().maxCoeff(), tol) << D;
+    EXPECT_EQ(r.mass, 1.0);
+    const Loaded same = load(inertia_element(R * want.asDiagonal() * R.transpose()), "");
+    for (const auto& n : same.notes)
+      EXPECT_EQ(n.find("repaired"), std::string::npos)
+          << "the written tensor needs no repair: " << n;
+    EXPECT_LT((r.M - same.M).cwiseAbs().maxCoeff(), 1e-12 * same.M.cwiseAbs().maxCoeff());
+  }
+};
+
+// Principal moments 0.01, 0.02, 0.05 on tilted axes: 0.01 + 0.02 < 0.05 by
+// d = 0.02. The repair raises the two smaller by d/2 = 0.01 each (the
+// second moment of mass along the third axis, (0.01 + 0.02 - 0.05)/2 < 0,
+// set to 0): 0.02, 0.03, 0.05 (0.02 + 0.03 = 0.05 exactly).
+TEST_F(BalanceInertia, TriangleBreakingTensorIsRepaired) {
+  const Matrix3d R = tilt();
+  const Loaded r =
+      load(inertia_element(R * Vector3d(0.01, 0.02, 0.05).asDiagonal() * R.transpose()));
+  expect_repaired(r, R, Vector3d(0.02, 0.03, 0.05));
+  ASSERT_FALSE(r.notes.empty());
+  EXPECT_NE(r.notes[0].find("r.urdf: link 'arm': <inertial> <inertia>: repaired (balance_inertia: "
+                            "the triangle inequality broken): principal moments 0.01, 0.02, 0.05 "
+                            "-> 0.02, 0.03, 0.05 kg m^2 (principal axes and mass kept)"),
+            std::string::npos)
+      << r.notes[0];
+}
+
+// Tiago's base_antenna links: a moment of -3.5e-8 kg m^2 (beyond the
+// tolerance 1e-4 * 1.2e-4 = 1.2e-8). Moments -3.5e-8, 1e-4, 1.2e-4: the
+// negative one set to 0, then 0 + 1e-4 < 1.2e-4 by 2e-5, so 1e-5 added to
+// the two smaller: 1e-5, 1.1e-4, 1.2e-4. Diagonal, the clip alone suffices:
+// -3.5e-8, 1e-4, 1e-4 -> 0, 1e-4, 1e-4.
+TEST_F(BalanceInertia, SlightlyNegativeMomentIsRepaired) {
+  const Matrix3d R = tilt();
+  const Loaded r =
+      load(inertia_element(R * Vector3d(-3.5e-8, 1e-4, 1.2e-4).asDiagonal() * R.transpose()));
+  expect_repaired(r, R, Vector3d(1e-5, 1.1e-4, 1.2e-4));
+  ASSERT_FALSE(r.notes.empty());
+  EXPECT_NE(r.notes[0].find("link 'arm': <inertial> <inertia>: repaired (balance_inertia: a "
+                            "negative moment): principal moments -3.5e-08, 0.0001, 0.00012 -> "
+                            "1e-05, 0.00011, 0.00012 kg m^2"),
+            std::string::npos)
+      << r.notes[0];
+  const Loaded d = load("<inertia ixx='1e-4' ixy='0' ixz='0' iyy='-3.5e-8' iyz='0' izz='1e-4'/>");
+  // About y = the second principal axis of the diagonal tensor: iyy 0 exactly.
+  EXPECT_EQ(d.I, Matrix3d(Vector3d(1e-4, 0.0, 1e-4).asDiagonal()));
+}
+
+// Valid tensors are never changed, even within the tolerance (the thin disc
+// rounded to 6 digits), and give no note.
+TEST_F(BalanceInertia, ValidTensorsAreKeptAsWritten) {
+  for (const char* in :
+       {"<inertia ixx='0.02' ixy='0' ixz='0' iyy='0.02' iyz='0' izz='0.01'/>",
+        "<inertia ixx='0.01' ixy='0' ixz='0' iyy='0.01' iyz='0' izz='0.0200001'/>"}) {
+    const Loaded r = load(in);
+    const Loaded plain = load(in, "");
+    EXPECT_EQ(r.I, plain.I) << in;
+    EXPECT_EQ(r.notes, plain.notes) << in;
+    EXPECT_EQ(r.M, plain.M) << in;
+  }
+  EXPECT_EQ(load(kGoodInertia, "balance_inertia: false\n").I(2, 2), 0.01);
+}
+
+// Without the key (or with false) the refusals suggest it.
+TEST_F(UrdfValidity, RefusalsSuggestBalanceInertia) {
+  const std::string hint =
+      "; write balance_inertia: true in the scene to repair it (like MuJoCo's balanceinertia, by "
+      "a smaller change: docs/model-format.md)";
+  for (const char* in : {"<inertia ixx='0.02' ixy='0' ixz='0' iyy='-0.01' iyz='0' izz='0.02'/>",
+                         "<inertia ixx='0.01' ixy='0' ixz='0' iyy='0.01' iyz='0' izz='0.05'/>"})
+    for (const char* key : {"", "balance_inertia: false\n"}) {
+      const std::string e =
+          error(robot(in, kLimit), std::string("urdf: r.urdf\njoints: [j]\n") + key);
+      EXPECT_EQ(e.size() >= hint.size() ? e.substr(e.size() - hint.size()) : e, hint) << e;
+    }
+}
+
+// The key takes true or false only (yaml-cpp would read yes and on as true).
+TEST_F(UrdfValidity, BalanceInertiaTakesTrueOrFalse) {
+  for (const char* v : {"3", "yes", "[true]", "''"}) {
+    const std::string e =
+        error(robot(kGoodInertia, kLimit),
+              std::string("urdf: r.urdf\njoints: [j]\nbalance_inertia: ") + v + "\n");
+    EXPECT_NE(e.find("s.yaml: balance_inertia: expected true or false (got "), std::string::npos)
+        << e;
+  }
 }
 
 }  // namespace

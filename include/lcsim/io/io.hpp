@@ -123,7 +123,9 @@ namespace lcsim::io {
 
 // Parses a URDF file with urdfdom and checks what lcsim relies on: finite
 // numbers in every <origin>, <axis>, <inertial>, <limit> and <dynamics>;
-// masses >= 0; non-zero axes on revolute, continuous and prismatic joints.
+// masses >= 0; inertia tensors positive semi-definite with I1 + I2 >= I3
+// (refused, or repaired: UrdfRepairs); non-zero axes on revolute,
+// continuous and prismatic joints.
 // <visual>, <collision> and <material> are dropped unread (no geometry is
 // used). A <limit> with lower > upper is no limit; a scene refuses it only
 // where it would become a stop. InputError names the file, the element and
@@ -131,6 +133,23 @@ namespace lcsim::io {
 std::shared_ptr<urdf::ModelInterface> load_urdf(const std::filesystem::path& path);
 // The same from URDF text; `source` names it in messages.
 std::shared_ptr<urdf::ModelInterface> parse_urdf(const std::string& xml, const std::string& source);
+
+// What parse_urdf repairs instead of refusing (a scene's `balance_inertia:
+// true`), and what it repaired. An inertia tensor that is not positive
+// semi-definite or breaks the triangle inequality I1 + I2 >= I3 (beyond the
+// check's 1e-4 of the largest moment) is refused unless balance_inertia;
+// then it is replaced, in its principal frame, by the moments with each
+// negative one set to 0 and, if still I1 + I2 < I3, I1 and I2 each raised by
+// half the deficit (I3, the principal axes and the mass kept; the result is
+// positive semi-definite with I1 + I2 = I3). Valid tensors are never
+// changed. Each repair adds a note naming the URDF, the link and the
+// moments before and after.
+struct UrdfRepairs {
+  bool balance_inertia = false;
+  std::vector<std::string> notes;
+};
+std::shared_ptr<urdf::ModelInterface> parse_urdf(const std::string& xml, const std::string& source,
+                                                 UrdfRepairs& repairs);
 
 // The rigid-body part of a scene linearised about a reference configuration.
 // Coordinates are the joint positions themselves (rad for revolute, m for
@@ -216,6 +235,7 @@ struct Scene {
   std::map<std::string, double> q0;  // as the scene gives it (joints not named: 0)
   Eigen::Vector3d gravity;           // m/s^2, URDF root frame
   UrdfLinearisation lin;             // M, tau_g, K_g, damping at q0 (coordinates: lin.joints)
+  std::vector<std::string> notes;    // what loading repaired (UrdfRepairs::notes)
 };
 Scene read_scene(const std::string& yaml_text, const std::string& source);
 // The scene in `path`, or nullopt when the file is a model, not a scene (no
@@ -228,6 +248,9 @@ struct LoadedModel {
   std::optional<Scene> scene;
 };
 LoadedModel load_model_and_scene(const std::filesystem::path& path);
+// model_notes of the model, after the scene's notes (what loading repaired):
+// the notes `analyze` prints.
+std::vector<std::string> model_notes(const LoadedModel& loaded);
 
 // ---- How far the linear model holds (src/io/linearisation.cpp) ----
 //
