@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <exception>
 #include <lcsim/io/io.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <string>
@@ -48,7 +49,12 @@ int main(int argc, char** argv) {
   std::vector<std::pair<std::string, lcsim::mech::Model>> models;
   if (argc < 2)
     models.emplace_back("chain of 32 carts", lcsim::mech::chain_model({32, false, false, true}));
-  for (int i = 1; i < argc; ++i) models.emplace_back(argv[i], lcsim::io::load_model(argv[i]));
+  for (int i = 1; i < argc; ++i) try {
+      models.emplace_back(argv[i], lcsim::io::load_model(argv[i]));
+    } catch (const std::exception& e) {  // a model the loader refuses: its one line
+      std::fprintf(stderr, "table_samples: %s\n", e.what());
+      return 2;
+    }
   std::printf("%-28s %8s %10s %9s %12s %14s\n", "model", "dt_out", "samples", "wall s",
               "events-only s", "per sample us");
   for (const auto& [name, model] : models) {

@@ -341,11 +341,8 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const io::Scene& se
         1e-10 * (1.0 + (m.M * v).cwiseAbs().maxCoeff() + h * tau.cwiseAbs().maxCoeff());
     if (std::string why =
             rec.step(last ? *opt.t_end : j * opt.h, h, last, q_next, v_next, impulse, tiny);
-        !why.empty()) {
-      rec.finish();  // the last sane state, and the time reached
-      tr.t_end = (j - 1) * grid.h;
+        !why.empty())
       return fail("bullet: " + why);
-    }
     q = q_next;
     v = v_next;
   }

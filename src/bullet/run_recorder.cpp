@@ -88,7 +88,11 @@ void RunRecorder::record(double t, const VectorXd& u) {
 
 std::string RunRecorder::step(double t, double h, bool last, const VectorXd& q, const VectorXd& v,
                               const VectorXd& impulse, double tiny) {
-  if (std::string why = guard_.check(t, q, v, last); !why.empty()) return why;
+  if (std::string why = guard_.check(t, q, v, last); !why.empty()) {
+    finish();
+    tr_.t_end = t_;
+    return why;
+  }
   const int N = m_.dofs(), k = m_.num_constraints();
   sim::IndexSet mode;
   for (int i = 0; i < k; ++i)
@@ -118,6 +122,7 @@ std::string RunRecorder::step(double t, double h, bool last, const VectorXd& q, 
   }
   q_ = q;
   v_ = v;
+  t_ = t;
   ++tr_.steps;
   if (k > 0) ++tr_.lcp_solves;  // the constraint solver runs every step
   y_ = m_.E * q_ + m_.g;

@@ -34,8 +34,9 @@ class RunRecorder {
               const Eigen::VectorXd& q0, const Eigen::VectorXd& v0);
   // One step of length h ending at t (the last one when `last`), from the
   // state held to (q, v), with constraint impulses `impulse` (h u, size k).
-  // "" when recorded; else the state diverged (sim::DivergenceGuard), nothing
-  // is recorded and the message says what.
+  // "" when recorded; else the state diverged (sim::DivergenceGuard): nothing
+  // more is recorded, the run is finished at the last sane step (its final
+  // state, and t_end the time it reached) and the message says what.
   std::string step(double t, double h, bool last, const Eigen::VectorXd& q,
                    const Eigen::VectorXd& v, const Eigen::VectorXd& impulse, double tiny);
   // Final state and energy.
@@ -49,6 +50,7 @@ class RunRecorder {
   sim::OutputSampler sampler_;
   sim::DivergenceGuard guard_;
   Eigen::VectorXd q_, v_, y_;
+  double t_ = 0.0;  // time of (q_, v_), the last step recorded (s)
   sim::IndexSet mode_;
 };
 

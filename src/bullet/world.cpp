@@ -368,11 +368,8 @@ sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>&
         1e-10 * (1.0 + (m.M * v).cwiseAbs().maxCoeff() + h * F.cwiseAbs().maxCoeff());
     if (std::string why =
             rec.step(last ? *opt.t_end : j * opt.h, h, last, q_next, v_next, impulse, tiny);
-        !why.empty()) {
-      rec.finish();  // the last sane state, and the time reached
-      tr.t_end = (j - 1) * grid.h;
+        !why.empty())
       return fail("bullet: " + why);
-    }
     q = q_next;
     v = v_next;
   }
