@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <string>
 #include <vector>
@@ -110,7 +111,7 @@ void print(const std::vector<Row>& rows) {
 
 int main(int argc, char** argv) {
   const std::string path = argc > 1 ? argv[1] : "robots/block_on_floor_friction.yaml";
-  const mech::Model model = io::load_model(path);
+  const mech::Model model = scene::load_model(path);
   const bullet::FrictionBlockOf of = bullet::friction_block_of(model);
   if (of.status != Status::kOk) {
     std::fprintf(stderr, "%s\n", of.message.c_str());

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <exception>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <string>
 #include <vector>
@@ -50,7 +51,7 @@ int main(int argc, char** argv) {
   if (argc < 2)
     models.emplace_back("chain of 32 carts", lcsim::mech::chain_model({32, false, false, true}));
   for (int i = 1; i < argc; ++i) try {
-      models.emplace_back(argv[i], lcsim::io::load_model(argv[i]));
+      models.emplace_back(argv[i], lcsim::scene::load_model(argv[i]));
     } catch (const std::exception& e) {  // a model the loader refuses: its one line
       std::fprintf(stderr, "table_samples: %s\n", e.what());
       return 2;

@@ -1,4 +1,4 @@
-// libFuzzer target: io::parse_model on arbitrary text. A model file is input
+// libFuzzer target: scene::parse_model on arbitrary text. A model file is input
 // from a user: the only exception that may escape is io::InputError (one line
 // naming the file, key and value); a crash, a sanitizer report or any other
 // exception is a bug. A valid model also goes through model_notes and
@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <string>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -13,7 +14,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     // The source names a file in a directory without URDFs: a `urdf:` key
     // makes this a scene whose URDF is not found (fuzz_scene covers scenes).
-    const lcsim::mech::Model model = lcsim::io::parse_model(text, "/nonexistent/fuzz.yaml");
+    const lcsim::mech::Model model = lcsim::scene::parse_model(text, "/nonexistent/fuzz.yaml");
     (void)lcsim::io::model_notes(model);
     (void)model.as_lcs();
   } catch (const lcsim::io::InputError& e) {

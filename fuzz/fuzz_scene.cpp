@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <string>
 
 namespace {
@@ -42,14 +43,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string scene_text = sep == std::string::npos ? "" : text.substr(sep + 4);
 
   try {
-    const auto model = lcsim::io::parse_urdf(urdf_text, "fuzz.urdf");
+    const auto model = lcsim::scene::parse_urdf(urdf_text, "fuzz.urdf");
     std::vector<std::string> joints;
     for (const auto& [name, j] : model->joints_)
       if (j && (j->type == urdf::Joint::REVOLUTE || j->type == urdf::Joint::PRISMATIC))
         joints.push_back(name);
     if (joints.size() <= 8)
-      (void)lcsim::io::linearise_urdf(*model, joints, {}, Eigen::Vector3d(0.0, 0.0, -9.81),
-                                      "fuzz.urdf");
+      (void)lcsim::scene::linearise_urdf(*model, joints, {}, Eigen::Vector3d(0.0, 0.0, -9.81),
+                                         "fuzz.urdf");
   } catch (const lcsim::io::InputError& e) {
     one_line(e);
   }
@@ -61,8 +62,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   try {
     const lcsim::mech::Model m =
-        lcsim::io::parse_model(scene_text, (folder() / "scene.yaml").string());
-    (void)lcsim::io::model_notes(m);
+        lcsim::scene::parse_model(scene_text, (folder() / "scene.yaml").string());
+    (void)lcsim::scene::model_notes(m);
   } catch (const lcsim::io::InputError& e) {
     one_line(e);
   }

@@ -7,8 +7,8 @@
 #include <cstdio>
 #include <exception>
 #include <lcsim/impact/impact.hpp>
-#include <lcsim/io/io.hpp>
 #include <lcsim/lcp/lcp.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <string>
 
 namespace {
@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    const lcsim::mech::Model model = lcsim::io::load_model(argv[1]);
+    const lcsim::mech::Model model = lcsim::scene::load_model(argv[1]);
     if (!model.is_mechanical()) {  // an `lcs:` file has no masses or contacts
       std::fprintf(stderr, "%s: not a mechanical model\n", argv[1]);
       return 2;

@@ -6,7 +6,7 @@
 //   usage: two_carts <path to robots/two_carts.yaml>
 #include <cstdio>
 #include <exception>
-#include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <string>
 
@@ -17,7 +17,7 @@ int main(int argc, char** argv) {
   }
   try {
     // Throws lcsim::io::InputError naming the file, key and value on bad input.
-    const lcsim::mech::Model model = lcsim::io::load_model(argv[1]);
+    const lcsim::mech::Model model = lcsim::scene::load_model(argv[1]);
     if (!model.is_mechanical()) {  // an `lcs:` file has no masses or contacts
       std::fprintf(stderr, "%s: not a mechanical model\n", argv[1]);
       return 2;

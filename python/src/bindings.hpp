@@ -11,6 +11,7 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -21,7 +22,7 @@ namespace py = pybind11;
 
 // A model with, for a URDF scene, what it was linearised from (the Python
 // `lcsim.Model`). Shared: a trajectory keeps its model for to_csv/to_json.
-using ModelHandle = std::shared_ptr<io::LoadedModel>;
+using ModelHandle = std::shared_ptr<scene::LoadedModel>;
 
 // A numpy array owning `data` (moved, not copied): the capsule frees it
 // when the last array viewing it is gone.

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <lcsim/mech/mech.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <limits>
 #include <optional>
 #include <string>
@@ -28,7 +29,7 @@ ModelHandle checked(mech::Model model, const OptVector& initial, std::optional<d
   if (t_end) model.t_end = *t_end;
   if (auto p = mech::check_model(model))
     throw io::InputError("model '" + model.name + "': " + p->field + ": " + p->what);
-  return std::make_shared<io::LoadedModel>(io::LoadedModel{std::move(model), std::nullopt});
+  return std::make_shared<scene::LoadedModel>(scene::LoadedModel{std::move(model), std::nullopt});
 }
 
 // One entry of Model.mechanical's `friction`: {contact: index or name,
@@ -101,10 +102,10 @@ ModelHandle make_lcs(const MatrixXd& A, const MatrixXd& B, const MatrixXd& C, co
 }
 
 ModelHandle load(const std::filesystem::path& path) {
-  return std::make_shared<io::LoadedModel>(io::load_model_and_scene(path));
+  return std::make_shared<scene::LoadedModel>(scene::load_model_and_scene(path));
 }
 
-const mech::MechanicalModel& mechanical(const io::LoadedModel& m) {
+const mech::MechanicalModel& mechanical(const scene::LoadedModel& m) {
   if (!m.model.is_mechanical())
     throw io::InputError("model '" + m.model.name + "': not a mechanical model (an `lcs:` model)");
   return *m.model.mechanical;
@@ -113,7 +114,7 @@ const mech::MechanicalModel& mechanical(const io::LoadedModel& m) {
 }  // namespace
 
 void bind_model(py::module_& m) {
-  py::class_<io::LoadedModel, ModelHandle> c(m, "Model", R"(A model: a mechanical model
+  py::class_<scene::LoadedModel, ModelHandle> c(m, "Model", R"(A model: a mechanical model
 M q'' + D q' + K q = f + E' u, 0 <= E q + g _|_ u >= 0 (with restitution per contact),
 or a general LCS x' = A x + B u, y = C x + D u, 0 <= y _|_ u >= 0. Built by lcsim.load
 (a YAML model or a URDF scene), Model.mechanical or Model.lcs; checked by the library.)");
@@ -138,42 +139,42 @@ positive definite, a restitution lies outside [0, 1], ...)");
                "A general LCS x' = A x + B u, y = C x + D u, 0 <= y _|_ u >= 0 (numpy arrays). "
                "Raises InputError when the library refuses it.");
   c.def_property_readonly(
-      "name", [](const io::LoadedModel& l) { return l.model.name; }, "The model's name.");
+      "name", [](const scene::LoadedModel& l) { return l.model.name; }, "The model's name.");
   c.def_property_readonly(
-      "source", [](const io::LoadedModel& l) { return l.model.source; },
+      "source", [](const scene::LoadedModel& l) { return l.model.source; },
       "The file it was loaded from ('' if built in code).");
   c.def_property_readonly(
-      "is_mechanical", [](const io::LoadedModel& l) { return l.model.is_mechanical(); },
+      "is_mechanical", [](const scene::LoadedModel& l) { return l.model.is_mechanical(); },
       "True for a mechanical model, False for a general LCS.");
   c.def_property_readonly(
-      "is_scene", [](const io::LoadedModel& l) { return l.scene.has_value(); },
+      "is_scene", [](const scene::LoadedModel& l) { return l.scene.has_value(); },
       "True when loaded from a URDF scene.");
   c.def_property_readonly(
-      "state_size", [](const io::LoadedModel& l) { return l.model.state_size(); },
+      "state_size", [](const scene::LoadedModel& l) { return l.model.state_size(); },
       "Size of the state: 2N (q then v) for a mechanical model, n for an LCS.");
   c.def_property_readonly(
-      "num_constraints", [](const io::LoadedModel& l) { return l.model.num_constraints(); },
+      "num_constraints", [](const scene::LoadedModel& l) { return l.model.num_constraints(); },
       "Number of complementarity pairs (constraints).");
   c.def_property_readonly(
-      "dofs", [](const io::LoadedModel& l) { return mechanical(l).dofs(); },
+      "dofs", [](const scene::LoadedModel& l) { return mechanical(l).dofs(); },
       "Number of coordinates N (mechanical models).");
   c.def_property_readonly(
       "initial",
-      [](const io::LoadedModel& l) -> std::optional<VectorXd> {
+      [](const scene::LoadedModel& l) -> std::optional<VectorXd> {
         if (l.model.initial.size() == 0) return std::nullopt;
         return l.model.initial;
       },
       "The default initial state, or None.");
   c.def_property_readonly(
       "t_end",
-      [](const io::LoadedModel& l) -> std::optional<double> {
+      [](const scene::LoadedModel& l) -> std::optional<double> {
         if (std::isnan(l.model.t_end)) return std::nullopt;
         return l.model.t_end;
       },
       "The default horizon (s), or None.");
 #define LCSIM_MECH_FIELD(field, doc) \
   c.def_property_readonly(           \
-      #field, [](const io::LoadedModel& l) { return mechanical(l).field; }, doc)
+      #field, [](const scene::LoadedModel& l) { return mechanical(l).field; }, doc)
   LCSIM_MECH_FIELD(M, "Mass matrix (scipy.sparse).");
   LCSIM_MECH_FIELD(D, "Damping matrix (scipy.sparse).");
   LCSIM_MECH_FIELD(K, "Stiffness matrix (scipy.sparse).");
@@ -184,14 +185,14 @@ positive definite, a restitution lies outside [0, 1], ...)");
   LCSIM_MECH_FIELD(coordinates, "Coordinate names.");
   LCSIM_MECH_FIELD(constraints, "Constraint names.");
 #undef LCSIM_MECH_FIELD
-  c.def("__repr__", [](const io::LoadedModel& l) {
+  c.def("__repr__", [](const scene::LoadedModel& l) {
     return "<lcsim.Model '" + l.model.name + "': " +
            (l.model.is_mechanical() ? std::to_string(l.model.mechanical->dofs()) + " coordinates"
                                     : std::to_string(l.model.state_size()) + " states (LCS)") +
            ", " + std::to_string(l.model.num_constraints()) + " constraints>";
   });
   m.def("load", &load, py::arg("path"),
-        "Reads a YAML model file or a URDF scene (io::load_model_and_scene). Raises InputError "
+        "Reads a YAML model file or a URDF scene (scene::load_model_and_scene). Raises InputError "
         "naming the file, the key and the value when it is invalid.");
 }
 

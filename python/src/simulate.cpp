@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdint>
 #include <exception>
+#include <lcsim/scene/linearisation.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <optional>
 #include <string>
@@ -104,14 +106,14 @@ struct Run {
   // scene's linearisation check over the recorded states.
   std::string json_text() const {
     nlohmann::json j = io::trajectory_json(model->model, traj);
-    std::optional<io::LinearisationCheck> lin;
+    std::optional<scene::LinearisationCheck> lin;
     if (model->scene) {
-      io::LinearisationStates visited;  // as `lcsim simulate` thins them
+      scene::LinearisationStates visited;  // as `lcsim simulate` thins them
       for (py::ssize_t i = 0; i < t.shape(0); ++i) visited.add(sample(i).x);
-      lin = io::check_linearisation(*model->scene, visited.states());
+      lin = scene::check_linearisation(*model->scene, visited.states());
     }
     j["linearisation_error"] = lin ? nlohmann::json(lin->error) : nlohmann::json(nullptr);
-    j["linearisation_check"] = lin ? io::to_json(*lin) : nlohmann::json(nullptr);
+    j["linearisation_check"] = lin ? scene::to_json(*lin) : nlohmann::json(nullptr);
     return j.dump(2) + "\n";
   }
 };

@@ -1,12 +1,13 @@
 // lcsim.impacts, lcsim.impact_map, lcsim.solve_lcp, lcsim.analyze and
 // lcsim.sweep: the library's impact laws, LCP solvers, model analysis and
 // work-precision sweep, called as the CLI calls them.
+#include <lcsim/app/impact_map.hpp>
+#include <lcsim/app/sweep.hpp>
 #include <lcsim/impact/impact.hpp>
-#include <lcsim/io/impact_map.hpp>
-#include <lcsim/io/sweep.hpp>
 #include <lcsim/lcp/lcp.hpp>
 #include <lcsim/lcs/lcs.hpp>
 #include <lcsim/mech/mech.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <map>
 #include <optional>
 #include <string>
@@ -41,7 +42,7 @@ std::map<std::string, impact::ImpactResult> impacts(const ModelHandle& model,
   in.model = &m;
   in.q = x.head(m.dofs());
   in.v = x.tail(m.dofs());
-  in.closed = io::closed_constraints(m, in.q, "x0");
+  in.closed = app::closed_constraints(m, in.q, "x0");
   if (restitution) {  // checked as the model's own would be (mech::check_mechanical)
     mech::MechanicalModel with = m;
     with.restitution = *restitution;
@@ -76,7 +77,7 @@ py::dict analyze(const ModelHandle& model) {
   d["name"] = mm.name;
   d["state_size"] = mm.state_size();
   d["constraints"] = mm.num_constraints();
-  d["notes"] = io::model_notes(*model);
+  d["notes"] = scene::model_notes(*model);
   if (mm.is_mechanical()) {
     const mech::MechanicalModel& m = *mm.mechanical;
     const MatrixXd W = mech::delassus(m);
@@ -101,7 +102,7 @@ py::dict analyze(const ModelHandle& model) {
 std::string sweep(const ModelHandle& model, std::vector<std::string> methods,
                   std::vector<double> hs, std::optional<VectorXd> x0, std::optional<double> t_end,
                   std::optional<std::string> impact, std::optional<double> theta, int repeat) {
-  io::SweepOptions o;
+  app::SweepOptions o;
   o.methods = std::move(methods);
   o.hs = std::move(hs);
   o.repeat = repeat;
@@ -109,19 +110,19 @@ std::string sweep(const ModelHandle& model, std::vector<std::string> methods,
   if (!t_end && !std::isnan(model->model.t_end)) o.base.t_end = model->model.t_end;
   if (impact) o.base.impact = *impact;
   if (theta) o.base.theta = *theta;
-  io::SweepResult r;
+  app::SweepResult r;
   {
     py::gil_scoped_release release;
-    r = io::run_sweep(model->model, x0.value_or(model->model.initial), o);
+    r = app::run_sweep(model->model, x0.value_or(model->model.initial), o);
   }
-  return io::sweep_json(r).dump(2);
+  return app::sweep_json(r).dump(2);
 }
 
 std::string impact_map_csv(const ModelHandle& model, std::pair<double, double> v1,
                            std::pair<double, double> v2, int n, std::optional<VectorXd> x0,
                            std::string law) {
   const mech::MechanicalModel& m = mechanical(model, "impact maps");
-  io::ImpactMapSpec spec;
+  app::ImpactMapSpec spec;
   const VectorXd x = x0.value_or(VectorXd::Zero(2 * m.dofs()));
   if (x.size() != 2 * m.dofs())
     throw io::InputError("x0: expected " + std::to_string(2 * m.dofs()) + " entries (got " +
@@ -131,13 +132,13 @@ std::string impact_map_csv(const ModelHandle& model, std::pair<double, double> v
   spec.axis1 = {v1.first, v1.second, n};
   spec.axis2 = {v2.first, v2.second, n};
   spec.law = std::move(law);
-  io::ImpactMap map;
+  app::ImpactMap map;
   {
     py::gil_scoped_release release;
-    map = io::impact_map(m, spec);
+    map = app::impact_map(m, spec);
   }
   if (!map.failure.empty()) throw std::runtime_error("impact map: " + map.failure);
-  return io::impact_map_csv(m, map);
+  return app::impact_map_csv(m, map);
 }
 
 void bind_results(py::module_& m) {
@@ -191,10 +192,10 @@ void bind_tools(py::module_& m) {
   m.def("_sweep_json", &sweep, py::arg("model"), py::arg("methods"), py::arg("hs"),
         py::arg("x0") = py::none(), py::arg("t_end") = py::none(), py::arg("impact") = py::none(),
         py::arg("theta") = py::none(), py::arg("repeat") = 3,
-        "The work-precision sweep (io::run_sweep) as the JSON text `lcsim sweep --json` prints.");
+        "The work-precision sweep (app::run_sweep) as the JSON text `lcsim sweep --json` prints.");
   m.def("_impact_map_csv", &impact_map_csv, py::arg("model"), py::arg("v1"), py::arg("v2"),
         py::arg("n") = 41, py::arg("x0") = py::none(), py::arg("law") = "newton",
-        "The impact map of thesis Figure 3.5 (io::impact_map) as the CSV `lcsim impacts --map` "
+        "The impact map of thesis Figure 3.5 (app::impact_map) as the CSV `lcsim impacts --map` "
         "prints.");
 }
 

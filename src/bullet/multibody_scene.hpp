@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <string>
 #include <vector>
 
@@ -30,7 +31,7 @@ std::string multibody_description(const WorldSettings& s);
 
 // The scene run as a btMultiBody (multibody_world.cpp); `limits` from
 // joint_limits_of. Never throws.
-sim::Trajectory simulate_multibody(const mech::Model& model, const io::Scene& setup,
+sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene& setup,
                                    const std::vector<JointLimit>& limits, const Eigen::VectorXd& x0,
                                    const sim::Options& opt, const WorldSettings& s);
 

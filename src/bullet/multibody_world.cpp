@@ -12,7 +12,7 @@
 // added as joint torques before every step:
 //   tau = f_s - K_s q - D v,   K_s = K - K_g,   f_s = f - tau_g(q0) - K_g q0,
 // i.e. the scene's springs and dampers (and the URDF's joint damping, all in
-// D), without the linearised gravity that K and f also hold (io::Scene).
+// D), without the linearised gravity that K and f also hold (scene::Scene).
 //
 // Constraints. Each row of E must be a joint limit c q_j + g >= 0 (one
 // non-zero coefficient): it becomes a btMultiBodyJointLimitConstraint on q_j
@@ -51,6 +51,7 @@
 #include <algorithm>
 #include <cmath>
 #include <lcsim/bullet/bullet.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <memory>
 #include <stdexcept>
 
@@ -76,11 +77,11 @@ struct FollowingMimic {
   int link = 0;  // Bullet link
 };
 
-// The mimics of `coordinates` in the URDF (io::mimic_joints, chains resolved).
-std::vector<FollowingMimic> following_mimics(const io::Scene& setup,
+// The mimics of `coordinates` in the URDF (scene::mimic_joints, chains resolved).
+std::vector<FollowingMimic> following_mimics(const scene::Scene& setup,
                                              const std::vector<std::string>& coordinates) {
   std::vector<FollowingMimic> out;
-  for (const auto& [name, mm] : io::mimic_joints(*setup.urdf, setup.urdf_source, coordinates)) {
+  for (const auto& [name, mm] : scene::mimic_joints(*setup.urdf, setup.urdf_source, coordinates)) {
     const auto it = std::find(coordinates.begin(), coordinates.end(), mm.leader);
     if (it == coordinates.end()) continue;  // frozen with its frozen leader
     out.push_back({name, static_cast<int>(it - coordinates.begin()), mm.multiplier, mm.offset, 0});
@@ -129,7 +130,7 @@ void set_state(btMultiBody& b, const UrdfMultiBody& mb, const std::vector<Follow
   b.updateCollisionObjectWorldTransforms(world_to_local, local_origin);
 }
 
-std::unique_ptr<MbWorld> build(const io::Scene& setup, const mech::MechanicalModel& m,
+std::unique_ptr<MbWorld> build(const scene::Scene& setup, const mech::MechanicalModel& m,
                                const std::vector<JointLimit>& limits, const VectorXd& q0,
                                const VectorXd& v0, const WorldSettings& s) {
   auto w = std::make_unique<MbWorld>();
@@ -274,7 +275,7 @@ std::string multibody_description(const WorldSettings& s) {
          fmt(s.limit_max_impulse) + ")";
 }
 
-sim::Trajectory simulate_multibody(const mech::Model& model, const io::Scene& setup,
+sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene& setup,
                                    const std::vector<JointLimit>& limits, const VectorXd& x0,
                                    const sim::Options& opt, const WorldSettings& s) {
   sim::Trajectory tr;
@@ -291,7 +292,7 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const io::Scene& se
   const int N = m.dofs(), k = m.num_constraints();
 
   // The scene's own forces: K and f without the linearised gravity.
-  const io::UrdfLinearisation& lin = setup.lin;
+  const scene::UrdfLinearisation& lin = setup.lin;
   VectorXd q_ref = VectorXd::Zero(N);
   for (int j = 0; j < N; ++j)
     if (const auto it = setup.q0.find(m.coordinates[static_cast<std::size_t>(j)]);

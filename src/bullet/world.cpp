@@ -47,6 +47,7 @@
 #include <cmath>
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -237,7 +238,7 @@ std::unique_ptr<World> build(const mech::MechanicalModel& m, const std::vector<L
 // all joint limits; else rb6 (a scene's matrices included, with a warning);
 // std::invalid_argument when neither can express it.
 struct Plan {
-  std::optional<io::Scene> scene;  // set: the multibody
+  std::optional<scene::Scene> scene;  // set: the multibody
   std::vector<JointLimit> joint_limits;
   std::vector<Limit> rb6_limits;
   std::string warning;
@@ -245,7 +246,8 @@ struct Plan {
 
 Plan plan_of(const mech::Model& model, const WorldSettings& s) {
   Plan p;
-  std::optional<io::Scene> setup = model.is_mechanical() ? io::scene_setup(model) : std::nullopt;
+  std::optional<scene::Scene> setup =
+      model.is_mechanical() ? scene::scene_setup(model) : std::nullopt;
   if (!setup) {
     p.rb6_limits = limits_of(model, s.limit_range);
     return p;

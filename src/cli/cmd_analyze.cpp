@@ -12,6 +12,8 @@
 #include <lcsim/lcp/lcp.hpp>
 #include <lcsim/lcs/lcs.hpp>
 #include <lcsim/mech/mech.hpp>
+#include <lcsim/scene/linearisation.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -30,7 +32,7 @@ struct AnalyzeArgs {
   bool json = false;
   bool full = false;      // --full: every matrix and set (default: the library's summary)
   std::string model_out;  // --model-out: the linear model as YAML
-  double linearisation_threshold = io::kLinearisationThreshold;
+  double linearisation_threshold = scene::kLinearisationThreshold;
 };
 
 std::string num(double x) {
@@ -183,15 +185,15 @@ std::string coactive_text(const mech::MechanicalModel& m, const Coactive& c, boo
   return out.str();
 }
 
-// Scenes: where the linear model holds, per simulated joint (io::linear_ranges).
-void linear_ranges_section(const std::optional<io::Scene>& scene, double threshold,
+// Scenes: where the linear model holds, per simulated joint (scene::linear_ranges).
+void linear_ranges_section(const std::optional<scene::Scene>& scene, double threshold,
                            nlohmann::json& j, std::ostringstream& out) {
   if (!scene) {
     j["linear_ranges"] = nullptr;
     return;
   }
-  const std::vector<io::LinearRange> ranges = io::linear_ranges(*scene, threshold);
-  j["linear_ranges"] = io::to_json(ranges);
+  const std::vector<scene::LinearRange> ranges = scene::linear_ranges(*scene, threshold);
+  j["linear_ranges"] = scene::to_json(ranges);
   j["linearisation_threshold"] = threshold;
   out << "linear model: error <= " << num(100.0 * threshold)
       << " % (mass and forces, docs/model-format.md) for q in, each joint alone:\n";
@@ -201,12 +203,12 @@ void linear_ranges_section(const std::optional<io::Scene>& scene, double thresho
 }
 
 void run_analyze(const AnalyzeArgs& args) {
-  io::check_linearisation_threshold(args.linearisation_threshold);
+  scene::check_linearisation_threshold(args.linearisation_threshold);
   if (!args.model_out.empty()) check_writable(args.model_out);
-  const io::LoadedModel loaded = io::load_model_and_scene(args.file);
-  const std::optional<io::Scene>& scene = loaded.scene;
+  const scene::LoadedModel loaded = scene::load_model_and_scene(args.file);
+  const std::optional<scene::Scene>& scene = loaded.scene;
   const mech::Model& model = loaded.model;
-  const std::vector<std::string> notes = io::model_notes(loaded);
+  const std::vector<std::string> notes = scene::model_notes(loaded);
   const lcs::Lcs sys = model.as_lcs();
   const lcs::WellPosednessReport wp = lcs::analyze_well_posedness(sys);
 

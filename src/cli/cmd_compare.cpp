@@ -1,5 +1,5 @@
 // `lcsim compare MODEL --h H`: the model run in Bullet beside lcsim's exact
-// event-driven solution of the nearest exact law (io::reference_law: the
+// event-driven solution of the nearest exact law (sim::reference_law: the
 // inelastic one when the model has restitution, which Bullet loses at the
 // scene's stop ERP) (bullet::compare_trajectories):
 //   deviation_max  largest max-abs state difference over the Bullet samples
@@ -18,9 +18,12 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <lcsim/app/sweep.hpp>
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
-#include <lcsim/io/sweep.hpp>
+#include <lcsim/scene/linearisation.hpp>
+#include <lcsim/scene/scene.hpp>
+#include <lcsim/sim/reference.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -85,7 +88,7 @@ void print_friction(const mech::Model& model, const CompareArgs& a,
 }
 
 void run_compare(const CompareArgs& a) {
-  const io::LoadedModel loaded = io::load_model_and_scene(a.model);
+  const scene::LoadedModel loaded = scene::load_model_and_scene(a.model);
   const mech::Model& model = loaded.model;
   const bool friction = model.is_mechanical() && !model.mechanical->friction.empty();
   if (!friction) bullet::check_expressible(model);  // invalid_argument naming it: exit 2
@@ -99,17 +102,18 @@ void run_compare(const CompareArgs& a) {
     opt.dt_out = std::max(1.0, std::round(*opt.t_end / (2000.0 * a.h))) * a.h;
 
   // Like with like (issue 13): Bullet loses restitution at the scene's stop
-  // ERP, so its exact counterpart is the nearest exact law (io::reference_law).
-  const io::ReferenceLaw law = io::reference_law("bullet", opt.impact, model);
-  const sim::Trajectory exact = io::run_reference(model, x0, law, opt);
+  // ERP, so its exact counterpart is the nearest exact law (sim::reference_law).
+  const sim::ReferenceLaw law = sim::reference_law("bullet", opt.impact, model);
+  const sim::Trajectory exact = sim::run_reference(model, x0, law, opt);
   check_status(exact.status, "compare: the exact event-driven run failed: " + exact.message);
   // A scene's linear model checked at the exact run's states, as `simulate`
-  // checks its run (io::check_linearisation, default threshold).
+  // checks its run (scene::check_linearisation, default threshold).
   if (loaded.scene) {
-    io::LinearisationStates visited;
+    scene::LinearisationStates visited;
     for (const auto& s : exact.samples) visited.add(s.x);
-    const std::string w = io::linearisation_warning(
-        io::check_linearisation(*loaded.scene, visited.states()), io::kLinearisationThreshold);
+    const std::string w =
+        scene::linearisation_warning(scene::check_linearisation(*loaded.scene, visited.states()),
+                                     scene::kLinearisationThreshold);
     if (!w.empty()) std::cerr << "lcsim: warning: " << w << "\n";
   }
   if (friction) {

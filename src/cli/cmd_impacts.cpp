@@ -7,7 +7,7 @@
 //                                                 approach velocities of a, b)
 //
 // The closed set is the constraints with zero gap at q, with the integrator's
-// tolerance |gap| <= 1e-9 (|E_i||q| + |g_i|) + 1e-13 (src/io/impact_map.hpp). Exit 2 on bad input,
+// tolerance |gap| <= 1e-9 (|E_i||q| + |g_i|) + 1e-13 (src/app/impact_map.hpp). Exit 2 on bad input,
 // 3 if a rule failed (the table is printed first).
 #include <unistd.h>
 
@@ -16,9 +16,10 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <lcsim/app/impact_map.hpp>
 #include <lcsim/impact/impact.hpp>
-#include <lcsim/io/impact_map.hpp>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <memory>
 #include <sstream>
 
@@ -105,7 +106,7 @@ void run_compare(const ImpactsArgs& a, const mech::Model& model) {
   in.model = &m;
   in.q = x0.head(N);
   in.v = x0.tail(N);
-  in.closed = io::closed_constraints(m, in.q, "--x0");
+  in.closed = app::closed_constraints(m, in.q, "--x0");
   in.restitution = restitution(a, m);
   const auto solver = lcp::make_solver("pivot");
   // Rows by the law's own name: an alias ("moreau") gives its law's row
@@ -197,21 +198,21 @@ void run_map(const ImpactsArgs& a, const mech::Model& model) {
   const int N = m.dofs();
   const std::vector<std::string> ranges = io::split(a.map, ',');
   if (ranges.size() != 2) throw io::InputError("--map: expected v1range,v2range (lo:hi[:n] each)");
-  io::ImpactMapSpec spec;
-  spec.axis1 = io::parse_map_range(ranges[0], "--map");
-  spec.axis2 = io::parse_map_range(ranges[1], "--map");
-  if (!a.closed.empty()) spec.closed = io::parse_constraint_list(m, a.closed, "--closed");
+  app::ImpactMapSpec spec;
+  spec.axis1 = app::parse_map_range(ranges[0], "--map");
+  spec.axis2 = app::parse_map_range(ranges[1], "--map");
+  if (!a.closed.empty()) spec.closed = app::parse_constraint_list(m, a.closed, "--closed");
   // Figure 3.5 is drawn at x1 = x2 = 0: q = 0 unless --x0 gives another q.
   // With --closed and no --x0, q is placed on the named contacts.
   const Eigen::VectorXd x0 = a.x0.empty() ? Eigen::VectorXd::Zero(2 * N) : initial_state(a, model);
   spec.q = x0.head(N);
   spec.v0 = x0.tail(N);
   if (a.x0.empty() && spec.closed.size() == 2)
-    spec.q = io::close_contacts(m, spec.q, spec.closed, "--closed");
+    spec.q = app::close_contacts(m, spec.q, spec.closed, "--closed");
   spec.restitution = restitution(a, m);
-  const io::ImpactMap map = io::impact_map(m, spec);
+  const app::ImpactMap map = app::impact_map(m, spec);
   if (!map.failure.empty()) throw NumericalError("--map: " + map.failure);
-  const std::string csv = io::impact_map_csv(m, map);
+  const std::string csv = app::impact_map_csv(m, map);
   std::cout << csv;
   std::cout.flush();
   if (a.plot.empty()) return;
@@ -224,7 +225,7 @@ void run_map(const ImpactsArgs& a, const mech::Model& model) {
 }
 
 void run_impacts(const ImpactsArgs& a) {
-  const mech::Model model = io::load_model(a.model);
+  const mech::Model model = scene::load_model(a.model);
   if (!model.is_mechanical())
     throw io::InputError(a.model + ": impact rules need a mechanical model (M, E), not `lcs:`");
   if (!a.plot.empty() && a.map.empty()) throw io::InputError("--plot: only with --map");

@@ -4,6 +4,8 @@
 #include <iostream>
 #include <lcsim/impact/impact.hpp>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/linearisation.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <memory>
 #include <optional>
@@ -38,7 +40,7 @@ struct SimulateArgs {
   bool project = false;              // move an infeasible q0 onto E q + g >= 0 first
   bool progress = false;     // --progress: progress lines on stderr even when not a terminal
   bool no_progress = false;  // --no-progress
-  double linearisation_threshold = io::kLinearisationThreshold;  // scenes: warn above it
+  double linearisation_threshold = scene::kLinearisationThreshold;  // scenes: warn above it
 };
 
 std::string fmt_vec(const Eigen::VectorXd& v) {
@@ -77,7 +79,7 @@ sim::Options run_options(const SimulateArgs& a, const mech::Model& model) {
 }
 
 void print_summary(const SimulateArgs& a, const mech::Model& model, const sim::Trajectory& tr,
-                   const std::optional<io::LinearisationCheck>& lin, bool written) {
+                   const std::optional<scene::LinearisationCheck>& lin, bool written) {
   std::printf("model %s, method %s, t_end %g\n", model.name.c_str(), tr.method.c_str(), tr.t_end);
   if (!tr.impact_law.empty()) std::printf("impact law %s\n", tr.impact_law.c_str());
   for (const auto& e : tr.events) {
@@ -100,9 +102,9 @@ void print_summary(const SimulateArgs& a, const mech::Model& model, const sim::T
 }
 
 void run_simulate(const SimulateArgs& a) {
-  io::check_linearisation_threshold(a.linearisation_threshold);
-  const io::LoadedModel loaded = io::load_model_and_scene(a.model);
-  const std::optional<io::Scene>& scene = loaded.scene;
+  scene::check_linearisation_threshold(a.linearisation_threshold);
+  const scene::LoadedModel loaded = scene::load_model_and_scene(a.model);
+  const std::optional<scene::Scene>& scene = loaded.scene;
   const mech::Model& model = loaded.model;
   if (scene)  // what loading repaired (balance_inertia)
     for (const auto& n : scene->notes) std::cerr << "lcsim: note: " << n << "\n";
@@ -122,17 +124,17 @@ void run_simulate(const SimulateArgs& a) {
   }
   sim::Options opt = run_options(a, model);
   // Samples feed only the CSV, streamed to disk as the run goes, and a
-  // scene's check of its linear model (io::check_linearisation) at the
+  // scene's check of its linear model (scene::check_linearisation) at the
   // visited states, thinned as they pass: nothing is kept in
   // Trajectory::samples. Without --out a scene's states are taken on a grid
-  // of io::kLinearisationStates points unless an output grid was asked for.
+  // of scene::kLinearisationStates points unless an output grid was asked for.
   opt.record_samples = !a.out.empty() || scene.has_value();
   if (scene && opt.dt_out == 0.0 && a.out.empty())
-    opt.dt_out = *opt.t_end / static_cast<double>(io::kLinearisationStates);
+    opt.dt_out = *opt.t_end / static_cast<double>(scene::kLinearisationStates);
   // An unwritable --out fails now, not after the run.
   std::optional<io::TrajectoryCsvWriter> csv;
   if (!a.out.empty()) csv.emplace(a.out, model);
-  io::LinearisationStates visited;
+  scene::LinearisationStates visited;
   if (opt.record_samples)
     opt.sample_sink = [&csv, &visited, &scene](const sim::Sample& s) {
       if (csv) csv->write(s);
@@ -156,18 +158,18 @@ void run_simulate(const SimulateArgs& a) {
   if (tr.status == sim::RunStatus::kCompleted) progress.done();
   const bool failed = tr.status != sim::RunStatus::kCompleted;
   if (!failed && csv) csv->commit();
-  std::optional<io::LinearisationCheck> lin;
-  if (scene) lin = io::check_linearisation(*scene, visited.states());
+  std::optional<scene::LinearisationCheck> lin;
+  if (scene) lin = scene::check_linearisation(*scene, visited.states());
   if (a.json) {
     nlohmann::json j = io::trajectory_json(model, tr);
     j["linearisation_error"] = lin ? nlohmann::json(lin->error) : nlohmann::json(nullptr);
-    j["linearisation_check"] = lin ? io::to_json(*lin) : nlohmann::json(nullptr);
+    j["linearisation_check"] = lin ? scene::to_json(*lin) : nlohmann::json(nullptr);
     std::cout << j.dump(2) << "\n";
   } else {
     print_summary(a, model, tr, lin, csv && !failed);
   }
   if (lin) {
-    const std::string w = io::linearisation_warning(*lin, a.linearisation_threshold);
+    const std::string w = scene::linearisation_warning(*lin, a.linearisation_threshold);
     if (!w.empty()) std::cerr << "lcsim: warning: " << w << "\n";
   }
   print_warnings(tr);
@@ -207,7 +209,7 @@ void setup(CLI::App& app) {
   cmd->add_option("--linearisation-threshold", a->linearisation_threshold,
                   "Scenes: warn when the linear model is off by more than this (relative; "
                   "default " +
-                      sim::short_number(io::kLinearisationThreshold) + ")");
+                      sim::short_number(scene::kLinearisationThreshold) + ")");
   cmd->add_option("--impact", a->impact,
                   "Impact law (default " + defaults.impact +
                       ", with the model's restitution): " + name_list(impact::impact_law_names()));

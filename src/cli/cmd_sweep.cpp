@@ -1,7 +1,7 @@
 // `lcsim sweep MODEL`: the speed–accuracy trade, measured. Runs each method at
 // each step h and compares it with an exact event-driven run of the same
 // impact law, or of the nearest exact law where the method has none (the
-// computation, the reference laws and the row's fields: src/io/sweep.hpp).
+// computation, the reference laws and the row's fields: src/app/sweep.hpp).
 // Each row names its reference law and carries its run's warnings and the
 // reference's (count and first message).
 #include <unistd.h>
@@ -11,9 +11,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <lcsim/app/sweep.hpp>
 #include <lcsim/io/io.hpp>
-#include <lcsim/io/sweep.hpp>
 #include <lcsim/lcp/lcp.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -56,7 +57,7 @@ std::string warning_text(long count, const std::string& first) {
   return std::to_string(count) + " (" + first + ")";
 }
 
-void print_text(const io::SweepResult& s, const std::string& x0_from) {
+void print_text(const app::SweepResult& s, const std::string& x0_from) {
   std::printf("model %s, t_end %g, --impact %s, x0 from %s\n", s.model.c_str(), s.t_end,
               s.impact.c_str(), x0_from.c_str());
   std::printf("%-12s %-8s %-24s %-11s %-11s %-11s %-11s %-9s %-9s %-10s\n", "method", "h",
@@ -79,7 +80,7 @@ void print_text(const io::SweepResult& s, const std::string& x0_from) {
       std::printf("    reference warnings: %s\n",
                   warning_text(r.reference_warnings, r.reference_first_warning).c_str());
   }
-  std::printf("errors: %s\n", io::kErrorMeasures);
+  std::printf("errors: %s\n", app::kErrorMeasures);
   std::printf("reference laws:\n");
   std::vector<std::string> seen;
   for (const auto& r : s.rows) {
@@ -91,8 +92,8 @@ void print_text(const io::SweepResult& s, const std::string& x0_from) {
 }
 
 void run_sweep(const SweepArgs& a) {
-  const mech::Model model = io::load_model(a.model);
-  io::SweepOptions o;
+  const mech::Model model = scene::load_model(a.model);
+  app::SweepOptions o;
   o.methods = split_list(a.methods);
   for (const auto& tok : split_list(a.hs)) o.hs.push_back(io::parse_vector(tok, "--h")(0));
   o.repeat = a.repeat;
@@ -109,8 +110,8 @@ void run_sweep(const SweepArgs& a) {
     check_writable(a.plot);
     script = find_plot_script("work-precision", "LCSIM_PLOT_WORK_PRECISION");
   }
-  const io::SweepResult s = io::run_sweep(model, x0, o);
-  const nlohmann::json j = io::sweep_json(s);
+  const app::SweepResult s = app::run_sweep(model, x0, o);
+  const nlohmann::json j = app::sweep_json(s);
   if (a.json)
     std::cout << j.dump(2) << "\n";
   else

@@ -3,10 +3,9 @@
 
 #include <cmath>
 #include <lcsim/io/io.hpp>
+#include <lcsim/io/text.hpp>
 #include <sstream>
 #include <stdexcept>
-
-#include "io/detail.hpp"
 
 namespace lcsim::io {
 

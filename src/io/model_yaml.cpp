@@ -13,12 +13,11 @@
 #include <cstdio>
 #include <fstream>
 #include <lcsim/io/io.hpp>
+#include <lcsim/io/text.hpp>
+#include <lcsim/io/yaml.hpp>
 #include <map>
 #include <set>
 #include <sstream>
-
-#include "io/detail.hpp"
-#include "io/yaml_read.hpp"
 
 namespace lcsim::io {
 
@@ -332,19 +331,6 @@ std::string read_file(const std::filesystem::path& path) {
   return ss.str();
 }
 
-mech::Model parse_model(const std::string& yaml_text, const std::string& source) {
-  const YAML::Node root = load_model_root(yaml_text, source);
-  // A top-level `urdf:` key makes the file a scene (scene.cpp).
-  if (is_scene(root)) {
-    try {
-      return parse_scene(yaml_text, source);
-    } catch (const InputError& e) {
-      throw InputError(one_line(e.what()));  // URDF names and values may hold newlines
-    }
-  }
-  return parse_model_root(root, source);
-}
-
 YAML::Node load_model_root(const std::string& yaml_text, const std::string& source) {
   YAML::Node root = load(yaml_text, source);
   if (root.IsNull() || !root.IsDefined())
@@ -356,7 +342,7 @@ YAML::Node load_model_root(const std::string& yaml_text, const std::string& sour
 
 bool is_scene(const YAML::Node& root) { return root.IsMap() && root["urdf"]; }
 
-mech::Model parse_model_root(const YAML::Node& root, const std::string& source) {
+mech::Model parse_matrix_model(const YAML::Node& root, const std::string& source) {
   const Keys keys = mapping(root, source, "", {"name", "mechanical", "lcs", "initial", "t_end"});
   mech::Model model;
   model.source = source;
@@ -393,8 +379,17 @@ mech::Model parse_model_root(const YAML::Node& root, const std::string& source) 
   return model;
 }
 
-mech::Model load_model(const std::filesystem::path& path) {
-  return parse_model(read_file(path), path.string());
+mech::Model parse_matrix_model(const std::string& yaml_text, const std::string& source) {
+  const YAML::Node root = load_model_root(yaml_text, source);
+  if (is_scene(root))
+    throw InputError(source +
+                     ": a scene (a top-level `urdf:` key), not a matrix model: scene::load_model "
+                     "reads both kinds");
+  return parse_matrix_model(root, source);
+}
+
+mech::Model load_matrix_model(const std::filesystem::path& path) {
+  return parse_matrix_model(read_file(path), path.string());
 }
 
 std::vector<std::string> model_notes(const mech::Model& model) {

@@ -11,9 +11,8 @@
 #include <cstdio>
 #include <cstring>
 #include <lcsim/io/io.hpp>
+#include <lcsim/io/text.hpp>
 #include <stdexcept>
-
-#include "io/detail.hpp"
 
 namespace lcsim::io {
 

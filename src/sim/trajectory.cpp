@@ -129,7 +129,7 @@ class EventDrivenIntegrator : public Integrator {
 
 }  // namespace
 
-// Time-stepping schemes (src/sim/time_stepping.cpp): backward Euler
+// Time-stepping schemes (src/sim/stepping/time_stepping.cpp): backward Euler
 // (Algorithm 7.3.1) and the Moreau–Jean theta-method.
 std::unique_ptr<Integrator> make_euler_integrator();
 std::unique_ptr<Integrator> make_moreau_jean_integrator();

@@ -4,10 +4,9 @@
 #include <algorithm>
 #include <cstdio>
 #include <lcsim/io/io.hpp>
+#include <lcsim/io/text.hpp>
 #include <nlohmann/json.hpp>
 #include <thread>
-
-#include "io/detail.hpp"
 
 namespace lcsim::study {
 

@@ -7,10 +7,10 @@
 #include <cerrno>
 #include <cstring>
 #include <lcsim/io/io.hpp>
+#include <lcsim/io/text.hpp>
 #include <nlohmann/json.hpp>
 #include <set>
 
-#include "io/detail.hpp"
 #include "study/detail.hpp"
 
 namespace lcsim::study {

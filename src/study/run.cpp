@@ -2,10 +2,9 @@
 #include <array>
 #include <chrono>
 #include <lcsim/io/io.hpp>
-#include <lcsim/io/sweep.hpp>
+#include <lcsim/io/text.hpp>
+#include <lcsim/sim/reference.hpp>
 #include <lcsim/study/run.hpp>
-
-#include "io/detail.hpp"
 
 namespace lcsim::study {
 
@@ -144,12 +143,12 @@ void reference_cells(std::vector<std::string>& c, const Study& s, const Setup& u
     c.insert(c.end(), {"", "", ""});
     return;
   }
-  const io::ReferenceLaw law = io::reference_law(u.method, u.opt.impact, u.model);
+  const sim::ReferenceLaw law = sim::reference_law(u.method, u.opt.impact, u.model);
   c.push_back(law.label());
   // The exact method of its own law is its own reference.
   const bool itself = u.method == "event" && !law.inelastic;
   const sim::Trajectory ref =
-      itself ? sim::Trajectory{} : io::run_reference(u.model, u.x0, law, u.opt);
+      itself ? sim::Trajectory{} : sim::run_reference(u.model, u.x0, law, u.opt);
   const sim::Trajectory& r = itself ? t : ref;
   c.push_back(status_word(r));
   if (r.status != sim::RunStatus::kCompleted) completed = false;

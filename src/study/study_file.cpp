@@ -5,11 +5,12 @@
 #include <cstdint>
 #include <lcsim/impact/impact.hpp>
 #include <lcsim/io/io.hpp>
+#include <lcsim/io/text.hpp>
+#include <lcsim/io/yaml.hpp>
 #include <lcsim/lcp/lcp.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/study/study.hpp>
 
-#include "io/detail.hpp"
-#include "io/yaml_read.hpp"
 #include "study/detail.hpp"
 
 namespace lcsim::study {
@@ -267,7 +268,7 @@ void parse_models(Study& s, const y::Keys& k, std::string& text) {
     const std::filesystem::path p = dir / entries[i].Scalar();
     try {
       text += io::read_file(p);
-      s.models.push_back(io::load_model(p));
+      s.models.push_back(scene::load_model(p));
     } catch (const io::InputError& e) {
       y::fail(s.source, sub, e.what());
     }

@@ -6,9 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <lcsim/app/sweep.hpp>
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
-#include <lcsim/io/sweep.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <string>
 
@@ -41,7 +42,7 @@ double stated_h(const std::string& w) {
 }
 
 TEST(BulletDivergence, ExplicitDampersAboveTheStatedStepStopTheRun) {
-  const mech::Model m = io::parse_model(kDamped, "damped.yaml");
+  const mech::Model m = scene::parse_model(kDamped, "damped.yaml");
   sim::Options o;
   o.h = 1e-2;  // above 6.28e-3: the damping term multiplies v by up to |1 - 3.19| per step
   const sim::Trajectory tr = simulate_bullet(m, m.initial, o);
@@ -71,16 +72,16 @@ TEST(BulletDivergence, ExplicitDampersAboveTheStatedStepStopTheRun) {
 // method before any run, so the sweep keeps the other rows (it threw at the
 // Bullet row after computing the others, losing the table).
 TEST(BulletDivergence, SweepKeepsTheOtherRowsWhenBulletRefuses) {
-  const mech::Model m = io::parse_model(
+  const mech::Model m = scene::parse_model(
       "name: nondiagonal\nmechanical:\n  M: [[1, 0.1], [0.1, 1]]\n  K: [[1, 0], [0, 1]]\n"
       "  E: [[1, 0]]\n  g: [0.5]\ninitial: [0.2, 0, 0, 0]\nt_end: 1\n",
       "nondiagonal.yaml");
-  io::SweepOptions o;
+  app::SweepOptions o;
   o.methods = {"event", "bullet", "moreau-jean"};
   o.hs = {1e-2};
   o.repeat = 1;
   o.base.t_end = 1.0;
-  const io::SweepResult s = io::run_sweep(m, m.initial, o);
+  const app::SweepResult s = app::run_sweep(m, m.initial, o);
   ASSERT_EQ(s.rows.size(), 3u);
   EXPECT_EQ(s.rows[0].status, "completed");
   EXPECT_EQ(s.rows[1].method, "bullet");
@@ -91,7 +92,7 @@ TEST(BulletDivergence, SweepKeepsTheOtherRowsWhenBulletRefuses) {
   EXPECT_TRUE(std::isfinite(s.rows[2].error_max));
   // Bullet alone: nothing to measure, the refusal is the sweep's input error.
   o.methods = {"bullet"};
-  EXPECT_THROW((void)io::run_sweep(m, m.initial, o), io::InputError);
+  EXPECT_THROW((void)app::run_sweep(m, m.initial, o), io::InputError);
 }
 
 // On a URDF scene Bullet integrates the nonlinear multibody, the exact run
@@ -99,19 +100,19 @@ TEST(BulletDivergence, SweepKeepsTheOtherRowsWhenBulletRefuses) {
 // Moreau-Jean's row (the same linear model) says nothing.
 TEST(BulletDivergence, SweepNamesTheLinearisationGapOfBulletsMultibody) {
   const mech::Model m =
-      io::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/double_pendulum_scene.yaml");
-  io::SweepOptions o;
+      scene::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/double_pendulum_scene.yaml");
+  app::SweepOptions o;
   o.methods = {"bullet", "moreau-jean"};
   o.hs = {1e-2};
   o.repeat = 1;
   o.base.t_end = m.t_end;
-  const io::SweepResult s = io::run_sweep(m, m.initial, o);
+  const app::SweepResult s = app::run_sweep(m, m.initial, o);
   ASSERT_EQ(s.rows.size(), 2u);
   ASSERT_EQ(s.rows[0].status, "completed");
   EXPECT_EQ(s.rows[0].error_floor.rfind("the linearisation gap: ", 0), 0u) << s.rows[0].error_floor;
   EXPECT_TRUE(has(s.rows[0].error_floor, "nonlinear multibody")) << s.rows[0].error_floor;
   EXPECT_EQ(s.rows[1].error_floor, "");
-  const auto j = io::sweep_json(s);
+  const auto j = app::sweep_json(s);
   EXPECT_TRUE(j["rows"][0]["error_floor"].is_string());
   EXPECT_TRUE(j["rows"][1]["error_floor"].is_null());
 }

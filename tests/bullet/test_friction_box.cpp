@@ -7,6 +7,7 @@
 #include <cmath>
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <stdexcept>
 #include <string>
@@ -16,7 +17,7 @@ namespace lcsim::bullet {
 namespace {
 
 mech::Model shipped() {
-  return io::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/block_on_floor_friction.yaml");
+  return scene::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/block_on_floor_friction.yaml");
 }
 
 // robots/block_on_floor_friction.yaml built in code, to be varied.
@@ -390,7 +391,7 @@ TEST(FrictionBox, CompareFrictionBoxBesideTheExactRun) {
 
   // A frictional model of another shape is refused, naming why.
   const mech::Model incline =
-      io::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/incline_friction.yaml");
+      scene::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/incline_friction.yaml");
   const FrictionComparison r = compare_friction_box(incline, incline.initial, exact, s);
   EXPECT_EQ(r.status, Status::kInvalidInput);
   EXPECT_NE(r.message.find("is not a block on a floor: mechanical.f[0]"), std::string::npos)

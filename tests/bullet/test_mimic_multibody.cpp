@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 
 namespace lcsim {
 namespace {
@@ -23,8 +24,8 @@ const std::string kRobots = std::string(LCSIM_SOURCE_DIR) + "/robots/";
 void cross_check_mimic(const urdf::ModelInterface& model, const std::vector<std::string>& joints,
                        std::map<std::string, double> q0, const std::string& mimic, int leader,
                        double a, double b, const std::string& what) {
-  const io::UrdfLinearisation lin =
-      io::linearise_urdf(model, joints, q0, Eigen::Vector3d(0, 0, -9.81), what);
+  const scene::UrdfLinearisation lin =
+      scene::linearise_urdf(model, joints, q0, Eigen::Vector3d(0, 0, -9.81), what);
   std::vector<std::string> moving = joints;
   moving.push_back(mimic);
   q0[mimic] = a * (q0.count(joints[static_cast<std::size_t>(leader)])
@@ -44,7 +45,7 @@ void cross_check_mimic(const urdf::ModelInterface& model, const std::vector<std:
 }
 
 TEST(MultibodyMimic, PandaFingersMatchBullet) {
-  const auto model = io::load_urdf(kRobots + "panda.urdf");
+  const auto model = scene::load_urdf(kRobots + "panda.urdf");
   const std::map<std::string, double> q0 = {{"panda_joint2", -0.785},
                                             {"panda_joint4", -2.356},
                                             {"panda_joint6", 1.571},
@@ -78,7 +79,7 @@ TEST(MultibodyMimic, RevoluteMimicOnAnotherBranchMatchesBullet) {
     <limit lower="-3" upper="3" effort="1" velocity="1"/>
     <mimic joint="tilt" multiplier="-0.7" offset="0.2"/></joint>
 </robot>)";
-  const auto model = io::parse_urdf(urdf, "mimic.urdf");
+  const auto model = scene::parse_urdf(urdf, "mimic.urdf");
   cross_check_mimic(*model, {"yaw", "tilt"}, {{"yaw", 0.4}, {"tilt", -0.6}}, "branch", 1, -0.7, 0.2,
                     "tree, branch mimics tilt");
 }

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 
 namespace lcsim {
 namespace {
@@ -25,8 +26,8 @@ const std::string kRobots = std::string(LCSIM_SOURCE_DIR) + "/robots/";
 
 double cross_check(const urdf::ModelInterface& model, const std::vector<std::string>& joints,
                    const std::map<std::string, double>& q0, const std::string& what) {
-  const io::UrdfLinearisation lin =
-      io::linearise_urdf(model, joints, q0, Eigen::Vector3d(0, 0, -9.81), what);
+  const scene::UrdfLinearisation lin =
+      scene::linearise_urdf(model, joints, q0, Eigen::Vector3d(0, 0, -9.81), what);
   const MatrixXd Mb = bullet::multibody_mass_matrix(model, joints, q0);
   const double rel = (lin.M - Mb).cwiseAbs().maxCoeff() / lin.M.cwiseAbs().maxCoeff();
   std::printf("[ M check  ] %-28s N = %d  max|M| = %.6g  max|M_crba - M_bullet| / max|M| = %.3g\n",
@@ -36,7 +37,7 @@ double cross_check(const urdf::ModelInterface& model, const std::vector<std::str
 }
 
 TEST(Multibody, DoublePendulumMassMatrixMatchesBullet) {
-  const auto model = io::load_urdf(kRobots + "double_pendulum.urdf");
+  const auto model = scene::load_urdf(kRobots + "double_pendulum.urdf");
   cross_check(*model, {"shoulder", "elbow"}, {}, "double pendulum q0 = 0");
   cross_check(*model, {"shoulder", "elbow"}, {{"shoulder", 0.3}, {"elbow", -0.2}},
               "double pendulum q0 = (.3,-.2)");
@@ -44,7 +45,7 @@ TEST(Multibody, DoublePendulumMassMatrixMatchesBullet) {
 }
 
 TEST(Multibody, ArmWithFrozenGripperMatchesBullet) {
-  const auto model = io::load_urdf(kRobots + "arm_gripper.urdf");
+  const auto model = scene::load_urdf(kRobots + "arm_gripper.urdf");
   const std::map<std::string, double> q0 = {{"shoulder", 0.2},
                                             {"elbow", 0.5},
                                             {"wrist", 0.4},
@@ -58,7 +59,7 @@ TEST(Multibody, ArmWithFrozenGripperMatchesBullet) {
 }
 
 TEST(Multibody, TwoCartsMatchBullet) {
-  const auto model = io::load_urdf(kRobots + "two_carts.urdf");
+  const auto model = scene::load_urdf(kRobots + "two_carts.urdf");
   cross_check(*model, {"x1", "x2"}, {{"x1", 0.3}}, "two carts");
 }
 
@@ -99,7 +100,7 @@ const char* kSpatial = R"(<robot name="spatial">
 </robot>)";
 
 TEST(Multibody, SpatialTreeMatchesBullet) {
-  const auto model = io::parse_urdf(kSpatial, "spatial.urdf");
+  const auto model = scene::parse_urdf(kSpatial, "spatial.urdf");
   const std::map<std::string, double> q0 = {
       {"yaw", 0.4}, {"slide", 0.15}, {"tilt", -0.6}, {"frozen", 0.9}, {"branch", 0.3}};
   cross_check(*model, {"yaw", "slide", "tilt", "branch"}, q0, "spatial tree");
@@ -110,8 +111,8 @@ TEST(Multibody, SpatialTreeMatchesBullet) {
   auto q1 = q0;
   q1["frozen"] = -0.5;
   q1["tilt"] = 0.8;
-  const io::UrdfLinearisation lin = io::linearise_urdf(*model, {"yaw", "slide", "tilt", "branch"},
-                                                       q0, Eigen::Vector3d::Zero(), "spatial");
+  const scene::UrdfLinearisation lin = scene::linearise_urdf(
+      *model, {"yaw", "slide", "tilt", "branch"}, q0, Eigen::Vector3d::Zero(), "spatial");
   const MatrixXd other =
       bullet::multibody_mass_matrix(*model, {"yaw", "slide", "tilt", "branch"}, q1);
   EXPECT_GT((lin.M - other).cwiseAbs().maxCoeff(), 1e-3);

@@ -13,6 +13,7 @@
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
 #include <lcsim/lcp/lcp.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <stdexcept>
 #include <string>
@@ -29,7 +30,7 @@ const std::string kRobots = std::string(LCSIM_SOURCE_DIR) + "/robots/";
 mech::Model temp_scene(const std::string& name, const std::string& yaml) {
   const fs::path p = fs::path(::testing::TempDir()) / (name + ".yaml");
   std::ofstream(p) << yaml;
-  return io::load_model(p);
+  return scene::load_model(p);
 }
 
 struct BulletRun {
@@ -78,7 +79,7 @@ BulletRun compare_at(const mech::Model& m, const Eigen::VectorXd& x0, double h, 
 // must fall by at least 5: measured 13.8 from 1e-3 to 1e-4 and 7.8 from 1e-4 to
 // 1e-5; first order gives 10 up to that factor-2 phase effect.
 TEST(MultibodyScene, PrismaticChainAgreesWithExactToFirstOrder) {
-  const mech::Model m = io::load_model(kRobots + "prismatic_chain_scene.yaml");
+  const mech::Model m = scene::load_model(kRobots + "prismatic_chain_scene.yaml");
   EXPECT_EQ(solver_description(m).rfind("btMultiBody from the URDF", 0), 0u);
   // Not diagonal: M(0, 1) = a1.a2 (m2 + m3) = 0.6 * 0.75, exact to rounding.
   EXPECT_NEAR(m.mechanical->M.coeff(0, 1), 0.45, 1e-12);
@@ -110,7 +111,7 @@ TEST(MultibodyScene, PrismaticChainAgreesWithExactToFirstOrder) {
 // of thesis §3.7 (two branches from the rail). Measured 5.52e-4 and 5.52e-5
 // at h = 1e-3 and 1e-4 (C = 0.55; the rb6 scene gives 0.21); bound 2 C h.
 TEST(MultibodyScene, TwoCartsSceneIsFirstOrder) {
-  const mech::Model m = io::load_model(kRobots + "two_carts_scene.yaml");
+  const mech::Model m = scene::load_model(kRobots + "two_carts_scene.yaml");
   EXPECT_EQ(solver_description(m).rfind("btMultiBody from the URDF", 0), 0u);
   for (double h : {1e-3, 1e-4}) {
     const BulletRun r = compare_at(m, m.initial, h, m.t_end);
@@ -134,7 +135,7 @@ TEST(MultibodyScene, TwoCartsSceneIsFirstOrder) {
 // A = 0.05: 1.5 x measured; the ratio must lie in [6, 10] (A^2 would give 4,
 // A^4 16).
 TEST(MultibodyScene, DoublePendulumDeviatesLikeTheCubeOfTheAmplitude) {
-  const mech::Model m = io::load_model(kRobots + "double_pendulum_scene.yaml");
+  const mech::Model m = scene::load_model(kRobots + "double_pendulum_scene.yaml");
   Eigen::VectorXd x0 = Eigen::VectorXd::Zero(4);
   x0(0) = 0.05;
   const BulletRun small = compare_at(m, x0, 1e-3, m.t_end);
@@ -157,7 +158,7 @@ TEST(MultibodyScene, DoublePendulumDeviatesLikeTheCubeOfTheAmplitude) {
 // rad at h = 1e-3, -6.6e-5 at 1e-4: ERP 0 never pushes back, so every
 // re-contact can add up to |v| h).
 TEST(MultibodyScene, ShippedDoublePendulumRunsAndSaysWhatItDrops) {
-  const mech::Model m = io::load_model(kRobots + "double_pendulum_scene.yaml");
+  const mech::Model m = scene::load_model(kRobots + "double_pendulum_scene.yaml");
   for (double h : {1e-3, 1e-4}) {
     const BulletRun r = compare_at(m, m.initial, h, m.t_end);
     EXPECT_GE(r.c.max_violation, -2e-4);
@@ -180,7 +181,7 @@ TEST(MultibodyScene, ShippedDoublePendulumRunsAndSaysWhatItDrops) {
 // excursion from q0 is 0.054 rad (asserted from the exact run). Bounds: 1.5 x
 // measured. No stop is reached.
 TEST(MultibodyScene, ShippedArmAgreesToTheLinearisationError) {
-  const mech::Model m = io::load_model(kRobots + "arm_gripper_scene.yaml");
+  const mech::Model m = scene::load_model(kRobots + "arm_gripper_scene.yaml");
   sim::Options o;
   o.t_end = m.t_end;
   o.dt_out = 1e-3;
@@ -260,7 +261,7 @@ TEST(MultibodyScene, ExplicitSpringsAndDampersAreSaid) {
       Eigen::Vector3d(20, 10, 8).asDiagonal().toDenseMatrix(), M);
   const double omega = std::sqrt(es.eigenvalues().maxCoeff());
   EXPECT_NEAR(omega, 6.7035, 1e-4);
-  const mech::Model m = io::load_model(kRobots + "prismatic_chain_scene.yaml");
+  const mech::Model m = scene::load_model(kRobots + "prismatic_chain_scene.yaml");
   EXPECT_NEAR((MatrixXd(m.mechanical->M) - M).cwiseAbs().maxCoeff(), 0.0, 1e-12);
   sim::Options o;
   o.t_end = 2;
@@ -273,7 +274,7 @@ TEST(MultibodyScene, ExplicitSpringsAndDampersAreSaid) {
   EXPECT_TRUE(said(simulate_bullet(m, m.initial, o), "omega h > 2"));
   o.h = 0.29;
   EXPECT_FALSE(said(simulate_bullet(m, m.initial, o), "omega h > 2"));
-  const mech::Model arm = io::load_model(kRobots + "arm_gripper_scene.yaml");
+  const mech::Model arm = scene::load_model(kRobots + "arm_gripper_scene.yaml");
   o.h = 1e-3;
   EXPECT_TRUE(said(simulate_bullet(arm, arm.initial, o), "dampers are explicit joint torques"));
 }
@@ -281,7 +282,7 @@ TEST(MultibodyScene, ExplicitSpringsAndDampersAreSaid) {
 // What Bullet cannot express is refused, 0-based, before anything runs.
 TEST(MultibodyScene, InexpressibleModelsThrowWithZeroBasedMessages) {
   // A matrix model with a non-diagonal M (no URDF to build a multibody from).
-  mech::Model nd = io::load_model(kRobots + "two_carts.yaml");
+  mech::Model nd = scene::load_model(kRobots + "two_carts.yaml");
   nd.mechanical->M.coeffRef(0, 1) = nd.mechanical->M.coeffRef(1, 0) = 0.1;
   sim::Options o;
   o.t_end = 1;
@@ -308,7 +309,7 @@ TEST(MultibodyScene, InexpressibleModelsThrowWithZeroBasedMessages) {
   }
   // The hook scene: the hook is not a joint limit, but the scene's matrices
   // are rb6's (diagonal M, a stop and a hook): run there, with a warning.
-  const mech::Model hook = io::load_model(kRobots + "two_carts_hook_scene.yaml");
+  const mech::Model hook = scene::load_model(kRobots + "two_carts_hook_scene.yaml");
   EXPECT_EQ(solver_description(hook).rfind("btSequentialImpulseConstraintSolver", 0), 0u);
   const sim::Trajectory tr = simulate_bullet(hook, hook.initial, o);
   ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
@@ -316,7 +317,7 @@ TEST(MultibodyScene, InexpressibleModelsThrowWithZeroBasedMessages) {
   EXPECT_NE(tr.first_warning().find("constraint 'hook' (row 1 of E)"), std::string::npos)
       << tr.first_warning();
   // A scene changed after loading is no longer the URDF's: rb6 (or refused).
-  mech::Model changed = io::load_model(kRobots + "two_carts_scene.yaml");
+  mech::Model changed = scene::load_model(kRobots + "two_carts_scene.yaml");
   changed.mechanical->K *= 2.0;
   EXPECT_EQ(solver_description(changed).rfind("btSequentialImpulseConstraintSolver", 0), 0u);
 }
@@ -332,9 +333,9 @@ TEST(MultibodyScene, InexpressibleModelsThrowWithZeroBasedMessages) {
 // 0.098 h; bound 0.2 h, and a fall of at least 5 per decade (measured 9.1).
 TEST(MultibodyScene, MasslessBodyGetsASpeckAndIsFirstOrder) {
   const std::string data = std::string(LCSIM_SOURCE_DIR) + "/tests/bullet/data/";
-  const auto urdf = io::load_urdf(data + "massless_yoke.urdf");
-  const io::UrdfLinearisation lin =
-      io::linearise_urdf(*urdf, {"z", "x"}, {}, Eigen::Vector3d(0, 0, -9.81), "massless_yoke");
+  const auto urdf = scene::load_urdf(data + "massless_yoke.urdf");
+  const scene::UrdfLinearisation lin =
+      scene::linearise_urdf(*urdf, {"z", "x"}, {}, Eigen::Vector3d(0, 0, -9.81), "massless_yoke");
   const MatrixXd Mb = multibody_mass_matrix(*urdf, {"z", "x"}, {});
   ASSERT_TRUE(Mb.allFinite()) << Mb;
   EXPECT_LE((Mb - lin.M).cwiseAbs().maxCoeff() / lin.M.cwiseAbs().maxCoeff(), 1e-8)
@@ -342,7 +343,7 @@ TEST(MultibodyScene, MasslessBodyGetsASpeckAndIsFirstOrder) {
       << Mb << "\nCRBA:\n"
       << lin.M;
 
-  const mech::Model m = io::load_model(data + "massless_yoke_scene.yaml");
+  const mech::Model m = scene::load_model(data + "massless_yoke_scene.yaml");
   const BulletRun coarse = compare_at(m, m.initial, 1e-3, 1.0);
   const BulletRun fine = compare_at(m, m.initial, 1e-4, 1.0);
   EXPECT_LE(coarse.c.error_final, 0.2 * 1e-3);
@@ -398,7 +399,7 @@ TEST(MultibodyScene, MimicFingerMovesWithItsLeader) {
 // fall of at least 5 per decade (measured 8.6).
 TEST(MultibodyScene, MimicWithNegativeMultiplierAndOffsetIsFirstOrder) {
   const mech::Model m =
-      io::load_model(std::string(LCSIM_SOURCE_DIR) + "/tests/bullet/data/mimic_pair_scene.yaml");
+      scene::load_model(std::string(LCSIM_SOURCE_DIR) + "/tests/bullet/data/mimic_pair_scene.yaml");
   const BulletRun coarse = compare_at(m, m.initial, 1e-3, 1.0);
   const BulletRun fine = compare_at(m, m.initial, 1e-4, 1.0);
   EXPECT_LE(coarse.c.error_final, 0.4 * 1e-3);

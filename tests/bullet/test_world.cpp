@@ -5,6 +5,7 @@
 #include <cmath>
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <stdexcept>
 #include <string>
@@ -14,7 +15,7 @@ namespace lcsim::bullet {
 namespace {
 
 mech::Model load(const std::string& name) {
-  return io::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/" + name);
+  return scene::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/" + name);
 }
 
 sim::Trajectory exact_run(const mech::Model& m, const Eigen::VectorXd& x0, double dt_out) {

@@ -4,6 +4,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <lcsim/scene/linearisation.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -118,7 +120,7 @@ TEST(BulletCli, CompareSaysWhenAnExactSwitchHasNoBulletMatch) {
 }
 
 // compare checks a scene's linear model at the exact run's states, as
-// simulate does (io::check_linearisation): the shipped double pendulum's
+// simulate does (scene::check_linearisation): the shipped double pendulum's
 // exact run (inelastic reference law) swings to q = (-0.151, -0.368), where
 // the linear model is off by 2.5 % (simulate's run, with restitution: 4.8 %),
 // above the default 1 %; the prismatic chain's model is exact (constant M,

@@ -5,8 +5,9 @@
 
 #include <filesystem>
 #include <fstream>
-#include <lcsim/io/impact_map.hpp>
+#include <lcsim/app/impact_map.hpp>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -31,7 +32,7 @@ fs::path write_model(const std::string& text) {
   return p;
 }
 
-// The coupled stops of tests/io/test_sweep.cpp (e = 0.9 and 0.1, both closing at t = 0).
+// The coupled stops of tests/app/test_sweep.cpp (e = 0.9 and 0.1, both closing at t = 0).
 const char* const kCoupled =
     "name: coupled_stops\nmechanical:\n  M: [[2, 1], [1, 2]]\n  K: [[0, 0], [0, 4]]\n"
     "  E: [[1, 0], [0, 1]]\n  g: [0, 0.5]\n  f: [-1, 0]\n  restitution: [0.9, 0.1]\n"
@@ -177,7 +178,7 @@ TEST(AnalyzeCommand, RepeatedStopStaysDependent) {
 
 // --closed on the arm scene: q placed on shoulder_upper and elbow_lower
 // (without --x0), the map over their approach velocities. Each cell is
-// checked against io::impact_map called directly with the same spec (the
+// checked against app::impact_map called directly with the same spec (the
 // library the command prints), and the corner cell by hand: both contacts
 // separating (rates +1, +1) is unconstrained with unchanged rates.
 TEST(ImpactsCommand, ClosedMapMatchesTheLibraryAndTheFreeCorner) {
@@ -192,15 +193,15 @@ TEST(ImpactsCommand, ClosedMapMatchesTheLibraryAndTheFreeCorner) {
   while (std::getline(in, line)) lines.push_back(line);
   ASSERT_EQ(lines.size(), 9u);
   EXPECT_EQ(lines[8], "1,1,unconstrained,1,1");
-  const lcsim::mech::Model model = lcsim::io::load_model(kRobots + "arm_gripper_scene.yaml");
+  const lcsim::mech::Model model = lcsim::scene::load_model(kRobots + "arm_gripper_scene.yaml");
   const auto& m = *model.mechanical;
-  lcsim::io::ImpactMapSpec spec;
+  lcsim::app::ImpactMapSpec spec;
   spec.closed = {1, 2};
-  spec.q = lcsim::io::close_contacts(m, Eigen::VectorXd::Zero(2), spec.closed, "--closed");
+  spec.q = lcsim::app::close_contacts(m, Eigen::VectorXd::Zero(2), spec.closed, "--closed");
   spec.v0 = Eigen::VectorXd::Zero(2);
-  spec.axis1 = spec.axis2 = lcsim::io::parse_map_range("-1:1:3", "--map");
-  const lcsim::io::ImpactMap map = lcsim::io::impact_map(m, spec);
-  EXPECT_EQ(lcsim::io::impact_map_csv(m, map), r.out);
+  spec.axis1 = spec.axis2 = lcsim::app::parse_map_range("-1:1:3", "--map");
+  const lcsim::app::ImpactMap map = lcsim::app::impact_map(m, spec);
+  EXPECT_EQ(lcsim::app::impact_map_csv(m, map), r.out);
   // Both approaching (-1, -1) at e = 0 (this scene): the rates after are
   // non-negative, and zero where an impulse acts (complementarity).
   ASSERT_EQ(map.cells.size(), 9u);

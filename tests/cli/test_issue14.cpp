@@ -14,6 +14,7 @@
 #include <fstream>
 #include <lcsim/io/io.hpp>
 #include <lcsim/lcp/lcp.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <string>
 #include <thread>
@@ -51,7 +52,7 @@ void expect_streamed_equals_in_memory(const std::string& model_file, const std::
                                       double dt_out) {
   SCOPED_TRACE(model_file + " " + method);
   const fs::path d = fresh_dir("stream");
-  const lcsim::mech::Model model = lcsim::io::load_model(kRobots + model_file);
+  const lcsim::mech::Model model = lcsim::scene::load_model(kRobots + model_file);
   lcsim::sim::Options opt;
   opt.dt_out = dt_out;
   opt.t_end = model.t_end;  // the model's horizon, as the command takes it

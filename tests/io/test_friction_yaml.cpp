@@ -4,12 +4,17 @@
 #include <gtest/gtest.h>
 
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <string>
 
 #include "support/model_error.hpp"
 
 namespace lcsim::io {
 namespace {
+
+// Any model file, as every command reads it (matrix models and scenes).
+using scene::load_model;
+using scene::parse_model;
 
 std::string error_of(const std::string& yaml) { return test_support::model_error(yaml); }
 

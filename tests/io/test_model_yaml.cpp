@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <string>
 #include <unsupported/Eigen/MatrixFunctions>
 
@@ -14,6 +15,10 @@
 
 namespace lcsim::io {
 namespace {
+
+// Any model file, as every command reads it (matrix models and scenes).
+using scene::load_model;
+using scene::parse_model;
 
 using Eigen::MatrixXd;
 using Eigen::VectorXd;

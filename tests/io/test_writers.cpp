@@ -5,11 +5,16 @@
 #include <filesystem>
 #include <fstream>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <sstream>
 #include <string>
 
 namespace lcsim::io {
 namespace {
+
+// Any model file, as every command reads it (matrix models and scenes).
+using scene::load_model;
+using scene::parse_model;
 
 namespace fs = std::filesystem;
 using Eigen::VectorXd;

@@ -70,7 +70,7 @@ def test_cli_and_python_agree(name, how, robots, lcsim_binary, tmp_path):
 
 def test_long_scene_run_reports_the_same_linearisation_check(robots, lcsim_binary, tmp_path):
     """Past 2 x 200 samples both thin the visited states the same way
-    (io::LinearisationStates) before the scene's linearisation check: 1001 samples."""
+    (scene::LinearisationStates) before the scene's linearisation check: 1001 samples."""
     path = robots / "two_carts_scene.yaml"
     cli = subprocess.run([str(lcsim_binary), "simulate", str(path), "--t-end", "1",
                           "--dt-out", "0.001", "--out", str(tmp_path / "cli.csv"), "--json",

@@ -37,7 +37,7 @@ def test_impact_map_python_and_cli(robots, lcsim_binary, tmp_path):
                           "--map", "-1:1:5,-1:1:5", "--plot", str(tmp_path / "cli.png")],
                          capture_output=True, text=True)
     assert cli.returncode == 0, cli.stderr
-    assert grid == cli.stdout  # the same io::impact_map_csv text
+    assert grid == cli.stdout  # the same app::impact_map_csv text
     assert_png(tmp_path / "cli.png")
     lcsim.plot.impact_map(grid, tmp_path / "py.png")
     assert_png(tmp_path / "py.png")

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <limits>
 #include <string>
@@ -18,7 +19,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 mech::Model carts() {
-  return io::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/two_carts.yaml");
+  return scene::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/two_carts.yaml");
 }
 
 // Options a method accepts: the horizon, and the defaults of the rest.

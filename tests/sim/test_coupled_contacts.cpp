@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <numbers>
 
@@ -354,7 +355,7 @@ TEST(CoupledContacts, DefaultLawKeepsARestingContactAtRest) {
 // across an event (the scene has no damping, so phases conserve it).
 TEST(CoupledContacts, NaoLegsRunWithoutChatter) {
   const std::string path = std::string(LCSIM_SOURCE_DIR) + "/robots/nao_legs_scene.yaml";
-  const mech::Model model = io::load_model(path);
+  const mech::Model model = scene::load_model(path);
   sim::Options opt;
   opt.t_end = 2.0;
   opt.dt_out = 0.01;
@@ -386,7 +387,7 @@ namespace {
 // before the 1e6-event guard, and never report "completed".
 TEST(CoupledContacts, LivelockFailsNamingTheContacts) {
   const std::string path = std::string(LCSIM_SOURCE_DIR) + "/robots/nao_legs_scene.yaml";
-  const mech::Model model = io::load_model(path);
+  const mech::Model model = scene::load_model(path);
   sim::Options opt;
   opt.t_end = 2.0;
   opt.accumulation_dt = 0.0;

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <limits>
 #include <string>
@@ -19,9 +20,9 @@ bool has(const std::string& text, const std::string& part) {
 
 // An undamped oscillator, omega = 10 rad/s, from q = 1 at rest: energy 50 J.
 mech::Model oscillator(double k) {
-  return io::parse_model("name: osc\nmechanical:\n  M: [[1]]\n  K: [[" + std::to_string(k) +
-                             "]]\n  coordinates: [a]\ninitial: [1, 0]\nt_end: 100\n",
-                         "osc.yaml");
+  return scene::parse_model("name: osc\nmechanical:\n  M: [[1]]\n  K: [[" + std::to_string(k) +
+                                "]]\n  coordinates: [a]\ninitial: [1, 0]\nt_end: 100\n",
+                            "osc.yaml");
 }
 
 // Moreau-Jean with theta < 1/2 gains energy every step: E+ - E =
@@ -75,7 +76,7 @@ TEST(Divergence, ExactMethodWithANonFiniteFinalStateIsAFailure) {
 // t_end 2 s (no spring, so a far position costs no energy and the gap test
 // is seen alone).
 mech::Model carts() {
-  return io::parse_model(
+  return scene::parse_model(
       "name: carts\nmechanical:\n  M: [[1, 0], [0, 2]]\n"
       "  E: [[1, 0]]\n  g: [0.5]\n  f: [0, -1]\n  coordinates: [a, b]\n  constraints: [stop]\n"
       "initial: [0, 0, 1, 0]\nt_end: 2\n",
@@ -120,7 +121,7 @@ TEST(Divergence, GuardNamesWhatDiverged) {
 TEST(Divergence, ShippedModelsStillComplete) {
   for (const char* name : {"two_carts.yaml", "two_carts_hook.yaml", "ball.yaml",
                            "belt_friction.yaml", "mass_spring_friction.yaml"}) {
-    const mech::Model m = io::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/" + name);
+    const mech::Model m = scene::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/" + name);
     for (const char* method : {"event", "moreau-jean", "euler"}) {
       auto integ = make_integrator(method);
       if (integ->refuse(m, m.initial, Options{})) continue;  // e.g. euler and friction

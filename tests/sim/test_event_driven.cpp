@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <numbers>
 #include <random>
@@ -85,7 +86,7 @@ TEST(EventDriven, TwoCartsSection37) {
 
 // The shipped model file gives the same run.
 TEST(EventDriven, ShippedTwoCartsModel) {
-  const auto model = io::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/two_carts.yaml");
+  const auto model = scene::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/two_carts.yaml");
   ASSERT_EQ(model.initial.size(), 4);
   const auto tr = run(model, model.initial, model.t_end);
   ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;

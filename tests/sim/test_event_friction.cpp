@@ -22,6 +22,7 @@
 #include <cmath>
 #include <cstdio>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <numbers>
 #include <random>
@@ -40,7 +41,7 @@ constexpr double kTol = 1e-10;  // see the header
 constexpr double kPi = std::numbers::pi;
 
 mech::Model robot(const std::string& file) {
-  return io::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/" + file);
+  return scene::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/" + file);
 }
 
 sim::Trajectory run(const mech::Model& model, double dt_out = 0.0,

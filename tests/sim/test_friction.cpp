@@ -7,6 +7,7 @@
 #include <cmath>
 #include <lcsim/impact/impact.hpp>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <string>
 #include <tuple>
@@ -73,7 +74,7 @@ TEST(FrictionMoreauJean, BlockOnFloorSticksAtVOverMuG) {
     // Resting contact: a step whose normal rate came out +1e-17 leaves the
     // contact out of the next active set (predicted gap > 0), which then falls
     // for one step, by g h^2 / 2 at theta = 1/2 (the penetration bound of
-    // src/sim/moreau_jean.cpp, frictionless alike): at most 2 g h^2 here.
+    // src/sim/stepping/moreau_jean.cpp, frictionless alike): at most 2 g h^2 here.
     EXPECT_LE(std::abs(tr.final_state(1)), 2 * kG * h * h);
   }
 }
@@ -131,7 +132,7 @@ TEST(FrictionMoreauJean, MassSpringOnRoughFloorStopsAfterNHalfCycles) {
 }
 
 mech::Model shipped(const std::string& name) {
-  return io::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/" + name);
+  return scene::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/" + name);
 }
 
 // robots/*friction*.yaml against the closed forms in their headers, at the

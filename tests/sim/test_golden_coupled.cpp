@@ -9,7 +9,7 @@
 #include <cmath>
 #include <lcsim/sim/sim.hpp>
 
-#include "sim/event_driven_detail.hpp"
+#include "sim/exact/event_driven_detail.hpp"
 
 namespace lcsim {
 namespace {

@@ -1,5 +1,5 @@
-// Moreau–Jean with friction on its sparse path (src/sim/mj_friction.cpp,
-// src/sim/friction_gs.cpp): one step against an independent dense
+// Moreau–Jean with friction on its sparse path (src/sim/stepping/mj_friction.cpp,
+// src/sim/stepping/friction_gs.cpp): one step against an independent dense
 // computation of the same friction LCP on random coupled models, and the
 // planar cart chain against closed forms and against the dense path.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Moreau–Jean at scale (src/sim/time_stepping.cpp): the chain of N carts of
+// Moreau–Jean at scale (src/sim/stepping/time_stepping.cpp): the chain of N carts of
 // `lcsim generate chain` (unit masses, unit springs between neighbours and from
 // cart 0 to the wall, a stop q_i + 1 >= 0 per cart, optional hooks
 // q_i - q_{i+1} + 0.5 >= 0), started at x_i = 0.1 (i mod 3), v_i = -1, so every

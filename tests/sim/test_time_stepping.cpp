@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <numbers>
 #include <random>
@@ -24,7 +25,7 @@ using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
 mech::Model load(const std::string& name) {
-  return io::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/" + name);
+  return scene::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/" + name);
 }
 
 VectorXd exact_two_carts_final() {

@@ -9,12 +9,12 @@
 #include <filesystem>
 #include <fstream>
 #include <lcsim/io/io.hpp>
+#include <lcsim/io/text.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <lcsim/study/run.hpp>
 #include <lcsim/study/study.hpp>
 #include <string>
-
-#include "io/detail.hpp"
 
 namespace lcsim::study {
 namespace {
@@ -60,7 +60,7 @@ TEST(StudyScene, RestitutionAxisKeepsTheSceneForBullet) {
   // `simulate --method bullet` of the scene that says restitution 0: the row
   // must be that run, cell for cell (same Bullet world, same steps: equal,
   // not near).
-  const mech::Model m = io::load_model(other);
+  const mech::Model m = scene::load_model(other);
   sim::Options o = s.base;
   o.dt_out = 0.0;
   o.record_samples = false;

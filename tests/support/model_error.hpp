@@ -3,13 +3,14 @@
 #pragma once
 
 #include <lcsim/io/io.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <string>
 
 namespace lcsim::test_support {
 
 inline std::string model_error(const std::string& yaml) {
   try {
-    io::parse_model(yaml, "bad.yaml");
+    scene::parse_model(yaml, "bad.yaml");
   } catch (const io::InputError& e) {
     return e.what();
   }

@@ -5,6 +5,7 @@
 // (pkg-config bullet-float64, BT_USE_DOUBLE_PRECISION).
 #pragma once
 
+#include <lcsim/scene/scene.hpp>
 #include <string>
 
 namespace lcsim::bullet {
@@ -167,7 +168,7 @@ namespace lcsim::bullet {
 // diagonalisation). Column j of M^{-1} is the joint acceleration that Bullet's
 // articulated-body algorithm (calcAccelerationDeltasMultiDof) gives for a unit
 // force on joint j at zero velocity without gravity; M is its inverse. The
-// model must be valid (io::load_urdf) with mass on every simulated body.
+// model must be valid (scene::load_urdf) with mass on every simulated body.
 Eigen::MatrixXd multibody_mass_matrix(const urdf::ModelInterface& model,
                                       const std::vector<std::string>& joints,
                                       const std::map<std::string, double>& q0);

@@ -164,7 +164,7 @@ struct Options {
   // Time-stepping: run backward Euler even where the consistency guard
   // refuses it (some leading row index rho_i >= 3, §7.3, Example 7.3.3).
   bool force = false;
-  // Moreau–Jean, how its linear algebra scales (src/sim/time_stepping.cpp):
+  // Moreau–Jean, how its linear algebra scales (src/sim/stepping/time_stepping.cpp):
   // models with more than `sparse_dofs_threshold` coordinates factor
   // W = M + h theta D + h^2 theta^2 K by sparse LDL'; smaller ones a dense
   // copy by LLT (the model's matrices are sparse either way). 0 forces the sparse path, a huge

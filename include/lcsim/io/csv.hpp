@@ -1,0 +1,43 @@
+// Trajectories as CSV: whole, or streamed to disk as a run goes.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <lcsim/io/atomic_output.hpp>
+#include <lcsim/mech/mech.hpp>
+#include <lcsim/sim/sim.hpp>
+#include <string>
+
+namespace lcsim::io {
+
+// CSV with header t, state (q names then v names for mechanical models, x1..
+// otherwise), u1.., y1.., mode (active constraints joined by ';').
+std::string trajectory_csv(const mech::Model& model, const sim::Trajectory& traj);
+
+// The same CSV streamed to disk as a run goes (sim::Options::sample_sink), so
+// a long run's output never has to fit in memory: rows go to a temporary
+// file beside `path` (".<name>.tmp-XXXXXX"), which commit() renames into
+// place; a writer destroyed without commit() (a failed or refused run, an
+// exception) removes it. So `path` appears whole or not at all.
+// The constructor throws InputError when no file can be created beside
+// `path`; write() never throws (a sink must not): a write error is kept and
+// thrown by commit() as InputError "<path>: cannot write: <reason>".
+class TrajectoryCsvWriter {
+ public:
+  TrajectoryCsvWriter(const std::filesystem::path& path, const mech::Model& model);
+  ~TrajectoryCsvWriter();
+  TrajectoryCsvWriter(const TrajectoryCsvWriter&) = delete;
+  TrajectoryCsvWriter& operator=(const TrajectoryCsvWriter&) = delete;
+  void write(const sim::Sample& sample) noexcept;
+  void commit();
+  const std::string& temporary_path() const { return temporary_; }
+
+ private:
+  void flush() noexcept;
+  static constexpr std::size_t kBufferBytes = 1 << 20;
+  std::string path_, temporary_, buffer_, logic_error_;
+  int n_ = 0, k_ = 0, nf_ = 0, fd_ = -1, error_ = 0;  // nf_: frictional contacts
+  std::size_t rows_ = 0;
+};
+
+}  // namespace lcsim::io

@@ -1,0 +1,87 @@
+// How far a scene's linear model holds: the error of the linearisation at
+// given states, its check on a run, and the range of each joint where it holds.
+#pragma once
+
+#include <Eigen/Dense>
+#include <cstddef>
+#include <lcsim/scene/scene.hpp>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace lcsim::scene {
+
+using Eigen::VectorXd;
+
+// At coordinates q the exact model has the mass matrix M(q) and the force
+// F(q) = tau_g(q) + springs(q) (springs are linear in q, so exact in the
+// model); the linear model has M0 = M(q0) and L(q) = f - K q. Velocity
+// terms (Coriolis and centrifugal forces, quadratic in v) are not measured.
+//   mass error   e_M(q) = ||M(q) - M0||_F / ||M0||_F
+//   force error  e_F(q) = ||F(q) - L(q)||_2 / max(||F(q)||_2, ||L(q)||_2, ||K (q - q0)||_2)
+//                (0 where all vanish), F(q) - L(q) = tau_g(q) - tau_g(q0) + K_g (q - q0);
+//                the last term of the scale, the linear model's change of force
+//                since q0, keeps rounding noise from counting where both forces
+//                vanish (a spring at its rest length, gravity along no joint)
+//   error        e(q) = max(e_M(q), e_F(q))
+// For a pendulum about its hanging equilibrium, e_F = |theta - sin theta| / |theta| ~ theta^2/6.
+struct LinearisationCheck {
+  double error = 0.0;        // max over the states of e(q)
+  double mass_error = 0.0;   // max of e_M
+  double force_error = 0.0;  // max of e_F
+  VectorXd worst_q;          // the state where e(q) was largest
+  std::size_t states = 0;    // how many states were evaluated
+};
+constexpr std::size_t kLinearisationStates = 200;  // states evaluated at most
+constexpr double kLinearisationThreshold = 0.01;   // default warning threshold (1 %)
+
+// e(q) at the given coordinates (size N each; the first N entries of a full
+// state are used, so trajectory states (q, v) may be passed as they are).
+// More than kLinearisationStates states are subsampled evenly, first and last
+// kept. std::invalid_argument for a wrong size.
+LinearisationCheck check_linearisation(const Scene& scene, const std::vector<VectorXd>& states);
+
+// The states of a run as they stream by (sim::Options::sample_sink), thinned
+// so that at most 2 * kLinearisationStates are kept, evenly spaced, plus the
+// last: what check_linearisation evaluates, in bounded memory however long
+// the run. The command line and the Python module check a scene's run with
+// it, so both report the same check.
+class LinearisationStates {
+ public:
+  void add(const VectorXd& x);
+  std::vector<VectorXd> states() const;
+
+ private:
+  std::vector<VectorXd> kept_;
+  VectorXd last_;
+  long seen_ = 0, stride_ = 1;
+};
+
+// "" when check.error <= threshold, else the warning line. InputError
+// ("--linearisation-threshold: ...") unless threshold is finite and > 0.
+std::string linearisation_warning(const LinearisationCheck& check, double threshold);
+void check_linearisation_threshold(double threshold);
+
+// Per simulated joint, the interval of q about q0 (other joints at q0) in
+// which e(q) <= threshold: from q0 outwards in 64 steps to the joint's limit
+// (or pi rad / 1 m when it has none), then 50 bisections where e first
+// exceeds the threshold (each coordinate alone; e need not be monotone, the
+// scan stops at the first crossing it sees).
+struct LinearRange {
+  std::string joint;
+  std::string unit;  // "rad" (revolute) or "m" (prismatic)
+  double q0 = 0.0;
+  double lower = 0.0, upper = 0.0;  // rad or m, absolute joint positions
+  // What ends each side: "threshold" (e crosses it there), "limit" (the
+  // joint's limit, no crossing before it) or "search" (no limit on that
+  // side: the scan stopped at pi rad or 1 m without a crossing).
+  std::string lower_end, upper_end;
+};
+std::vector<LinearRange> linear_ranges(const Scene& scene, double threshold);
+
+// JSON of the two: {error, mass_error, force_error, worst_q, states} and
+// [{joint, unit, q0, lower, upper, lower_end, upper_end}, ...].
+nlohmann::json to_json(const LinearisationCheck& check);
+nlohmann::json to_json(const std::vector<LinearRange>& ranges);
+
+}  // namespace lcsim::scene

@@ -1,0 +1,71 @@
+// Scenes: a robot from its URDF with springs, stops and a reference
+// configuration (docs/model-format.md, "Scenes"), linearised into a mechanical
+// model; and the one entry that reads any model file.
+#pragma once
+
+#include <Eigen/Dense>
+#include <filesystem>
+#include <lcsim/io/input_error.hpp>
+#include <lcsim/mech/mech.hpp>
+#include <lcsim/scene/urdf.hpp>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace lcsim::scene {
+
+using io::InputError;
+
+// Any model file: a matrix model (io::parse_matrix_model) or, with a
+// top-level `urdf:` key, a scene (load_scene). Every command reads its model
+// through these. InputError names the file, the key and the value.
+mech::Model load_model(const std::filesystem::path& path);
+// The same from YAML text; `source` names it in messages (and a scene's URDF
+// path is relative to its directory).
+mech::Model parse_model(const std::string& yaml_text, const std::string& source);
+
+// Scenes: a YAML file with a top-level `urdf:` key. `load_model` and
+// `parse_model` dispatch to these, so every command accepts a scene. The URDF
+// path is relative to the directory of `source` (the scene's path). The
+// coordinates are the joint positions (not deviations from q0); format and
+// linearisation in docs/model-format.md, "Scenes".
+mech::Model load_scene(const std::filesystem::path& path);
+mech::Model parse_scene(const std::string& yaml_text, const std::string& source);
+
+// A scene's model with what it was linearised from, so that the exact
+// dynamics can be evaluated away from q0 (check_linearisation).
+struct Scene {
+  mech::Model model;
+  std::shared_ptr<urdf::ModelInterface> urdf;
+  std::string urdf_source;           // the URDF's path, for messages
+  std::map<std::string, double> q0;  // as the scene gives it (joints not named: 0)
+  Eigen::Vector3d gravity;           // m/s^2, URDF root frame
+  UrdfLinearisation lin;             // M, tau_g, K_g, damping at q0 (coordinates: lin.joints)
+  std::vector<std::string> notes;    // what loading repaired (UrdfRepairs::notes)
+};
+Scene read_scene(const std::string& yaml_text, const std::string& source);
+// The scene in `path`, or nullopt when the file is a model, not a scene (no
+// top-level `urdf:` key). Errors as load_model.
+std::optional<Scene> load_scene_details(const std::filesystem::path& path);
+// The model in `path` (as load_model) and, for a scene, the Scene: the file
+// is read and parsed once (a 10000-cart model's YAML tree is 75 MB).
+struct LoadedModel {
+  mech::Model model;
+  std::optional<Scene> scene;
+};
+LoadedModel load_model_and_scene(const std::filesystem::path& path);
+// model_notes of the model, after the scene's notes (what loading repaired):
+// the notes `analyze` prints.
+std::vector<std::string> model_notes(const LoadedModel& loaded);
+
+// The scene `model` was loaded from (model.source, read again), for building
+// it again from its URDF (src/bullet); std::nullopt when model.source is not
+// a readable, valid scene file or when `model` is not what that file gives
+// (changed after loading: M, D, K, E, g, f or the names differ). The
+// restitution may differ: the returned scene's model carries `model`'s (a
+// study's restitution axis changes a parameter, not the kind of model).
+std::optional<Scene> scene_setup(const mech::Model& model);
+
+}  // namespace lcsim::scene

@@ -1,0 +1,149 @@
+// URDF text without the elements lcsim never reads: <visual>, <collision>
+// and <material>. lcsim models no geometry (docs/model-format.md), but
+// urdfdom refuses a whole robot for an error in one of them: Bullet's own
+// geometry types (capsule, plane, cdf), a mesh scale of four numbers, two
+// materials of one name. Public robot files have all of these.
+//
+// A small scanner, not an XML parser: it copies the text, drops every such
+// element (from its start tag to its end tag, or a self-closing tag) and
+// keeps comments, CDATA sections and processing instructions verbatim, so
+// that a tag inside them is not taken for an element. Anything it does not
+// recognise is copied unchanged and left to urdfdom.
+#include <array>
+#include <cstring>
+#include <lcsim/io/text.hpp>
+#include <map>
+#include <regex>
+#include <string>
+
+#include "scene/detail.hpp"
+
+namespace lcsim::scene {
+
+using io::format_number;
+using io::one_line;
+
+namespace {
+
+constexpr std::array<const char*, 3> kIgnored{"visual", "collision", "material"};
+
+// Does `xml` at `pos` start the tag `<name` (followed by a space, '>' or
+// '/', so that <visual_frame> is not <visual>)?
+bool starts_tag(const std::string& xml, std::size_t pos, const std::string& name) {
+  if (xml.compare(pos, name.size() + 1, "<" + name) != 0) return false;
+  const std::size_t after = pos + name.size() + 1;
+  if (after >= xml.size()) return false;
+  const char c = xml[after];
+  return c == '>' || c == '/' || c == ' ' || c == '\t' || c == '\n' || c == '\r';
+}
+
+// End (one past '>') of the tag starting at `pos`, skipping quoted
+// attribute values; npos if it never closes.
+std::size_t tag_end(const std::string& xml, std::size_t pos) {
+  char quote = 0;
+  for (std::size_t i = pos; i < xml.size(); ++i) {
+    const char c = xml[i];
+    if (quote) {
+      if (c == quote) quote = 0;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '>') {
+      return i + 1;
+    }
+  }
+  return std::string::npos;
+}
+
+// End of the element `name` whose start tag begins at `pos` (one past its
+// end tag, or past a self-closing start tag); npos if it never closes.
+// URDF never nests these elements in themselves.
+std::size_t element_end(const std::string& xml, std::size_t pos, const std::string& name) {
+  const std::size_t open = tag_end(xml, pos);
+  if (open == std::string::npos) return open;
+  if (xml[open - 2] == '/') return open;
+  std::size_t close = xml.find("</" + name, open);
+  if (close == std::string::npos) return close;
+  return tag_end(xml, close);
+}
+
+// Text kept verbatim from `pos`: a comment, CDATA or processing instruction
+// ends at its terminator (npos: not one of them).
+std::size_t verbatim_end(const std::string& xml, std::size_t pos) {
+  for (const auto& [open, close] :
+       {std::pair<const char*, const char*>{"<!--", "-->"}, {"<![CDATA[", "]]>"}, {"<?", "?>"}}) {
+    if (xml.compare(pos, std::strlen(open), open) != 0) continue;
+    const std::size_t e = xml.find(close, pos + std::strlen(open));
+    return e == std::string::npos ? xml.size() : e + std::strlen(close);
+  }
+  return std::string::npos;
+}
+
+// The value of attribute `name` in the start tag `tag` ("" if absent), and
+// whether it is there at all.
+bool has_attribute(const std::string& tag, const std::string& name, std::string* value = nullptr) {
+  const std::regex re("[\\s]" + name + "\\s*=\\s*(\"([^\"]*)\"|'([^']*)')");
+  std::smatch m;
+  if (!std::regex_search(tag, m, re)) return false;
+  if (value) *value = m[2].matched ? m[2].str() : m[3].str();
+  return true;
+}
+
+}  // namespace
+
+std::map<std::string, std::string> limits_without_bounds(const std::string& xml) {
+  std::map<std::string, std::string> out;
+  std::string joint;  // the <joint> element the scan is in ("" outside)
+  std::size_t pos = 0;
+  while ((pos = xml.find('<', pos)) != std::string::npos) {
+    if (const std::size_t v = verbatim_end(xml, pos); v != std::string::npos) {
+      pos = v;
+      continue;
+    }
+    const std::size_t e = tag_end(xml, pos);
+    if (e == std::string::npos) break;  // unclosed: urdfdom reports it
+    const std::string tag = xml.substr(pos, e - pos);
+    if (starts_tag(xml, pos, "joint")) {
+      joint.clear();
+      if (tag[tag.size() - 2] != '/') has_attribute(tag, "name", &joint);
+    } else if (tag.compare(0, 7, "</joint") == 0) {
+      joint.clear();
+    } else if (!joint.empty() && starts_tag(xml, pos, "limit")) {
+      const bool lower = has_attribute(tag, "lower"), upper = has_attribute(tag, "upper");
+      if (!lower || !upper)
+        out[joint] = !lower && !upper ? "lower and upper" : !lower ? "lower" : "upper";
+    }
+    pos = e;
+  }
+  return out;
+}
+
+std::string without_geometry(const std::string& xml) {
+  std::string out;
+  out.reserve(xml.size());
+  std::size_t pos = 0;
+  while (pos < xml.size()) {
+    const std::size_t lt = xml.find('<', pos);
+    if (lt == std::string::npos) break;
+    out.append(xml, pos, lt - pos);
+    pos = lt;
+    if (const std::size_t v = verbatim_end(xml, pos); v != std::string::npos) {
+      out.append(xml, pos, v - pos);
+      pos = v;
+      continue;
+    }
+    bool dropped = false;
+    for (const char* name : kIgnored) {
+      if (!starts_tag(xml, pos, name)) continue;
+      const std::size_t e = element_end(xml, pos, name);
+      if (e == std::string::npos) break;  // unclosed: urdfdom reports it
+      pos = e;
+      dropped = true;
+      break;
+    }
+    if (!dropped) out += xml[pos++];
+  }
+  out.append(xml, pos, std::string::npos);
+  return out;
+}
+
+}  // namespace lcsim::scene

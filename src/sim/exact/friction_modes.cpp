@@ -1,0 +1,203 @@
+// Stick / slip selection at an event of the event-driven method (issue 17).
+// After the normal mode I is selected, each frictional contact in I slides
+// (its sliding velocity t'v - velocity is nonzero: slip in that direction,
+// which is also what an impact's outcome slip+/slip- leaves) or not (zero to
+// rounding, or the impact's outcome stick). The contacts that do not slide
+// get their mode from the acceleration-level friction LCP (the relay LCP
+// (4.44) of thesis §4.6.2; the structure of impact::friction_lcp with
+// W = G M^{-1} G' and the free accelerations as rates, the slipping
+// contacts entering with their fixed force columns E_i - sigma mu t_i):
+// stick where the stick force is inside the cone, else slip the way the
+// tangential acceleration drives. The choice is then checked on the phase
+// itself: each of its friction monitors must start positive or leave zero
+// upwards (its first nonzero derivative), which also settles the degenerate
+// points (the stick force exactly on the cone's edge) as the LDCP does for
+// the normals; the other combinations are tried when it fails.
+#include <algorithm>
+#include <cmath>
+#include <lcsim/impact/impact.hpp>
+#include <sstream>
+
+#include "sim/exact/event_driven_detail.hpp"
+
+namespace lcsim::sim::detail {
+
+namespace {
+
+constexpr FrictionMode kCandidates[] = {FrictionMode::kStick, FrictionMode::kSlipPositive,
+                                        FrictionMode::kSlipNegative};
+// Combinations tried when the LCP's choice is not consistent: 3^8 phases.
+constexpr size_t kMaxEnumerated = 8;
+
+}  // namespace
+
+// The frictional contacts of `mode` that do not slide (entries of
+// mechanical.friction); fm gets slip+/slip- for those that do, open for
+// those outside the mode.
+std::vector<int> EventDriven::zero_sliding(const lcs::IndexSet& mode, const VectorXd& xa,
+                                           std::vector<FrictionMode>& fm) const {
+  const mech::MechanicalModel& m = *model_.mechanical;
+  const VectorXd q = xa.head(N_), v = xa.segment(N_, N_);
+  std::vector<int> zero;
+  fm.assign(m.friction.size(), FrictionMode::kOpen);
+  for (size_t f = 0; f < m.friction.size(); ++f) {
+    const mech::FrictionalContact& fc = m.friction[f];
+    if (std::find(mode.begin(), mode.end(), fc.contact) == mode.end()) continue;
+    const double s = fc.sliding(v);
+    // Zero as a normal rate is in process_mechanical: the rounding of its
+    // terms, and of the state through the fastest frequency.
+    const double noise = 64.0 * kEps * fc.tangent.cwiseAbs().sum() *
+                         (v.cwiseAbs().maxCoeff() + rho_A_ * q.cwiseAbs().maxCoeff());
+    const double tol =
+        ldcp_.tol_rel * (fc.tangent.cwiseAbs().dot(v.cwiseAbs()) + std::abs(fc.velocity)) +
+        ldcp_.tol_abs + noise;
+    if (std::abs(s) <= tol ||
+        outcome_[static_cast<size_t>(fc.contact)] == impact::ContactOutcome::kStick) {
+      zero.push_back(static_cast<int>(f));
+      fm[f] = FrictionMode::kStick;
+    } else {
+      fm[f] = s > 0.0 ? FrictionMode::kSlipPositive : FrictionMode::kSlipNegative;
+    }
+  }
+  return zero;
+}
+
+// Sets the sliding velocities of `zero` exactly to zero, keeping E_I v = 0:
+// the M-orthogonal projection onto those rows (they are zero up to the
+// state's rounding, or to the impact law's stick tolerance).
+void EventDriven::project_sliding(const lcs::IndexSet& mode, const std::vector<int>& zero,
+                                  VectorXd& xa) const {
+  const mech::MechanicalModel& m = *model_.mechanical;
+  const Eigen::Index nI = static_cast<Eigen::Index>(mode.size());
+  const Eigen::Index nr = nI + static_cast<Eigen::Index>(zero.size());
+  MatrixXd G(nr, N_);
+  VectorXd r(nr);
+  const VectorXd v = xa.segment(N_, N_);
+  for (Eigen::Index i = 0; i < nI; ++i) {
+    G.row(i) = m.E.row(mode[static_cast<size_t>(i)]);
+    r(i) = G.row(i).dot(v);
+  }
+  for (size_t z = 0; z < zero.size(); ++z) {
+    const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(zero[z])];
+    G.row(nI + static_cast<Eigen::Index>(z)) = fc.tangent.transpose();
+    r(nI + static_cast<Eigen::Index>(z)) = fc.sliding(v);
+  }
+  const MatrixXd MinvGt = Minv_ * G.transpose();
+  const VectorXd lambda = (G * MinvGt).completeOrthogonalDecomposition().solve(r);
+  xa.segment(N_, N_) -= MinvGt * lambda;
+}
+
+// The acceleration-level friction LCP over the normals of `mode` and the
+// contacts `zero`, with `fixed` giving the slipping contacts' directions:
+// the modes it selects for `zero` (others as in `fixed`), or `fixed` with
+// stick for `zero` when it has no solution.
+std::vector<FrictionMode> EventDriven::friction_lcp_modes(const lcs::IndexSet& mode,
+                                                          const std::vector<FrictionMode>& fixed,
+                                                          const std::vector<int>& zero,
+                                                          const VectorXd& xa, long& solves) const {
+  const mech::MechanicalModel& m = *model_.mechanical;
+  const Eigen::Index nn = static_cast<Eigen::Index>(mode.size());
+  const Eigen::Index nz = static_cast<Eigen::Index>(zero.size());
+  MatrixXd H(nn + nz, N_), G(nn + nz, N_);
+  std::vector<int> normal_of(zero.size());
+  VectorXd mu(nz);
+  for (Eigen::Index i = 0; i < nn; ++i) H.row(i) = m.E.row(mode[static_cast<size_t>(i)]);
+  G.topRows(nn) = H.topRows(nn);
+  for (size_t f = 0; f < fixed.size(); ++f) {
+    if (fixed[f] == FrictionMode::kOpen || fixed[f] == FrictionMode::kStick) continue;
+    const auto it = std::find(mode.begin(), mode.end(), m.friction[f].contact);
+    const double sigma = fixed[f] == FrictionMode::kSlipPositive ? 1.0 : -1.0;
+    G.row(it - mode.begin()) -= sigma * m.friction[f].mu * m.friction[f].tangent.transpose();
+  }
+  for (Eigen::Index z = 0; z < nz; ++z) {
+    const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(zero[z])];
+    H.row(nn + z) = G.row(nn + z) = fc.tangent.transpose();
+    normal_of[z] = static_cast<int>(std::find(mode.begin(), mode.end(), fc.contact) - mode.begin());
+    mu(z) = fc.mu;
+  }
+  const VectorXd rates = H * (sys_.A.middleRows(N_, N_) * xa);  // free accelerations
+  const impact::FrictionLcp p = impact::friction_lcp(H * Minv_ * G.transpose(), rates.head(nn),
+                                                     rates.tail(nz), normal_of, mu);
+  int lcp_solves = 0;
+  const lcp::Result res = impact::solve_friction_lcp(p, *solver_, &lcp_solves, nullptr);
+  solves += lcp_solves;
+  std::vector<FrictionMode> fm = fixed;
+  if (!res.ok()) return fm;
+  const VectorXd w = p.M * res.z + p.q;
+  const VectorXd w_scale = p.M.cwiseAbs() * res.z.cwiseAbs() + p.q.cwiseAbs();
+  for (Eigen::Index z = 0; z < nz; ++z) {
+    // Sliding acceleration t'v' = w_T - xi; zero to the rounding of its terms.
+    const double a = w(nn + z) - res.z(nn + nz + z);
+    const double tol =
+        ldcp_.tol_rel * (w_scale(nn + z) + std::abs(res.z(nn + nz + z))) + ldcp_.tol_abs;
+    FrictionMode& mode_z = fm[static_cast<size_t>(zero[z])];
+    mode_z = a > tol ? FrictionMode::kSlipPositive
+                     : (a < -tol ? FrictionMode::kSlipNegative : FrictionMode::kStick);
+  }
+  return fm;
+}
+
+// True if every friction monitor of `ph` starts positive, or at zero and
+// leaves it upwards (or stays at zero identically).
+bool EventDriven::consistent(const Phase& ph, const VectorXd& xa, double t) const {
+  const MonitorStart st = monitor_start(ph, xa.cwiseQuotient(ph.D), t, 1.0);
+  for (size_t j = 0; j < ph.monitors.size(); ++j) {
+    if (ph.monitors[j].friction < 0) continue;
+    if (st.m0[j] >= 0 && !(st.d0[j] > 0.0)) return false;
+  }
+  return true;
+}
+
+// Selects out.friction for out.mode at state xa (sliding velocities that
+// vanish set exactly to zero). "" or the failure message.
+std::string EventDriven::select_friction(double t, const lcs::IndexSet& undetermined, VectorXd& xa,
+                                         EventResult& out) {
+  std::vector<FrictionMode> fixed;
+  const std::vector<int> zero = zero_sliding(out.mode, xa, fixed);
+  out.friction = fixed;
+  if (zero.empty()) return "";
+  project_sliding(out.mode, zero, xa);
+  const std::vector<FrictionMode> first =
+      friction_lcp_modes(out.mode, fixed, zero, xa, out.lcp_solves);
+  std::string err, painleve;
+  auto accept = [&](const std::vector<FrictionMode>& fm) {
+    err.clear();
+    const Phase ph = make_phase(out.mode, fm, undetermined, xa, err);
+    if (!err.empty()) {
+      if (painleve.empty() && err.find("Painlev") != std::string::npos) painleve = err;
+      return false;
+    }
+    return consistent(ph, xa, t);
+  };
+  if (accept(first)) {
+    out.friction = first;
+    return "";
+  }
+  if (zero.size() <= kMaxEnumerated) {
+    std::vector<FrictionMode> fm = fixed;
+    for (long code = 0, n = std::lround(std::pow(3.0, static_cast<double>(zero.size()))); code < n;
+         ++code) {
+      long c = code;
+      for (int f : zero) {
+        fm[static_cast<size_t>(f)] = kCandidates[c % 3];
+        c /= 3;
+      }
+      if (fm != first && accept(fm)) {
+        out.friction = fm;
+        return "";
+      }
+    }
+  }
+  if (!painleve.empty()) return painleve;
+  std::ostringstream msg;
+  msg << "stick / slip selection at t = " << t << ": no mode of the contacts";
+  for (int f : zero)
+    msg << " '"
+        << model_.mechanical
+               ->constraints[static_cast<size_t>(friction_contacts_[static_cast<size_t>(f)])]
+        << "'";
+  msg << " is consistent (each of stick, slip+, slip- leaves a friction monitor negative)";
+  return msg.str();
+}
+
+}  // namespace lcsim::sim::detail

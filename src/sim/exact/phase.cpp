@@ -1,0 +1,175 @@
+// A phase of the event-driven method: the closed loop x' = (A + B_.I F_I) x
+// of a mode I, balanced, with its spectral bound, its exponential (dense, or
+// its action on a vector for large states) and the monitors whose sign
+// changes end it (EventDriven::make_phase).
+#include <algorithm>
+#include <cmath>
+#include <unsupported/Eigen/MatrixFunctions>
+
+#include "sim/exact/event_driven_detail.hpp"
+
+namespace lcsim::sim::detail {
+
+namespace {
+
+// Diagonal balancing by powers of 2 (Parlett–Reinsch): D such that the
+// off-diagonal row and column norms of D^{-1} A D are comparable.
+// An entry below sqrt(eps) of the largest entries of both its row and its
+// column counts as zero: with Rayleigh damping D = alpha M and no spring or
+// force, A's velocity block -M^{-1} D is alpha I up to residues of the
+// solve (eps cond(M) alpha: 1e-17 ... 1e-10 for cond(M) <= 1e6), and
+// balancing those against the identity block scaled the velocities by
+// 1e-18, which made the monitors' noise bands 1e4 wide and hid every
+// contact (tests/sim/test_golden_coupled.cpp). An entry that matters in
+// its row or its column is kept (a stiff spring's 1 against 1e18 in a row).
+VectorXd balancing(const MatrixXd& A) {
+  const int n = static_cast<int>(A.rows());
+  VectorXd d = VectorXd::Ones(n);
+  const Eigen::ArrayXXd abs = A.array().abs();
+  const Eigen::ArrayXd row_max = abs.rowwise().maxCoeff(), col_max = abs.colwise().maxCoeff();
+  MatrixXd B = A;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      if (abs(i, j) <= kSqrtEps * std::min(row_max(i), col_max(j))) B(i, j) = 0.0;
+  for (int sweep = 0; sweep < 50; ++sweep) {
+    bool changed = false;
+    for (int i = 0; i < n; ++i) {
+      double c = 0.0, r = 0.0;
+      for (int j = 0; j < n; ++j) {
+        if (j == i) continue;
+        c += std::abs(B(j, i));
+        r += std::abs(B(i, j));
+      }
+      if (c == 0.0 || r == 0.0) continue;
+      double f = 1.0;
+      const double s = c + r;
+      while (c < r / 2.0) {
+        c *= 2.0;
+        r /= 2.0;
+        f *= 2.0;
+      }
+      while (c >= r * 2.0) {
+        c /= 2.0;
+        r *= 2.0;
+        f /= 2.0;
+      }
+      if (c + r < 0.95 * s) {
+        changed = true;
+        d(i) *= f;
+        B.col(i) *= f;
+        B.row(i) /= f;
+      }
+    }
+    if (!changed) break;
+  }
+  return d;
+}
+
+}  // namespace
+
+double spectral_radius_bound(const MatrixXd& A) {
+  const double a = A.cwiseAbs().rowwise().sum().maxCoeff();
+  if (a == 0.0) return 0.0;
+  MatrixXd B = A / a;
+  for (int i = 0; i < 4; ++i) B = (B * B).eval();
+  return std::pow(B.cwiseAbs().rowwise().sum().maxCoeff(), 1.0 / 16.0) * a;
+}
+
+// e^{Ab tau} z in balanced coordinates. Above kDenseExpMax: the Taylor
+// series of the action in s = ceil(||Ab tau||_1) substeps, so each substep
+// has ||Ab tau/s||_1 <= 1 and its series, truncated once two consecutive
+// terms are below eps/4 of the partial sum, converges like 1/k! (at most
+// ~20 terms); the error is that of the dense exponential's (both are
+// backward stable for ||Ab tau/s|| <= 1; Al-Mohy & Higham 2011 choose s
+// and the degree more finely).
+VectorXd Phase::expv(double tau, const VectorXd& z) const {
+  if (dense_exp()) return (Ab * tau).exp() * z;
+  const double a = Ab_norm1 * std::abs(tau);
+  const long steps = std::max(1L, static_cast<long>(std::ceil(a)));
+  const double dt = tau / static_cast<double>(steps);
+  VectorXd y = z, term(z.size());
+  for (long st = 0; st < steps; ++st) {
+    term = y;
+    VectorXd sum = y;
+    double prev = term.cwiseAbs().maxCoeff();
+    for (int k = 1; k <= 60; ++k) {
+      term = times(term);
+      term *= dt / static_cast<double>(k);
+      sum += term;
+      const double cur = term.cwiseAbs().maxCoeff();
+      const double bound = 0.25 * kEps * sum.cwiseAbs().maxCoeff();
+      if (cur <= bound && prev <= bound) break;
+      prev = cur;
+    }
+    y = sum;
+  }
+  return y;
+}
+
+Phase EventDriven::make_phase(const lcs::IndexSet& mode, const std::vector<FrictionMode>& friction,
+                              const lcs::IndexSet& undetermined, const VectorXd& xa,
+                              std::string& err) const {
+  Phase ph;
+  ph.mode = mode;
+  ph.friction = friction;
+  ph.Acl = sys_.A;
+  ph.F = MatrixXd::Zero(mode.size(), n_);
+  ph.Ft = MatrixXd::Zero(static_cast<Eigen::Index>(friction.size()), n_);
+  const bool frictional = std::any_of(friction.begin(), friction.end(),
+                                      [](FrictionMode f) { return f != FrictionMode::kOpen; });
+  if (frictional) {
+    if (!friction_feedback(ph, xa, err)) return ph;
+  } else if (!mode.empty()) {
+    auto it = feedback_cache_.find(mode);
+    if (it == feedback_cache_.end())
+      it = feedback_cache_.emplace(mode, lcs::mode_feedback(sys_, mode)).first;
+    const lcs::ModeFeedback& fb = it->second;
+    if (!fb.ok()) {
+      err = "mode feedback F_I unavailable: " + fb.message;
+      return ph;
+    }
+    ph.F = fb.F;
+    MatrixXd BI(n_, mode.size());
+    for (size_t i = 0; i < mode.size(); ++i) BI.col(i) = sys_.B.col(mode[i]);
+    ph.Acl += BI * ph.F;
+  }
+  for (int r = 0; r < k_; ++r) {
+    const auto in_mode = std::find(mode.begin(), mode.end(), r);
+    Monitor mon;
+    mon.constraint = r;
+    if (in_mode != mode.end()) {
+      mon.multiplier = true;
+      mon.w = ph.F.row(in_mode - mode.begin());
+    } else {
+      if (std::find(undetermined.begin(), undetermined.end(), r) != undetermined.end())
+        continue;  // y_r and u_r vanish identically in this mode (Remark 3.4.8)
+      mon.multiplier = false;
+      RowVectorXd w = sys_.C.row(r);
+      for (size_t i = 0; i < mode.size(); ++i) w += sys_.D(r, mode[i]) * ph.F.row(i);
+      mon.w = w;
+    }
+    ph.monitors.push_back(std::move(mon));
+  }
+  if (frictional) add_friction_monitors(ph);
+  ph.D = balancing(ph.Acl);
+  ph.Ab = ph.D.cwiseInverse().asDiagonal() * ph.Acl * ph.D.asDiagonal();
+  ph.Ab_norm1 = ph.Ab.cwiseAbs().colwise().sum().maxCoeff();
+  if (!ph.dense_exp()) {
+    ph.Ab_sparse = ph.Ab.sparseView();
+    ph.use_sparse = ph.Ab_sparse.nonZeros() * 10 <= ph.Ab.size();
+  }
+  // Ab depends on the mode only: its bound (four n x n squarings) is kept.
+  const auto key = std::make_pair(mode, friction);
+  auto rit = rho_cache_.find(key);
+  if (rit == rho_cache_.end()) rit = rho_cache_.emplace(key, spectral_radius_bound(ph.Ab)).first;
+  ph.rho = rit->second;
+  const VectorXd z = xa.cwiseQuotient(ph.D);
+  for (Monitor& mon : ph.monitors) {
+    mon.w = mon.w.cwiseProduct(ph.D.transpose());
+    mon.wA = ph.row_times(mon.w);
+    mon.scale = mon.w.cwiseAbs().dot(z.cwiseAbs());
+  }
+  return ph;
+}
+
+}  // namespace lcsim::sim::detail

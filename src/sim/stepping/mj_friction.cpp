@@ -1,0 +1,223 @@
+// Moreau–Jean's step with friction (see mj_friction.hpp).
+#include "sim/stepping/mj_friction.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "sim/stepping/friction_gs.hpp"
+
+namespace lcsim::sim::detail {
+
+MjFriction::MjFriction(const mech::MechanicalModel& m, const MjOperators& ops)
+    : m_(m),
+      Gt_(ops.rows_transposed()),
+      Gc_(ops.rows_transposed().transpose()),
+      of_contact_(static_cast<size_t>(m.num_constraints()), -1),
+      gpos_(static_cast<size_t>(ops.rows_transposed().cols()), -1),
+      lamT_prev_(VectorXd::Zero(m.num_constraints())) {
+  for (size_t f = 0; f < m.friction.size(); ++f)
+    of_contact_[static_cast<size_t>(m.friction[f].contact)] = static_cast<int>(f);
+  Gc_.makeCompressed();
+}
+
+bool MjFriction::any_in(const IndexSet& A) const {
+  if (m_.friction.empty()) return false;
+  for (int i : A)
+    if (of_contact_[static_cast<size_t>(i)] >= 0) return true;
+  return false;
+}
+
+// G = [E_A; T_F] and its Delassus matrix from the cached columns: entry
+// (p, g) sums G_p,r (W^{-1} G_g')_r over the column's rows r, as the
+// frictionless step's for_each_entry.
+bool MjFriction::assemble(MjIteration& f, const IndexSet& A,
+                          const std::vector<const SparseCol*>& cols) {
+  const int k = m_.num_constraints();
+  for (int i : A_) gpos_[static_cast<size_t>(i)] = -1;
+  for (int j : fric_) gpos_[static_cast<size_t>(k + j)] = -1;
+  A_ = A;
+  f_ = &f;
+  ++version_;
+  na_ = static_cast<long>(A.size());
+  fric_.clear();
+  normal_of_.clear();
+  tangent_of_.assign(A.size(), -1);
+  for (long a = 0; a < na_; ++a)
+    if (const int fi = of_contact_[static_cast<size_t>(A[a])]; fi >= 0) {
+      tangent_of_[static_cast<size_t>(a)] = static_cast<int>(na_ + fric_.size());
+      normal_of_.push_back(static_cast<int>(a));
+      fric_.push_back(fi);
+    }
+  nf_ = static_cast<long>(fric_.size());
+  const long ng = na_ + nf_;
+  gcols_.assign(cols.begin(), cols.end());
+  mu_.resize(nf_);
+  belt_.resize(nf_);
+  for (long a = 0; a < na_; ++a) gpos_[static_cast<size_t>(A[a])] = static_cast<int>(a);
+  for (long j = 0; j < nf_; ++j) {
+    const int fi = fric_[static_cast<size_t>(j)];
+    gpos_[static_cast<size_t>(k + fi)] = static_cast<int>(na_ + j);
+    const SparseCol* c = nullptr;
+    if (!f.column(k + fi, c)) return false;
+    gcols_.push_back(c);
+    mu_(j) = m_.friction[static_cast<size_t>(fi)].mu;
+    belt_(j) = m_.friction[static_cast<size_t>(fi)].velocity;
+  }
+  trip_.clear();
+  for (long g = 0; g < ng; ++g)
+    for (SparseCol::InnerIterator it(*gcols_[static_cast<size_t>(g)], 0); it; ++it)
+      for (SparseCol::InnerIterator r(Gc_, static_cast<int>(it.row())); r; ++r)
+        if (const int p = gpos_[static_cast<size_t>(r.row())]; p >= 0)
+          trip_.emplace_back(p, static_cast<int>(g), r.value() * it.value());
+  Wg_.resize(ng, ng);
+  Wg_.setFromTriplets(trip_.begin(), trip_.end());  // sums the entries
+  Wg_.makeCompressed();
+  return true;
+}
+
+// The dense friction LCP (the impact law's): first the previous step's basis
+// when A is unchanged (warm()), else the configured solver and its fallbacks
+// (impact::solve_friction_lcp). lam_ gets (lambda_N, lambda_T), zprev_ z.
+bool MjFriction::solve_dense(const MatrixXd& Wg, const lcp::Solver& solver, long& solves,
+                             lcp::Result& failed) {
+  if (p_version_ != version_) {  // M depends on Wg and mu only: kept while A stays
+    p_ = impact::friction_lcp(Wg, b_.head(na_), b_.tail(nf_), normal_of_, mu_);
+    p_version_ = version_;
+  } else {
+    p_.q.head(na_) = b_.head(na_);
+    p_.q.segment(na_, nf_) = b_.tail(nf_);
+  }
+  if (zprev_version_ == version_ && warm()) {
+    ++solves;
+  } else {
+    int attempts = 0;
+    lcp::Result r = impact::solve_friction_lcp(p_, solver, &attempts, nullptr);
+    solves += attempts;
+    if (!r.ok()) {
+      failed = std::move(r);
+      return false;
+    }
+    zprev_ = r.z;
+  }
+  zprev_version_ = version_;
+  for (long a = 0; a < na_; ++a) lam_(a) = zprev_(a);
+  for (long j = 0; j < nf_; ++j)
+    lam_(na_ + j) = zprev_(na_ + j) - mu_(j) * zprev_(normal_of_[static_cast<size_t>(j)]);
+  return true;
+}
+
+// The LCP's solution on the basis J = {i : z_prev,i > 0} of the previous step
+// (the same M: A unchanged): z_J = -M_JJ^{-1} q_J, zero off J, accepted when
+// it is a solution, z_J > 0 and w = M z + q > 0 off J, with |w_J| within
+// kWarmResidual of the terms forming it (the acceptance of
+// solve_friction_lcp, 1e-12). A sticking or sliding phase keeps its basis, so
+// a step is one solve with the kept LU factor of M_JJ. False: solve cold.
+bool MjFriction::warm() {
+  const Eigen::Index n = p_.q.size();
+  J_.clear();
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (zprev_(i) > 0.0) J_.push_back(static_cast<int>(i));
+  const Eigen::Index nj = static_cast<Eigen::Index>(J_.size());
+  if (J_ != J_factored_ || lu_version_ != version_) {
+    Mjj_.resize(nj, nj);
+    for (Eigen::Index r = 0; r < nj; ++r)
+      for (Eigen::Index c = 0; c < nj; ++c) Mjj_(r, c) = p_.M(J_[r], J_[c]);
+    lu_.compute(Mjj_);
+    J_factored_ = J_;
+    lu_version_ = version_;
+  }
+  qj_.resize(nj);
+  for (Eigen::Index r = 0; r < nj; ++r) qj_(r) = -p_.q(J_[r]);
+  zj_.resize(nj);
+  zj_ = lu_.solve(qj_);
+  zw_.setZero(n);
+  for (Eigen::Index r = 0; r < nj; ++r) {
+    if (!(zj_(r) > 0.0)) return false;
+    zw_(J_[r]) = zj_(r);
+  }
+  ww_.resize(n);
+  ww_.noalias() = p_.M * zw_;
+  double scale = 1.0 + p_.q.cwiseAbs().maxCoeff();
+  for (Eigen::Index i = 0; i < n; ++i) scale = std::max(scale, std::abs(ww_(i)));
+  ww_ += p_.q;
+  size_t r = 0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (r < J_.size() && J_[r] == i) {
+      if (!(std::abs(ww_(i)) <= kWarmResidual * scale)) return false;
+      ++r;
+    } else if (!(ww_(i) > 0.0)) {
+      return false;
+    }
+  }
+  zprev_.swap(zw_);
+  return true;
+}
+
+bool MjFriction::solve_sparse(const lcp::Solver& solver, long& solves, lcp::Result& failed,
+                              std::string& warning) {
+  const FrictionGsProblem p{&Wg_, &b_, &tangent_of_, &mu_, static_cast<int>(na_)};
+  const FrictionGsResult r = solve_friction_gs(p, kGsTolerance, kGsMaxSweeps, lam_, u_);
+  ++solves;
+  if (r.status == lcp::Status::kSolved && all_finite(lam_)) return true;
+  if (na_ + 2 * nf_ <= kDenseFallbackMax) return solve_dense(MatrixXd(Wg_), solver, solves, failed);
+  if (r.status == lcp::Status::kIterationLimit && all_finite(lam_)) {
+    warning = "moreau-jean: friction Gauss-Seidel stopped at residual " + short_number(r.residual) +
+              " after " + std::to_string(r.sweeps) + " sweeps";
+    return true;
+  }
+  failed.status = r.status;
+  failed.message = "friction Gauss-Seidel: " + r.message;
+  return false;
+}
+
+bool MjFriction::step(MjIteration& f, const IndexSet& A, const std::vector<const SparseCol*>& cols,
+                      const VectorXd& Ev, const VectorXd& e, const lcp::Solver& solver,
+                      int pivot_max_active, VectorXd& v_next, VectorXd& lambda_N,
+                      VectorXd& lambda_T, long& solves, lcp::Result& failed, std::string& warning) {
+  const int k = m_.num_constraints();
+  if (&f != f_ || A != A_) {
+    if (!assemble(f, A, cols)) {
+      failed.status = lcp::Status::kNumericalFailure;
+      failed.message = "a column W^{-1} t' is not finite";
+      return false;
+    }
+    if (na_ + nf_ <= pivot_max_active) Wd_ = MatrixXd(Wg_);
+  }
+  const long ng = na_ + nf_;
+  // Rates G v_free, restitution on the normals, minus the surfaces' velocities.
+  b_.resize(ng);
+  auto row_times = [&](int i) {
+    double s = 0.0;
+    for (SparseCol::InnerIterator it(Gt_, i); it; ++it) s += it.value() * v_next(it.row());
+    return s;
+  };
+  for (long a = 0; a < na_; ++a) {
+    const int i = A[static_cast<size_t>(a)];
+    b_(a) = row_times(i) + e(i) * Ev(i);
+  }
+  for (long j = 0; j < nf_; ++j)
+    b_(na_ + j) = row_times(k + fric_[static_cast<size_t>(j)]) - belt_(j);
+  lam_.resize(ng);
+  lam_.head(na_) = lambda_N;
+  for (long j = 0; j < nf_; ++j)
+    lam_(na_ + j) =
+        lamT_prev_(m_.friction[static_cast<size_t>(fric_[static_cast<size_t>(j)])].contact);
+  const bool ok = ng <= pivot_max_active ? solve_dense(Wd_, solver, solves, failed)
+                                         : solve_sparse(solver, solves, failed, warning);
+  if (!ok) return false;
+  for (long g = 0; g < ng; ++g)
+    if (const double x = lam_(g); x != 0.0)
+      for (SparseCol::InnerIterator it(*gcols_[static_cast<size_t>(g)], 0); it; ++it)
+        v_next(it.row()) += it.value() * x;
+  lambda_N = lam_.head(na_);
+  lamT_prev_.setZero();
+  for (long j = 0; j < nf_; ++j) {
+    const int c = m_.friction[static_cast<size_t>(fric_[static_cast<size_t>(j)])].contact;
+    lambda_T(c) = lamT_prev_(c) = lam_(na_ + j);
+  }
+  return true;
+}
+
+}  // namespace lcsim::sim::detail
