@@ -111,13 +111,10 @@ const mech::MechanicalModel& mechanical(const scene::LoadedModel& m) {
   return *m.model.mechanical;
 }
 
-}  // namespace
+using ModelClass = py::class_<scene::LoadedModel, ModelHandle>;
 
-void bind_model(py::module_& m) {
-  py::class_<scene::LoadedModel, ModelHandle> c(m, "Model", R"(A model: a mechanical model
-M q'' + D q' + K q = f + E' u, 0 <= E q + g _|_ u >= 0 (with restitution per contact),
-or a general LCS x' = A x + B u, y = C x + D u, 0 <= y _|_ u >= 0. Built by lcsim.load
-(a YAML model or a URDF scene), Model.mechanical or Model.lcs; checked by the library.)");
+// Model.mechanical and Model.lcs: models from matrices.
+void def_constructors(ModelClass& c) {
   c.def_static("mechanical", &make_mechanical, py::arg("M"), py::arg("K") = py::none(),
                py::arg("E") = py::none(), py::arg("D") = py::none(), py::arg("f") = py::none(),
                py::arg("g") = py::none(), py::arg("restitution") = py::none(),
@@ -138,6 +135,10 @@ positive definite, a restitution lies outside [0, 1], ...)");
                py::arg("t_end") = py::none(),
                "A general LCS x' = A x + B u, y = C x + D u, 0 <= y _|_ u >= 0 (numpy arrays). "
                "Raises InputError when the library refuses it.");
+}
+
+// What every model has: name, source, kind, sizes, defaults.
+void def_properties(ModelClass& c) {
   c.def_property_readonly(
       "name", [](const scene::LoadedModel& l) { return l.model.name; }, "The model's name.");
   c.def_property_readonly(
@@ -172,6 +173,10 @@ positive definite, a restitution lies outside [0, 1], ...)");
         return l.model.t_end;
       },
       "The default horizon (s), or None.");
+}
+
+// The matrices and names of a mechanical model.
+void def_mechanical_fields(ModelClass& c) {
 #define LCSIM_MECH_FIELD(field, doc) \
   c.def_property_readonly(           \
       #field, [](const scene::LoadedModel& l) { return mechanical(l).field; }, doc)
@@ -191,6 +196,18 @@ positive definite, a restitution lies outside [0, 1], ...)");
                                     : std::to_string(l.model.state_size()) + " states (LCS)") +
            ", " + std::to_string(l.model.num_constraints()) + " constraints>";
   });
+}
+
+}  // namespace
+
+void bind_model(py::module_& m) {
+  ModelClass c(m, "Model", R"(A model: a mechanical model
+M q'' + D q' + K q = f + E' u, 0 <= E q + g _|_ u >= 0 (with restitution per contact),
+or a general LCS x' = A x + B u, y = C x + D u, 0 <= y _|_ u >= 0. Built by lcsim.load
+(a YAML model or a URDF scene), Model.mechanical or Model.lcs; checked by the library.)");
+  def_constructors(c);
+  def_properties(c);
+  def_mechanical_fields(c);
   m.def("load", &load, py::arg("path"),
         "Reads a YAML model file or a URDF scene (scene::load_model_and_scene). Raises InputError "
         "naming the file, the key and the value when it is invalid.");
