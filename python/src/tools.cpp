@@ -1,11 +1,12 @@
 // lcsim.impacts, lcsim.impact_map, lcsim.solve_lcp, lcsim.analyze and
 // lcsim.sweep: the library's impact laws, LCP solvers, model analysis and
 // work-precision sweep, called as the CLI calls them.
+#include <lcsim/app/analysis.hpp>
 #include <lcsim/app/impact_map.hpp>
+#include <lcsim/app/impacts.hpp>
 #include <lcsim/app/sweep.hpp>
 #include <lcsim/impact/impact.hpp>
 #include <lcsim/lcp/lcp.hpp>
-#include <lcsim/lcs/lcs.hpp>
 #include <lcsim/mech/mech.hpp>
 #include <lcsim/scene/scene.hpp>
 #include <map>
@@ -27,37 +28,21 @@ const mech::MechanicalModel& mechanical(const ModelHandle& m, const std::string&
   return *m->model.mechanical;
 }
 
-// Each rule applied to the state x0 = (q, v) (default: the model's initial
-// state), the closed set being the constraints with zero gap at q.
+// app::impacts_at_state, keyed by each law's own name (sorted).
 std::map<std::string, impact::ImpactResult> impacts(const ModelHandle& model,
                                                     std::optional<VectorXd> x0,
                                                     std::optional<std::vector<std::string>> rules,
                                                     std::optional<VectorXd> restitution) {
-  const mech::MechanicalModel& m = mechanical(model, "impact rules");
-  const VectorXd x = x0.value_or(model->model.initial);
-  if (x.size() != model->model.state_size())
-    throw io::InputError("x0: expected " + std::to_string(model->model.state_size()) +
-                         " entries (q then v) (got " + std::to_string(x.size()) + ")");
-  impact::ImpactInput in;
-  in.model = &m;
-  in.q = x.head(m.dofs());
-  in.v = x.tail(m.dofs());
-  in.closed = app::closed_constraints(m, in.q, "x0");
-  if (restitution) {  // checked as the model's own would be (mech::check_mechanical)
-    mech::MechanicalModel with = m;
-    with.restitution = *restitution;
-    if (auto p = mech::check_mechanical(with))
-      throw io::InputError("restitution (" + p->field + "): " + p->what);
-    in.restitution = *restitution;
+  app::ImpactsRequest request;
+  if (x0) request.x0 = *x0;
+  if (rules) request.rules = *rules;
+  if (restitution) request.restitution = *restitution;
+  app::ImpactsAtState r;
+  {
+    py::gil_scoped_release release;
+    r = app::impacts_at_state(model->model, request);
   }
-  const auto solver = lcp::make_solver("pivot");
-  std::map<std::string, impact::ImpactResult> out;
-  py::gil_scoped_release release;
-  for (const auto& name : rules.value_or(impact::impact_law_names())) {
-    const auto law = impact::make_impact_law(name);  // an alias: its law, by that law's name
-    out[law->name()] = law->apply(in, *solver);
-  }
-  return out;
+  return {r.results.begin(), r.results.end()};
 }
 
 lcp::Result solve_lcp(const MatrixXd& M, const VectorXd& q, const std::string& solver) {
@@ -71,32 +56,17 @@ lcp::Result solve_lcp(const MatrixXd& M, const VectorXd& q, const std::string& s
   return r;
 }
 
-py::dict analyze(const ModelHandle& model) {
-  const mech::Model& mm = model->model;
-  py::dict d;
-  d["name"] = mm.name;
-  d["state_size"] = mm.state_size();
-  d["constraints"] = mm.num_constraints();
-  d["notes"] = scene::model_notes(*model);
-  if (mm.is_mechanical()) {
-    const mech::MechanicalModel& m = *mm.mechanical;
-    const MatrixXd W = mech::delassus(m);
-    d["dofs"] = m.dofs();
-    d["rank_E"] = mech::constraint_rank(m);
-    d["delassus"] = W;
-    d["delassus_p_matrix"] = W.rows() <= 20 ? py::cast(lcp::is_p_matrix(W)) : py::none();
+// app::analysis_report's JSON, as `lcsim analyze --json` prints it, as a dict.
+py::object analyze(const ModelHandle& model, bool full, double linearisation_threshold) {
+  app::AnalysisOptions o;
+  o.full = full;
+  o.linearisation_threshold = linearisation_threshold;
+  std::string json;
+  {
+    py::gil_scoped_release release;
+    json = app::analysis_report(*model, o).json.dump();
   }
-  if (mm.lcs_state_size() <= mech::kMaxDenseLcsState) {
-    const lcs::WellPosednessReport w = lcs::analyze_well_posedness(mm.as_lcs());
-    d["rho"] = w.rho;
-    d["eta"] = w.eta;
-    d["row_p_matrix"] = w.row_p_matrix;
-    d["column_p_matrix"] = w.column_p_matrix;
-    d["locally_well_posed"] = w.locally_well_posed;
-    d["passive"] = w.passive;
-    d["backward_euler_risky"] = w.backward_euler_risky;
-  }
-  return d;
+  return py::module_::import("json").attr("loads")(json);
 }
 
 std::string sweep(const ModelHandle& model, std::vector<std::string> methods,
@@ -178,17 +148,23 @@ void bind_tools(py::module_& m) {
   bind_results(m);
   m.def("impacts", &impacts, py::arg("model"), py::arg("x0") = py::none(),
         py::arg("rules") = py::none(), py::arg("restitution") = py::none(),
-        "Applies each impact rule (default: all, lcsim.impact_law_names()) at the state x0 = "
-        "(q, v) (default: the model's initial state); the closed contacts are those with zero "
-        "gap at q. Returns {rule: ImpactResult}, keyed by each law's own name (the alias "
+        "Applies each impact rule (default: all, lcsim.impact_law_names(); with friction, those "
+        "that handle it) at the state x0 = (q, v) (default: the model's initial state); the "
+        "closed contacts are those with zero gap at q (app::impacts_at_state, as `lcsim "
+        "impacts`). Returns {rule: ImpactResult}, keyed by each law's own name (the alias "
         "'moreau' gives 'newton'). `restitution`: one coefficient per constraint "
         "(default: the model's).");
   m.def("solve_lcp", &solve_lcp, py::arg("M"), py::arg("q"), py::arg("solver") = "lemke",
         "Solves 0 <= z _|_ w = M z + q >= 0 with a solver of lcsim.solver_names(). Raises "
         "InputError for a malformed problem; a failure is the result's status.");
-  m.def("analyze", &analyze, py::arg("model"),
-        "What the theory says of a model: sizes, rank of E, the Delassus matrix and its "
-        "P-property, the leading indices and Theorem 3.6.3, passivity, notes (a dict).");
+  m.def("analyze", &analyze, py::arg("model"), py::arg("full") = false,
+        py::arg("linearisation_threshold") = scene::kLinearisationThreshold,
+        "What the theory says of a model (app::analysis_report): sizes, M's eigenvalues, "
+        "rank of E, the Delassus matrix and its P-property, the sets of constraints active "
+        "together, the leading indices and Theorem 3.6.3, passivity, notes, a scene's linear "
+        "ranges, what was not judged. The dict `lcsim analyze --json` prints, field for field; "
+        "`full`: every matrix and set (default: a summary, naming what it left out in "
+        "'left_out').");
   m.def("_sweep_json", &sweep, py::arg("model"), py::arg("methods"), py::arg("hs"),
         py::arg("x0") = py::none(), py::arg("t_end") = py::none(), py::arg("impact") = py::none(),
         py::arg("theta") = py::none(), py::arg("repeat") = 3,

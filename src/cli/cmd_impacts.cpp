@@ -17,6 +17,7 @@
 #include <fstream>
 #include <iostream>
 #include <lcsim/app/impact_map.hpp>
+#include <lcsim/app/impacts.hpp>
 #include <lcsim/impact/impact.hpp>
 #include <lcsim/io/io.hpp>
 #include <lcsim/scene/scene.hpp>
@@ -24,6 +25,7 @@
 #include <sstream>
 
 #include "cli/command.hpp"
+#include "cli/flag_names.hpp"
 #include "cli/output.hpp"
 #include "cli/run_inputs.hpp"
 
@@ -64,130 +66,70 @@ Eigen::VectorXd initial_state(const ImpactsArgs& a, const mech::Model& model) {
   return resolve_initial_state(model, a.model, a.x0, "state");
 }
 
+// --restitution: one coefficient for every constraint, or one per constraint
+// (checked by the library, app::resolve_restitution); empty: the model's.
 Eigen::VectorXd restitution(const ImpactsArgs& a, const mech::MechanicalModel& m) {
-  const int k = m.num_constraints();
-  if (a.restitution.empty()) return m.restitution;
+  if (a.restitution.empty()) return Eigen::VectorXd();
   Eigen::VectorXd e = io::parse_vector(a.restitution, "--restitution");
-  if (e.size() == 1) e = Eigen::VectorXd::Constant(k, e(0));
-  if (e.size() != k)
-    throw io::InputError("--restitution: give one coefficient or " + std::to_string(k) +
-                         " (one per constraint), got " + std::to_string(e.size()));
-  for (int i = 0; i < k; ++i)
-    if (!(e(i) >= 0.0 && e(i) <= 1.0))
-      throw io::InputError("--restitution: coefficients must lie in [0, 1] (got " +
-                           std::to_string(e(i)) + ")");
+  if (e.size() == 1) e = Eigen::VectorXd::Constant(m.num_constraints(), e(0));
   return e;
 }
 
-// With friction, "all" is the laws that handle it and naming another is an
-// input error (ImpactLaw::handles_friction).
-std::vector<std::string> rule_list(const std::string& text, bool friction) {
-  std::vector<std::string> out;
-  if (text == "all") {
-    for (const auto& n : impact::impact_law_names())
-      if (!friction || impact::make_impact_law(n)->handles_friction()) out.push_back(n);
-    return out;
-  }
-  out = io::split(text, ',');
+// --rules: "all" (the library's choice: every law, with friction every law
+// that handles it) or a comma list of names.
+std::vector<std::string> rule_list(const std::string& text) {
+  if (text == "all") return {};
+  std::vector<std::string> out = io::split(text, ',');
   if (out.empty()) throw io::InputError("--rules: empty list (give all or a,b,...)");
-  for (const auto& n : out)  // invalid_argument -> exit 2
-    if (friction && !impact::make_impact_law(n)->handles_friction())
-      throw io::InputError("--rules: impact law '" + n +
-                           "' does not handle friction, and the model has friction");
   return out;
 }
 
-void run_compare(const ImpactsArgs& a, const mech::Model& model) {
-  const mech::MechanicalModel& m = *model.mechanical;
-  const int N = m.dofs();
-  const Eigen::VectorXd x0 = initial_state(a, model);
-  const std::vector<std::string> rules = rule_list(a.rules, m.has_friction());
-  impact::ImpactInput in;
-  in.model = &m;
-  in.q = x0.head(N);
-  in.v = x0.tail(N);
-  in.closed = app::closed_constraints(m, in.q, "--x0");
-  in.restitution = restitution(a, m);
-  const auto solver = lcp::make_solver("pivot");
-  // Rows by the law's own name: an alias ("moreau") gives its law's row
-  // ("newton"), once, and a note saying what the alias means.
-  std::vector<std::pair<std::string, impact::ImpactResult>> results;
-  std::vector<std::string> notes;
-  for (const auto& name : rules) {
-    const auto law = impact::make_impact_law(name);
-    if (const std::string note = impact::laws().alias_note(name); !note.empty())
-      notes.push_back(note);
-    bool seen = false;
-    for (const auto& row : results) seen = seen || row.first == law->name();
-    if (!seen) results.emplace_back(law->name(), law->apply(in, *solver));
+// `f()`, its input errors naming the command's flags where the library's
+// name the request's fields.
+template <class F>
+auto with_flags(F f) {
+  try {
+    return f();
+  } catch (const io::InputError& e) {
+    throw io::InputError(with_flag_names(e.what(), impacts_flags()));
   }
+}
 
-  std::string failures;
-  for (const auto& [name, r] : results)
-    if (!r.ok()) failures += (failures.empty() ? "" : "; ") + name + ": " + r.message;
-  if (a.json) {
-    nlohmann::json j;
-    j["model"] = model.name;
-    j["state_before"] = io::to_json(x0);
-    nlohmann::json closed = nlohmann::json::array();
-    for (int i : in.closed) closed.push_back(m.constraints[i]);
-    j["closed"] = closed;
-    j["restitution"] = io::to_json(in.restitution);
-    nlohmann::json js = nlohmann::json::object();
-    for (const auto& [name, r] : results) {
-      Eigen::VectorXd after(2 * N);
-      after << in.q, r.v_after;
-      nlohmann::json mode = nlohmann::json::array();
-      for (int i : r.mode) mode.push_back(m.constraints[i]);
-      js[name] = {{"ok", r.ok()},
-                  {"state_after", io::to_json(after)},
-                  {"impulse", io::to_json(r.impulse)},
-                  {"mode", mode},
-                  {"energy_before", r.energy_before},
-                  {"energy_after", r.energy_after},
-                  {"worst_violation", r.worst_rate},
-                  {"admissible", r.admissible},
-                  {"message", r.message}};
-      if (m.has_friction()) {  // frictionless output unchanged
-        nlohmann::json outcome = nlohmann::json::object();
-        for (const auto& fc : m.friction)
-          outcome[m.constraints[fc.contact]] =
-              r.outcome.empty() ? "none" : impact::to_string(r.outcome[fc.contact]);
-        js[name]["friction_impulse"] =
-            io::to_json(r.friction_impulse.size() ? r.friction_impulse
-                                                  : Eigen::VectorXd::Zero(m.num_constraints()));
-        js[name]["friction_outcome"] = outcome;
-        js[name]["painleve"] = r.painleve;
-        js[name]["energy_gain"] = r.energy_gain;
-      }
-    }
-    j["rules"] = js;
-    if (!notes.empty()) j["notes"] = notes;
-    std::cout << j.dump(2) << "\n";
-  } else {
-    std::printf("model %s at state %s, closed {", model.name.c_str(), fmt_vec(x0).c_str());
-    for (size_t i = 0; i < in.closed.size(); ++i)
-      std::printf("%s%s", i ? ", " : "", m.constraints[in.closed[i]].c_str());
-    std::printf("}, restitution %s\n", fmt_vec(in.restitution).c_str());
-    for (const auto& note : notes) std::printf("note: %s\n", note.c_str());
-    std::printf("%-19s %-28s %-24s %-18s %-12s %-12s %-10s %s\n", "rule", "velocity after",
-                "impulse", "mode", "T before", "T after", "worst Ev+", "note");
-    for (const auto& [name, r] : results) {
-      std::string note = r.ok() ? (r.admissible ? "" : "NOT ADMISSIBLE ") : "FAILED ";
-      note += r.message;
-      std::printf("%-19s %-28s %-24s %-18s %-12.6g %-12.6g %-10.3g %s\n", name.c_str(),
-                  fmt_vec(r.v_after).c_str(), fmt_vec(r.impulse).c_str(),
-                  mode_text(m, r.mode, ",").c_str(), r.energy_before, r.energy_after, r.worst_rate,
-                  note.c_str());
-      if (m.has_friction() && r.friction_impulse.size())  // frictionless output unchanged
-        for (const auto& fc : m.friction)
-          std::printf("%-19s friction at %s: P_T = %.6g, %s\n", "",
-                      m.constraints[fc.contact].c_str(), r.friction_impulse(fc.contact),
-                      impact::to_string(r.outcome[fc.contact]));
-    }
+void print_table(const mech::Model& model, const app::ImpactsAtState& r) {
+  const mech::MechanicalModel& m = *model.mechanical;
+  std::printf("model %s at state %s, closed {", model.name.c_str(), fmt_vec(r.x0).c_str());
+  for (size_t i = 0; i < r.closed.size(); ++i)
+    std::printf("%s%s", i ? ", " : "", m.constraints[r.closed[i]].c_str());
+  std::printf("}, restitution %s\n", fmt_vec(r.restitution).c_str());
+  for (const auto& note : r.notes) std::printf("note: %s\n", note.c_str());
+  std::printf("%-19s %-28s %-24s %-18s %-12s %-12s %-10s %s\n", "rule", "velocity after", "impulse",
+              "mode", "T before", "T after", "worst Ev+", "note");
+  for (const auto& [name, res] : r.results) {
+    std::string note = res.ok() ? (res.admissible ? "" : "NOT ADMISSIBLE ") : "FAILED ";
+    note += res.message;
+    std::printf("%-19s %-28s %-24s %-18s %-12.6g %-12.6g %-10.3g %s\n", name.c_str(),
+                fmt_vec(res.v_after).c_str(), fmt_vec(res.impulse).c_str(),
+                mode_text(m, res.mode, ",").c_str(), res.energy_before, res.energy_after,
+                res.worst_rate, note.c_str());
+    if (m.has_friction() && res.friction_impulse.size())  // frictionless output unchanged
+      for (const auto& fc : m.friction)
+        std::printf("%-19s friction at %s: P_T = %.6g, %s\n", "", m.constraints[fc.contact].c_str(),
+                    res.friction_impulse(fc.contact), impact::to_string(res.outcome[fc.contact]));
   }
+}
+
+void run_compare(const ImpactsArgs& a, const mech::Model& model) {
+  app::ImpactsRequest request;
+  request.x0 = initial_state(a, model);
+  request.rules = rule_list(a.rules);
+  request.restitution = restitution(a, *model.mechanical);
+  const app::ImpactsAtState r = with_flags([&] { return app::impacts_at_state(model, request); });
+  if (a.json)
+    std::cout << app::impacts_json(model, r).dump(2) << "\n";
+  else
+    print_table(model, r);
   std::cout.flush();
-  if (!failures.empty()) throw NumericalError(failures);
+  if (const std::string failures = r.failures(); !failures.empty()) throw NumericalError(failures);
 }
 
 // python/lcsim/plot.py impact-map (or $LCSIM_PLOT_IMPACT_MAP).
@@ -209,7 +151,7 @@ void run_map(const ImpactsArgs& a, const mech::Model& model) {
   spec.v0 = x0.tail(N);
   if (a.x0.empty() && spec.closed.size() == 2)
     spec.q = app::close_contacts(m, spec.q, spec.closed, "--closed");
-  spec.restitution = restitution(a, m);
+  spec.restitution = with_flags([&] { return app::resolve_restitution(m, restitution(a, m)); });
   const app::ImpactMap map = app::impact_map(m, spec);
   if (!map.failure.empty()) throw NumericalError("--map: " + map.failure);
   const std::string csv = app::impact_map_csv(m, map);

@@ -1,20 +1,15 @@
-// Field names of sim::Options to the flags of `lcsim simulate` (flag_names.hpp).
+// Field names of the library to the flags of the commands (flag_names.hpp).
 #include "cli/flag_names.hpp"
 
 #include <cctype>
-#include <string_view>
 
 namespace lcsim::cli {
 namespace {
 
-struct FieldFlag {
-  std::string_view field, flag;
-};
-
 // Longer names first, so "Options::dt_out" is replaced whole, not as
 // "Options::" followed by "dt_out". t_end is absent: a horizon comes from
 // --t-end or from the model file's t_end, and the message cannot tell which.
-constexpr FieldFlag kFieldFlags[] = {
+constexpr FieldFlag kSimulateFlags[] = {
     {"Options::max_output_bytes", "--max-output"},
     {"Options::lcp_solver", "--lcp"},
     {"Options::dt_out", "--dt-out"},
@@ -26,21 +21,41 @@ constexpr FieldFlag kFieldFlags[] = {
     {"dt_out", "--dt-out"},
 };
 
+// The report's text says "full = true prints it" (app/analysis.hpp).
+constexpr FieldFlag kAnalyzeFlags[] = {{"full = true", "--full"}};
+
+// app::ImpactsRequest's fields, as its messages name them.
+constexpr FieldFlag kImpactsFlags[] = {
+    {"restitution", "--restitution"},
+    {"rules", "--rules"},
+    {"x0", "--x0"},
+};
+
 bool word_char(char c) {
   return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == ':';
 }
 
+// A name ending at `end` is whole: what follows is no letter, digit or '_',
+// nor "::" (it would go on as "Options::dt_out" does); one ':' ends it ("x0: ...").
+bool ends_word(const std::string& message, size_t end) {
+  if (end == message.size() || !word_char(message[end])) return true;
+  return message[end] == ':' && (end + 1 == message.size() || message[end + 1] != ':');
+}
+
 }  // namespace
 
-std::string with_flag_names(const std::string& message) {
+FieldFlags simulate_flags() { return kSimulateFlags; }
+FieldFlags analyze_flags() { return kAnalyzeFlags; }
+FieldFlags impacts_flags() { return kImpactsFlags; }
+
+std::string with_flag_names(const std::string& message, FieldFlags flags) {
   std::string out;
   for (size_t i = 0; i < message.size();) {
     bool replaced = false;
-    if (i == 0 || !word_char(message[i - 1]))
-      for (const auto& [field, flag] : kFieldFlags) {
+    if (i == 0 || !(word_char(message[i - 1]) || message[i - 1] == '.'))
+      for (const auto& [field, flag] : flags) {
         const size_t end = i + field.size();
-        if (message.compare(i, field.size(), field) == 0 &&
-            (end == message.size() || !word_char(message[end]))) {
+        if (message.compare(i, field.size(), field) == 0 && ends_word(message, end)) {
           out += flag;
           i = end;
           replaced = true;

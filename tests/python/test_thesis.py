@@ -109,4 +109,4 @@ def test_analyze_two_carts():
     a = lcsim.analyze(two_carts(True))
     np.testing.assert_array_equal(a["delassus"], [[1.0, 1.0], [1.0, 2.0]])
     assert a["delassus_p_matrix"] is True
-    assert a["rank_E"] == 2
+    assert a["E_rank"] == 2
