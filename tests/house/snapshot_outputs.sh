@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Snapshot of every output a refactoring must keep byte for byte (the house
 # issue): for each shipped model and scene in robots/, `simulate --json` (less
-# wall_time_s), the CSV of `simulate --out`, `analyze --json` (less timings),
+# wall_time_s), the CSV of `simulate --out`, `analyze` (text, --json, --json --full; less timings),
 # for each method that accepts the model, and `impacts --json` at the model's
 # initial state where it is mechanical.
 #
@@ -46,6 +46,10 @@ for model in robots/*.yaml; do
   m=$(basename "$model" .yaml)
   [ "$m" = lcp_example ] && { run "$m.lcp.json" "$bin" lcp "$model" --json; continue; }
   run "$m.analyze.json" "$bin" analyze "$model" --json
+  run "$m.analyze.full.json" "$bin" analyze "$model" --json --full
+  run "$m.analyze.txt" "$bin" analyze "$model"
+  run "$m.impacts.json" "$bin" impacts "$model" --json
+  run "$m.impacts.txt" "$bin" impacts "$model"
   for method in event euler moreau-jean bullet; do
     run "$m.$method.json" "$bin" simulate "$model" --method "$method" --json --no-progress
     run "$m.$method.txt" "$bin" simulate "$model" --method "$method" --out "$out/$m.$method.csv" \
