@@ -22,9 +22,9 @@
 // acceleration-level friction LCP (friction_modes.cpp). Events that change
 // only those modes are kStick / kSlip.
 //
-// This file holds the main loop (EventDriven::run: phases, sampling, root
-// finding, events) and the entry point; event_driven_detail.hpp lists the
-// other parts.
+// This file holds the main loop (EventDriven::run and its stages: phases,
+// sampling, events) and the entry point; monitors.cpp the monitors' start
+// and root finding; event_driven_detail.hpp lists the other parts.
 #include <algorithm>
 #include <cmath>
 #include <lcsim/sim/sim.hpp>
@@ -32,7 +32,6 @@
 #include <sstream>
 #include <unsupported/Eigen/MatrixFunctions>
 
-#include "sim/exact/brent.hpp"
 #include "sim/exact/event_driven_detail.hpp"
 
 namespace lcsim::sim {
@@ -63,6 +62,18 @@ std::string friction_note(const std::vector<FrictionMode>& before,
             "': " + std::string(to_string(before[f])) + " -> " + std::string(to_string(after[f]));
   }
   return note;
+}
+
+// Ends the run with a numerical failure.
+void fail(Trajectory& tr, const std::string& msg) {
+  tr.status = RunStatus::kNumericalFailure;
+  tr.message = msg;
+}
+
+// An event's LCP solves and warnings, counted into the run.
+void count_event(Trajectory& tr, const EventResult& ev) {
+  tr.lcp_solves += ev.lcp_solves;
+  for (const auto& w : ev.warnings) tr.warn(w.kind, w.first_t, w.message);
 }
 
 }  // namespace
@@ -102,411 +113,270 @@ void EventDriven::record(Trajectory& tr, double t, const VectorXd& xa, const Pha
   tr.record_sample(std::move(s), opt_);
 }
 
-// How each monitor of `phase` starts at t from xstart (balanced): its noise
-// level, its first nonzero derivative, and the first sampling step (h_max,
-// shorter where a monitor starts at zero).
-EventDriven::MonitorStart EventDriven::monitor_start(const Phase& phase, const VectorXd& xstart,
-                                                     double t, double h_max) const {
-  MonitorStart st;
-  double& h_first = st.h_first;
-  h_first = h_max;
-  // Noise level of each monitor at the phase start: rounding of its terms
-  // |w| |x| plus the time quantisation of the event time (ulp(t) times its
-  // rate). Its own terms, not |w|_1 max|x|: balancing can scale a coordinate
-  // the monitor does not involve far above the others (a clamped joint of
-  // Talos at 2.7e5), and that band (2.5e-9) hid a gap of 1.2e-9 closing,
-  // wider than re-initialisation's zero test (1e-9 of the gap's terms).
-  std::vector<double>& noise = st.noise;
-  noise.resize(phase.monitors.size());
-  for (size_t j = 0; j < phase.monitors.size(); ++j) {
-    const Monitor& mon = phase.monitors[j];
-    noise[j] = 64.0 * kEps * mon.w.cwiseAbs().dot(xstart.cwiseAbs()) +
-               time_resolution(t) * std::abs(mon.wA.dot(xstart));
-  }
-  // Per monitor: the order m0 of its first nonzero derivative at the phase
-  // start (0 = the value itself; -1 = none up to n) and that derivative d0.
-  std::vector<int>& m0 = st.m0;
-  std::vector<double>& d0 = st.d0;
-  {
-    // Derivatives of the monitors at the phase start: d_m = w Acl^m x.
-    // A derivative is rounding noise when below the zero test of mode
-    // selection applied to the magnitudes of its terms |w| |Acl|^m |x|.
-    // Each monitor needs its first two nonzero derivatives only: the loop
-    // stops once every monitor has them (usually m <= 3), instead of
-    // always forming all n + 1 (O(n^3) per phase for large models).
-    const size_t nm = phase.monitors.size();
-    m0.assign(nm, -1);
-    d0.assign(nm, 0.0);
-    std::vector<char> done(nm, 0);
-    size_t remaining = nm;
-    VectorXd Amx = xstart;
-    VectorXd Amx_abs = xstart.cwiseAbs();
-    MatrixXd Acl_abs;
-    for (int m = 0; m <= n_ && remaining > 0; ++m) {
-      if (m > 0) {
-        if (m == 1) Acl_abs = phase.Ab.cwiseAbs();
-        Amx = phase.times(Amx);
-        Amx_abs = Acl_abs * Amx_abs;
-      }
-      for (size_t j = 0; j < nm; ++j) {
-        if (done[j]) continue;
-        const Monitor& mon = phase.monitors[j];
-        const double dm = mon.w * Amx;
-        const double zero =
-            m == 0 ? noise[j] : ldcp_.tol_rel * mon.w.cwiseAbs().dot(Amx_abs) + ldcp_.tol_abs;
-        if (std::abs(dm) <= zero) continue;
-        if (m0[j] < 0) {
-          m0[j] = m;
-          d0[j] = dm;
-          continue;
-        }
-        // Time scale of the first two nonzero Taylor terms:
-        // |d_m0| t^m0/m0! = |d_m| t^m/m!  ->  t = (|d_m0| m!/(m0! |d_m|))^(1/(m-m0))
-        const double ratio = std::abs(d0[j]) / std::abs(dm);
-        double f = 1.0;
-        for (int i = m0[j] + 1; i <= m; ++i) f *= i;
-        const double tau = std::pow(ratio * f, 1.0 / (m - m0[j]));
-        h_first = std::min(h_first, 0.25 * tau);
-        done[j] = 1;
-        --remaining;
-      }
-    }
-  }
-  return st;
-}
-
+// The run: the initial event, then phase by phase (next_phase: the phase's
+// monitors started and armed, march_phase over its sampling intervals with
+// their output samples) to the next event (take_event: zeno_guard,
+// reinitialise, the livelock guard, classify_event), until the horizon
+// (end_run).
 Trajectory EventDriven::run(const VectorXd& x0_user) {
-  Trajectory tr;
-  tr.method = "event";
-  tr.t_end = *opt_.t_end;
-  if (model_.is_mechanical()) tr.impact_law = impact_->name();
-  auto fail = [&](const std::string& msg) {
-    tr.status = RunStatus::kNumericalFailure;
-    tr.message = msg;
-  };
-  VectorXd xa = augment(x0_user);
-  tr.energy_initial = energy(xa);
-  double t = 0.0;
-
-  // Initial mode selection (and jump, if the initial state is not regular).
-  EventResult ev = process_event(t, xa);
-  tr.lcp_solves += ev.lcp_solves;
-  for (const auto& w : ev.warnings) tr.warn(w.kind, w.first_t, w.message);
-  std::string err;
-  Phase phase;
-  if (!ev.ok()) {
-    fail(ev.message);
-  } else {
-    phase = make_phase(ev.mode, ev.friction, ldcp_undetermined_, ev.x_plus, err);
-    if (!err.empty()) fail(err);
-  }
-  if (tr.status != RunStatus::kCompleted) {
-    tr.final_state = x0_user;
-    tr.energy_final = tr.energy_initial;
-    return tr;
-  }
-  if (ev.jumped) {
-    Phase before = phase;
-    before.mode.clear();
-    before.F.resize(0, n_);
-    std::fill(before.friction.begin(), before.friction.end(), FrictionMode::kOpen);
-    before.Ft.setZero();
-    record(tr, t, xa, before);
-    Event e;
-    e.t = t;
-    e.type = EventType::kImpact;
-    e.state_before = user(xa);
-    e.state_after = user(ev.x_plus);
-    e.mode_after = ev.mode;
-    e.impulse = ev.impulse;
-    set_friction(e, ev);
-    tr.events.push_back(std::move(e));
-  }
-  xa = ev.x_plus;
-  record(tr, t, xa, phase);
-
-  const double t_end = *opt_.t_end;
+  RunState r;
+  if (!start_run(r, x0_user)) return std::move(r.tr);
   LivelockGuard livelock(
       opt_.livelock_events, rho_A_,
       model_.is_mechanical() ? model_.mechanical->constraints : std::vector<std::string>{},
       friction_contacts_);
-  long events_in_window = 0;
-  double window_start = 0.0;
-  while (t < t_end) {
-    ++tr.steps;
-    if (opt_.progress) opt_.progress(t);
-    // Sampling step: a quarter of the fastest time scale of the closed loop,
-    // so a Bohl function changes the sign of its derivative at most once
-    // between samples; first steps shorter where a monitor starts at zero.
-    const double rho = phase.rho;
-    double h_max = t_end - t;
-    if (rho > 0.0) h_max = std::min(h_max, 0.5 / rho);
-    h_max = std::min(h_max, (t_end - t) / 4.0 + 1e-300);
-    const VectorXd xstart = xa.cwiseQuotient(phase.D);  // balanced
-    const MonitorStart start = monitor_start(phase, xstart, t, h_max);
-    const std::vector<double>& noise = start.noise;
-    const std::vector<int>& m0 = start.m0;
-    const std::vector<double>& d0 = start.d0;
-    double h_first = start.h_first;
-    h_first = std::max(h_first, 1e-15 * std::max(1.0, std::abs(t)));
-
-    // March over the samples of this phase. A monitor is armed (watched for
-    // a sign change) when it starts positive, or when it starts at zero
-    // (within noise) and its first nonzero derivative is positive: it opens,
-    // however little (a lift-off of 1e-10 m and its landing are both seen).
-    // Such a monitor is followed as phi(t) - phi(t0), the start's rounding
-    // residue removed, so it leaves exactly zero and its return is a root.
-    // A monitor that starts at zero and is identically zero, or whose first
-    // nonzero derivative is negative (mode selection rules that out up to
-    // rounding), only counts once it leaves the noise band.
-    std::vector<char> armed(phase.monitors.size());
-    std::vector<char> opening(phase.monitors.size(), 0);  // armed by a positive derivative
-    std::vector<double> offset(phase.monitors.size(), 0.0);
-    for (size_t j = 0; j < phase.monitors.size(); ++j) {
-      const double value = phase.monitors[j].w.dot(xstart);
-      if (m0[j] == 0) {
-        armed[j] = value > 0.0;
-      } else if (m0[j] > 0 && d0[j] > 0.0) {
-        armed[j] = true;
-        opening[j] = 1;
-        offset[j] = value;
-      }
-    }
-    double ta = t;
-    VectorXd xa_a = xstart;
-    MatrixXd Phi;
-    double h_phi = -1.0;
-    double h = h_first;
-    double t_event = std::numeric_limits<double>::infinity();
-    int trigger = -1;  // the constraint whose monitor gave t_event
-    bool event_found = false;
-    // Output grid k dt_out (not a running sum, whose rounding accumulates).
-    double k_out = opt_.dt_out > 0 ? std::floor(t / opt_.dt_out + 1e-9) + 1 : 0.0;
-    double next_out =
-        opt_.dt_out > 0 ? k_out * opt_.dt_out : std::numeric_limits<double>::infinity();
-    auto advance_out = [&] { next_out = ++k_out * opt_.dt_out; };
-    GridSampler sampler(phase, t, xstart, opt_.dt_out,
-                        [&]() -> StepExp& { return step_exp(phase, opt_.dt_out); });
-    auto state_at = [&](double tt) -> VectorXd {
-      return phase.D.cwiseProduct(phase.expv(tt - t, xstart));
-    };
-    while (ta < t_end && !event_found) {
-      const double tb = std::min(ta + h, t_end);
-      VectorXd xa_b;
-      if (!phase.dense_exp()) {
-        xa_b = phase.expv(tb - ta, xa_a);
-      } else {
-        if (tb - ta != h_phi) {
-          h_phi = tb - ta;
-          Phi = (phase.Ab * h_phi).exp();
-        }
-        xa_b = Phi * xa_a;
-      }
-      // Taylor terms A^k x_a / k! on this interval, built on first need:
-      // root refinement then evaluates polynomials instead of exponentials.
-      std::vector<VectorXd> taylor;
-      bool taylor_ok = false, taylor_built = false;
-      auto build_taylor = [&] {
-        taylor_built = true;
-        const double tau = tb - ta;
-        const double xnorm = xa_a.cwiseAbs().maxCoeff();
-        taylor.push_back(xa_a);
-        double factor = 1.0;  // tau^k
-        for (int k = 1; k <= 80; ++k) {
-          taylor.push_back(phase.times(taylor.back()) / static_cast<double>(k));
-          factor *= tau;
-          if (k >= 4 && taylor.back().cwiseAbs().maxCoeff() * factor <= 1e-18 * xnorm &&
-              taylor[k - 1].cwiseAbs().maxCoeff() * factor / tau <= 1e-17 * xnorm) {
-            taylor_ok = true;
-            return;
-          }
-        }
-      };
-      auto series = [&](const Eigen::RowVectorXd& w, double s, bool derivative) {
-        double acc = 0.0;
-        if (!derivative) {
-          for (int k = static_cast<int>(taylor.size()) - 1; k >= 0; --k)
-            acc = acc * s + w.dot(taylor[k]);
-        } else {
-          for (int k = static_cast<int>(taylor.size()) - 1; k >= 1; --k)
-            acc = acc * s + k * w.dot(taylor[k]);
-        }
-        return acc;
-      };
-      for (size_t j = 0; j < phase.monitors.size(); ++j) {
-        const Monitor& mon = phase.monitors[j];
-        const double fa = mon.w * xa_a - offset[j];
-        const double fb = mon.w * xa_b - offset[j];
-        const double tol_f = 1e-12 * mon.scale;
-        auto phi = [&](double tt) -> double {
-          if (!taylor_built) build_taylor();
-          if (taylor_ok) return series(mon.w, tt - ta, false) - offset[j];
-          return mon.w * phase.expv(tt - ta, xa_a) - offset[j];
-        };
-        auto dphi = [&](double tt) -> double {
-          if (!taylor_built) build_taylor();
-          if (taylor_ok) return series(mon.w, tt - ta, true);
-          return mon.wA * phase.expv(tt - ta, xa_a);
-        };
-        double root = std::numeric_limits<double>::infinity();
-        if (!armed[j]) {
-          // Started within rounding of zero: positive by mode selection, but
-          // only a departure beyond the noise band counts as a sign.
-          if (fb > noise[j]) {
-            armed[j] = true;
-          } else if (fb < -noise[j]) {
-            auto shifted = [&](double tt) { return phi(tt) + noise[j]; };
-            root = brent_root(shifted, ta, tb, fa + noise[j], fb + noise[j], opt_.event_time_tol);
-          }
-        } else {
-          const double da = mon.wA * xa_a;
-          const double db = mon.wA * xa_b;
-          // A tangential touch (gap and rate both zero) leaves a minimum
-          // within rounding of zero, of either sign: it is a graze, not an
-          // impact with a spurious 1e-8 rate.
-          const bool touch_shape = fa > 0.0 && da < 0.0 && db >= 0.0 && fb >= -tol_f;
-          if (fb < 0.0 && !touch_shape && fa <= 0.0 && ta == t && opening[j]) {
-            // Opened at the phase start and back below zero by tb: the
-            // return lies after a positive stretch that starts at t. (Its
-            // start may be exactly zero, a projected gap: offset 0.)
-            root = return_after_opening(phi, ta, tb, fb, opt_.event_time_tol);
-          } else if (fb < 0.0 && !touch_shape) {
-            root = fa <= 0.0 ? ta : brent_root(phi, ta, tb, fa, fb, opt_.event_time_tol);
-          } else if (fa > 0.0 && da < 0.0 && db > 0.0) {
-            // Positive (or touching) at both ends, derivative from - to +.
-            const double tm = brent_root(dphi, ta, tb, da, db, opt_.event_time_tol);
-            const double fm = phi(tm);
-            if (fm < -tol_f) {
-              root = brent_root(phi, ta, tm, fa, fm, opt_.event_time_tol);
-            } else if (fm <= tol_f) {
-              root = tm;  // touches zero with zero rate
-            }
-          }
-        }
-        if (root < t_event) {
-          t_event = root;
-          trigger = mon.constraint;
-        }
-      }
-      if (std::isfinite(t_event)) {
-        event_found = true;
-      } else {
-        // Exact output samples inside (ta, tb].
-        while (next_out <= tb && next_out < t_end) {
-          record(tr, next_out, sampler.at(next_out), phase);
-          advance_out();
-        }
-        ta = tb;
-        xa_a = xa_b;
-        h = std::min(2.0 * h, h_max);
-      }
-    }
-    if (!event_found) {
-      // Reached the horizon.
-      const VectorXd xend = state_at(t_end);
-      record(tr, t_end, xend, phase);
-      xa = xend;
-      t = t_end;
-      break;
-    }
-    // Output samples before the event.
-    while (next_out < t_event) {
-      record(tr, next_out, sampler.at(next_out), phase);
-      advance_out();
-    }
-    const VectorXd x_minus = state_at(t_event);
-    const long events_seen = static_cast<long>(tr.events.size()) + tr.events_not_recorded;
-    const bool keep = static_cast<long>(tr.events.size()) < opt_.max_recorded_events;
-    if (keep) record(tr, t_event, x_minus, phase);
-    t = t_event;
-    // Zeno guard.
-    if (t - window_start > 1.0) {
-      window_start = t;
-      events_in_window = 0;
-    }
-    if (++events_in_window > opt_.max_events_per_unit_time || events_seen >= opt_.max_events) {
-      std::ostringstream msg;
-      msg << "more than " << events_in_window << " events in less than unit time near t = " << t
-          << ": the event times accumulate without a limit the simulator can take";
-      fail(msg.str());
-      tr.status = RunStatus::kEventLimit;
-      xa = x_minus;
-      break;
-    }
-    ev = process_event(t, x_minus, phase.mode);
-    tr.lcp_solves += ev.lcp_solves;
-    for (const auto& w : ev.warnings) tr.warn(w.kind, w.first_t, w.message);
-    if (!ev.ok()) {
-      fail(ev.message);
-      xa = x_minus;
-      break;
-    }
-    const lcs::IndexSet old_mode = phase.mode;
-    const std::vector<FrictionMode> old_friction = phase.friction;
-    phase = make_phase(ev.mode, ev.friction, ldcp_undetermined_, ev.x_plus, err);
-    if (!err.empty()) {
-      fail(err);
-      xa = x_minus;
-      break;
-    }
-    xa = ev.x_plus;
-    if (ev.accumulation && ev.t_star > t) {
-      // Continue from the accumulation time in the limit mode; the bounces
-      // left out last ev.t_star - t seconds in all.
-      xa = phase.exp_apply(ev.t_star - t, xa);
-      t = ev.t_star;
-    }
-    if (const std::string why =
-            livelock.after_event(t, x_minus, xa, old_mode, ev, old_friction, trigger);
-        !why.empty()) {
-      fail(why);
-      tr.status = RunStatus::kEventLimit;
-      break;
-    }
-    Event e;
-    e.t = t;
-    e.state_before = user(x_minus);
-    e.state_after = user(xa);
-    e.mode_after = ev.mode;
-    e.impulse = ev.impulse;
-    set_friction(e, ev);
-    e.note = ev.note;
-    if (ev.accumulation) {
-      e.type = EventType::kAccumulation;
-    } else if (ev.jumped) {
-      e.type = EventType::kImpact;
-    } else {
-      bool gained = false, lost = false;
-      for (int r : ev.mode)
-        if (std::find(old_mode.begin(), old_mode.end(), r) == old_mode.end()) gained = true;
-      for (int r : old_mode)
-        if (std::find(ev.mode.begin(), ev.mode.end(), r) == ev.mode.end()) lost = true;
-      e.type = lost && !gained ? EventType::kRelease : EventType::kContact;
-      if (!gained && !lost && ev.friction != old_friction) {
-        e.type = friction_event_type(old_friction, ev.friction);
-        e.note = friction_note(old_friction, ev.friction, friction_contacts_,
-                               model_.mechanical->constraints);
-      } else if (!gained && !lost) {
-        // A graze or a re-selection of the same mode: not a mode change.
-        if (keep) record(tr, t, xa, phase);
-        continue;
-      }
-    }
-    if (!keep) {
-      if (tr.events_not_recorded++ == 0)
-        tr.warn("events-not-recorded", t,
-                "more than " + std::to_string(opt_.max_recorded_events) +
-                    " events: later events and their samples are counted, not recorded");
-      continue;
-    }
-    tr.events.push_back(std::move(e));
-    record(tr, t, xa, phase);
+  while (r.t < *opt_.t_end) {
+    ++r.tr.steps;
+    if (opt_.progress) opt_.progress(r.t);
+    if (!next_phase(r, livelock)) break;
   }
-  if (k_ > 0) check_feasible(t, xa, sys_.C * xa);
-  if (tr.status == RunStatus::kCompleted && !infeasible_.empty()) fail(infeasible_);
-  tr.final_state = user(xa);
-  tr.energy_final = energy(xa);
-  return tr;
+  end_run(r);
+  return std::move(r.tr);
+}
+
+// Initial mode selection (and jump, if the initial state is not regular) and
+// the first samples; false when the run ends there (r.tr says why).
+bool EventDriven::start_run(RunState& r, const VectorXd& x0_user) {
+  Trajectory& tr = r.tr;
+  tr.method = "event";
+  tr.t_end = *opt_.t_end;
+  if (model_.is_mechanical()) tr.impact_law = impact_->name();
+  r.xa = augment(x0_user);
+  tr.energy_initial = energy(r.xa);
+  r.t = 0.0;
+  const EventResult ev = process_event(r.t, r.xa);
+  count_event(tr, ev);
+  if (!ev.ok()) {
+    fail(tr, ev.message);
+  } else {
+    std::string err;
+    r.phase = make_phase(ev.mode, ev.friction, ldcp_undetermined_, ev.x_plus, err);
+    if (!err.empty()) fail(tr, err);
+  }
+  if (tr.status != RunStatus::kCompleted) {
+    tr.final_state = x0_user;
+    tr.energy_final = tr.energy_initial;
+    return false;
+  }
+  if (ev.jumped) record_initial_jump(r, ev);
+  r.xa = ev.x_plus;
+  record(tr, r.t, r.xa, r.phase);
+  return true;
+}
+
+// A jump at t = 0: the state before it (no contact force) and the impact.
+void EventDriven::record_initial_jump(RunState& r, const EventResult& ev) const {
+  Phase before = r.phase;
+  before.mode.clear();
+  before.F.resize(0, n_);
+  std::fill(before.friction.begin(), before.friction.end(), FrictionMode::kOpen);
+  before.Ft.setZero();
+  record(r.tr, r.t, r.xa, before);
+  Event e;
+  e.t = r.t;
+  e.type = EventType::kImpact;
+  e.state_before = user(r.xa);
+  e.state_after = user(ev.x_plus);
+  e.mode_after = ev.mode;
+  e.impulse = ev.impulse;
+  set_friction(e, ev);
+  r.tr.events.push_back(std::move(e));
+}
+
+// The phase from r.t to its event (then take_event) or to the horizon;
+// false when the run ends.
+bool EventDriven::next_phase(RunState& r, LivelockGuard& livelock) {
+  const double t_end = *opt_.t_end;
+  // Sampling step: a quarter of the fastest time scale of the closed loop,
+  // so a Bohl function changes the sign of its derivative at most once
+  // between samples; first steps shorter where a monitor starts at zero.
+  const double rho = r.phase.rho;
+  double h_max = t_end - r.t;
+  if (rho > 0.0) h_max = std::min(h_max, 0.5 / rho);
+  h_max = std::min(h_max, (t_end - r.t) / 4.0 + 1e-300);
+  const Phase& phase = r.phase;
+  PhaseMarch pm(phase, r.t, r.xa, opt_.dt_out,
+                [this, &phase]() -> StepExp& { return step_exp(phase, opt_.dt_out); });
+  pm.start = monitor_start(phase, pm.xstart, r.t, h_max);
+  const double h_first = std::max(pm.start.h_first, 1e-15 * std::max(1.0, std::abs(r.t)));
+  arm_monitors(pm);
+  march_phase(pm, h_first, h_max, r.tr);
+  if (std::isfinite(pm.t_event)) return take_event(r, pm, livelock);
+  // Reached the horizon.
+  const VectorXd xend = pm.state_at(t_end);
+  record(r.tr, t_end, xend, phase);
+  r.xa = xend;
+  r.t = t_end;
+  return false;
+}
+
+// March over the samples of a phase, doubling the step up to h_max, until a
+// monitor's root (pm.t_event) or the horizon; the output samples on the way.
+void EventDriven::march_phase(PhaseMarch& pm, double h_first, double h_max, Trajectory& tr) const {
+  const double t_end = *opt_.t_end;
+  double ta = pm.t0;
+  VectorXd xa_a = pm.xstart;
+  MatrixXd Phi;
+  double h_phi = -1.0;
+  double h = h_first;
+  while (ta < t_end) {
+    const double tb = std::min(ta + h, t_end);
+    VectorXd xa_b;
+    if (!pm.phase.dense_exp()) {
+      xa_b = pm.phase.expv(tb - ta, xa_a);
+    } else {
+      if (tb - ta != h_phi) {
+        h_phi = tb - ta;
+        Phi = (pm.phase.Ab * h_phi).exp();
+      }
+      xa_b = Phi * xa_a;
+    }
+    first_root(pm, ta, tb, xa_a, xa_b);
+    if (std::isfinite(pm.t_event)) return;
+    // Exact output samples inside (ta, tb].
+    while (pm.next_out <= tb && pm.next_out < t_end) {
+      record(tr, pm.next_out, pm.sampler.at(pm.next_out), pm.phase);
+      pm.advance_out();
+    }
+    ta = tb;
+    xa_a = xa_b;
+    h = std::min(2.0 * h, h_max);
+  }
+}
+
+// The event at pm.t_event: the samples before it, the state there, and the
+// re-initialisation into the next phase; false when the run ends.
+bool EventDriven::take_event(RunState& r, PhaseMarch& pm, LivelockGuard& livelock) {
+  Trajectory& tr = r.tr;
+  // Output samples before the event.
+  while (pm.next_out < pm.t_event) {
+    record(tr, pm.next_out, pm.sampler.at(pm.next_out), r.phase);
+    pm.advance_out();
+  }
+  const VectorXd x_minus = pm.state_at(pm.t_event);
+  const int trigger = pm.trigger;
+  const long events_seen = static_cast<long>(tr.events.size()) + tr.events_not_recorded;
+  const bool keep = static_cast<long>(tr.events.size()) < opt_.max_recorded_events;
+  if (keep) record(tr, pm.t_event, x_minus, r.phase);
+  r.t = pm.t_event;
+  // pm refers to r.phase, which reinitialise replaces: not used below.
+  const lcs::IndexSet old_mode = r.phase.mode;
+  const std::vector<FrictionMode> old_friction = r.phase.friction;
+  EventResult ev;
+  if (zeno_guard(r, events_seen) || !reinitialise(r, x_minus, ev)) {
+    r.xa = x_minus;
+    return false;
+  }
+  if (const std::string why =
+          livelock.after_event(r.t, x_minus, r.xa, old_mode, ev, old_friction, trigger);
+      !why.empty()) {
+    fail(tr, why);
+    tr.status = RunStatus::kEventLimit;
+    return false;
+  }
+  Event e;
+  e.t = r.t;
+  e.state_before = user(x_minus);
+  e.state_after = user(r.xa);
+  e.mode_after = ev.mode;
+  e.impulse = ev.impulse;
+  set_friction(e, ev);
+  e.note = ev.note;
+  if (!classify_event(e, ev, old_mode, old_friction)) {
+    // A graze or a re-selection of the same mode: not a mode change.
+    if (keep) record(tr, r.t, r.xa, r.phase);
+    return true;
+  }
+  if (!keep) {
+    if (tr.events_not_recorded++ == 0)
+      tr.warn("events-not-recorded", r.t,
+              "more than " + std::to_string(opt_.max_recorded_events) +
+                  " events: later events and their samples are counted, not recorded");
+    return true;
+  }
+  tr.events.push_back(std::move(e));
+  record(tr, r.t, r.xa, r.phase);
+  return true;
+}
+
+// Zeno guard: more than max_events_per_unit_time events within a unit of
+// time, or max_events in all, end the run (true).
+bool EventDriven::zeno_guard(RunState& r, long events_seen) const {
+  if (r.t - r.window_start > 1.0) {
+    r.window_start = r.t;
+    r.events_in_window = 0;
+  }
+  if (++r.events_in_window > opt_.max_events_per_unit_time || events_seen >= opt_.max_events) {
+    std::ostringstream msg;
+    msg << "more than " << r.events_in_window << " events in less than unit time near t = " << r.t
+        << ": the event times accumulate without a limit the simulator can take";
+    fail(r.tr, msg.str());
+    r.tr.status = RunStatus::kEventLimit;
+    return true;
+  }
+  return false;
+}
+
+// Re-initialisation at r.t from x_minus (the impact law and mode selection:
+// reinitialisation.cpp) and the next phase; an accumulation continues from
+// its limit time. False (r.tr says why) on failure.
+bool EventDriven::reinitialise(RunState& r, const VectorXd& x_minus, EventResult& ev) {
+  ev = process_event(r.t, x_minus, r.phase.mode);
+  count_event(r.tr, ev);
+  if (!ev.ok()) {
+    fail(r.tr, ev.message);
+    return false;
+  }
+  std::string err;
+  r.phase = make_phase(ev.mode, ev.friction, ldcp_undetermined_, ev.x_plus, err);
+  if (!err.empty()) {
+    fail(r.tr, err);
+    return false;
+  }
+  r.xa = ev.x_plus;
+  if (ev.accumulation && ev.t_star > r.t) {
+    // Continue from the accumulation time in the limit mode; the bounces
+    // left out last ev.t_star - t seconds in all.
+    r.xa = r.phase.exp_apply(ev.t_star - r.t, r.xa);
+    r.t = ev.t_star;
+  }
+  return true;
+}
+
+// The event's type from what changed; false for a graze or a re-selection
+// of the same modes (not an event).
+bool EventDriven::classify_event(Event& e, const EventResult& ev, const lcs::IndexSet& old_mode,
+                                 const std::vector<FrictionMode>& old_friction) const {
+  if (ev.accumulation) {
+    e.type = EventType::kAccumulation;
+    return true;
+  }
+  if (ev.jumped) {
+    e.type = EventType::kImpact;
+    return true;
+  }
+  bool gained = false, lost = false;
+  for (int r : ev.mode)
+    if (std::find(old_mode.begin(), old_mode.end(), r) == old_mode.end()) gained = true;
+  for (int r : old_mode)
+    if (std::find(ev.mode.begin(), ev.mode.end(), r) == ev.mode.end()) lost = true;
+  e.type = lost && !gained ? EventType::kRelease : EventType::kContact;
+  if (!gained && !lost && ev.friction != old_friction) {
+    e.type = friction_event_type(old_friction, ev.friction);
+    e.note = friction_note(old_friction, ev.friction, friction_contacts_,
+                           model_.mechanical->constraints);
+  } else if (!gained && !lost) {
+    return false;
+  }
+  return true;
+}
+
+// The final state, and the run's feasibility.
+void EventDriven::end_run(RunState& r) const {
+  if (k_ > 0) check_feasible(r.t, r.xa, sys_.C * r.xa);
+  if (r.tr.status == RunStatus::kCompleted && !infeasible_.empty()) fail(r.tr, infeasible_);
+  r.tr.final_state = user(r.xa);
+  r.tr.energy_final = energy(r.xa);
 }
 
 }  // namespace detail

@@ -1,5 +1,8 @@
 // Private to src/sim: the event-driven method's types, shared by its files.
-//   event_driven.cpp      the main loop (EventDriven::run) and the entry point
+//   event_driven.cpp      the main loop (EventDriven::run: its stages, phase
+//                         by phase and event by event) and the entry point
+//   monitors.cpp          a phase's monitors: how each starts, and their
+//                         first root on a sampling interval
 //   brent.hpp             roots of the monitored Bohl functions (Brent's method)
 //   phase.cpp             a phase: closed loop of a mode, balancing, spectral
 //                         bound, exponentials, the monitors (EventDriven::make_phase)
@@ -17,6 +20,7 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
+#include <cmath>
 #include <functional>
 #include <lcsim/sim/sim.hpp>
 #include <limits>
@@ -210,6 +214,8 @@ class LivelockGuard {
   std::set<int> involved_;
 };
 
+class IntervalSeries;  // monitors.cpp
+
 class EventDriven {
  public:
   // `model` fits the dense LCS (Integrator::run checks).
@@ -284,6 +290,23 @@ class EventDriven {
                       const VectorXd& noise);
   void project_onto(const std::vector<int>& rows, VectorXd& xa, bool positions) const;
   EventResult process_mechanical(double t, const VectorXd& xa, const lcs::IndexSet& held);
+  // What the contacts show at an event state: one round of
+  // process_mechanical (reinitialisation.cpp).
+  struct ContactScan {
+    VectorXd gap, gap_scale, rate;  // E q + g, the scale of its terms, E v
+    impact::ImpactInput in;         // q, v and the closed contacts (zero gap)
+    std::vector<int> resting;       // closed, with a zero rate
+    bool approaching = false;       // a closed contact with a negative rate
+    int accumulating = -1;          // a contact whose impacts accumulate at tail.t_star
+    GeometricTail tail;
+    std::string violation;  // a gap below zero beyond rounding: the message
+  };
+  // time_noise: the resolution of each approaching contact's impact time.
+  ContactScan scan_contacts(double t, const VectorXd& xa, const lcs::IndexSet& held,
+                            bool limit_taken, VectorXd& time_noise) const;
+  bool impact_round(double t, ContactScan& scan, bool limit_taken, const VectorXd& time_noise,
+                    VectorXd& xa, EventResult& out);
+  bool select_regular_mode(double t, const ContactScan& scan, VectorXd& xa, EventResult& out);
   std::string take_accumulation_limit(int r, double t, const GeometricTail& tail,
                                       const VectorXd& gap, const VectorXd& gap_scale,
                                       const VectorXd& rate, VectorXd& xa) const;
@@ -300,6 +323,70 @@ class EventDriven {
   };
   MonitorStart monitor_start(const Phase& phase, const VectorXd& xstart, double t,
                              double h_max) const;
+  // Noise level of each monitor at the phase start (monitors.cpp).
+  std::vector<double> monitor_noise(const Phase& phase, const VectorXd& xstart, double t) const;
+  // st.m0, st.d0 and st.h_first from st.noise.
+  void first_derivatives(const Phase& phase, const VectorXd& xstart, MonitorStart& st) const;
+
+  // One run's state between the stages of run() (event_driven.cpp).
+  struct RunState {
+    Trajectory tr;
+    double t = 0.0;
+    VectorXd xa;  // the augmented state at t
+    Phase phase;  // the phase from t
+    // The Zeno guard: events since window_start (at most a unit of time ago).
+    long events_in_window = 0;
+    double window_start = 0.0;
+  };
+  // The march over one phase from its start t0 (event_driven.cpp,
+  // monitors.cpp): the monitors' start and arming, the output grid, and the
+  // first event found. It refers to itself (the sampler to xstart): built in
+  // place, never copied.
+  struct PhaseMarch {
+    PhaseMarch(const Phase& ph, double t, const VectorXd& xa, double dt_out,
+               std::function<StepExp&()> fetch)
+        : phase(ph),
+          t0(t),
+          xstart(xa.cwiseQuotient(ph.D)),
+          // Output grid k dt_out (not a running sum, whose rounding accumulates).
+          k_out(dt_out > 0 ? std::floor(t / dt_out + 1e-9) + 1 : 0.0),
+          next_out(dt_out > 0 ? k_out * dt_out : std::numeric_limits<double>::infinity()),
+          dt_out_(dt_out),
+          sampler(ph, t, xstart, dt_out, std::move(fetch)) {}
+    PhaseMarch(const PhaseMarch&) = delete;
+    PhaseMarch& operator=(const PhaseMarch&) = delete;
+    void advance_out() { next_out = ++k_out * dt_out_; }
+    // The state (augmented, unbalanced) at tt, from the phase start.
+    VectorXd state_at(double tt) const { return phase.D.cwiseProduct(phase.expv(tt - t0, xstart)); }
+    const Phase& phase;
+    double t0;
+    VectorXd xstart;  // balanced
+    MonitorStart start;
+    std::vector<char> armed;
+    std::vector<char> opening;  // armed by a positive derivative
+    std::vector<double> offset;
+    double k_out, next_out;
+    double dt_out_;
+    GridSampler sampler;
+    double t_event = std::numeric_limits<double>::infinity();
+    int trigger = -1;  // the constraint whose monitor gave t_event
+  };
+  void arm_monitors(PhaseMarch& pm) const;
+  double monitor_root(PhaseMarch& pm, size_t j, double ta, double tb, const VectorXd& xa_a,
+                      const VectorXd& xa_b, IntervalSeries& series) const;
+  void first_root(PhaseMarch& pm, double ta, double tb, const VectorXd& xa_a,
+                  const VectorXd& xa_b) const;
+  // The stages of run() (event_driven.cpp).
+  bool start_run(RunState& r, const VectorXd& x0_user);
+  void record_initial_jump(RunState& r, const EventResult& ev) const;
+  bool next_phase(RunState& r, LivelockGuard& livelock);
+  void march_phase(PhaseMarch& pm, double h_first, double h_max, Trajectory& tr) const;
+  bool take_event(RunState& r, PhaseMarch& pm, LivelockGuard& livelock);
+  bool zeno_guard(RunState& r, long events_seen) const;
+  bool reinitialise(RunState& r, const VectorXd& x_minus, EventResult& ev);
+  bool classify_event(Event& e, const EventResult& ev, const lcs::IndexSet& old_mode,
+                      const std::vector<FrictionMode>& old_friction) const;
+  void end_run(RunState& r) const;
   void fill_friction(Sample& s, const Phase& ph, const VectorXd& xa) const;
   // An event's tangential impulses and friction modes after (models with
   // friction only).

@@ -3,6 +3,11 @@
 // closed contacts, repeated while a contact approaches (and an accumulation's
 // limit when impacts accumulate), then mode selection on the regular part;
 // for general LCS the LDCP with its impulsive levels (jump P_I x0).
+//
+// process_mechanical is the driver of its stages: scan_contacts (which
+// contacts are closed, resting, approaching, accumulating), then either the
+// accumulation's limit or impact_round (the impact law), and once no contact
+// approaches, select_regular_mode.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -11,81 +16,146 @@
 
 namespace lcsim::sim::detail {
 
+EventDriven::ContactScan EventDriven::scan_contacts(double t, const VectorXd& xa,
+                                                    const lcs::IndexSet& held, bool limit_taken,
+                                                    VectorXd& time_noise) const {
+  const mech::MechanicalModel& m = *model_.mechanical;
+  ContactScan s;
+  const VectorXd q = xa.head(N_), v = xa.segment(N_, N_);
+  s.gap = m.E * q + m.g;
+  s.gap_scale = m.E.cwiseAbs() * q.cwiseAbs() + m.g.cwiseAbs();
+  s.rate = m.E * v;
+  const VectorXd rate_scale = m.E.cwiseAbs() * v.cwiseAbs();
+  s.in.model = &m;
+  s.in.q = q;
+  s.in.v = v;
+  for (int r = 0; r < k_; ++r) {
+    // Zero within rounding, or within what the event time's resolution
+    // (a few ulp of t times the rate) leaves in the gap.
+    double gap_tol =
+        ldcp_.tol_rel * s.gap_scale(r) + ldcp_.tol_abs + time_resolution(t) * std::abs(s.rate(r));
+    // A constraint the ending phase held closed has a zero gap by
+    // construction; what it shows is the phase's drift, the rounding of
+    // the whole state carried through the coupling (its own entries may be
+    // tiny: a light finger on a heavy arm, gap 4e-13 at q ~ 1). Closed
+    // within sqrt(eps) of the state's scale, so that the impact law sees
+    // it: left open, an impact elsewhere can drive it into its stop.
+    if (std::find(held.begin(), held.end(), r) != held.end())
+      gap_tol +=
+          kSqrtEps * (m.E.row(r).cwiseAbs().sum() * q.cwiseAbs().maxCoeff() + std::abs(m.g(r)));
+    if (s.gap(r) < -gap_tol) {
+      std::ostringstream msg;
+      msg.precision(6);
+      msg << "constraint '" << m.constraints[r] << "' is violated at t = " << t
+          << " (gap = " << s.gap(r)
+          << "): the state is infeasible, E q + g >= 0 must hold (thesis §3.8)";
+      s.violation = msg.str();
+      return s;
+    }
+    if (s.gap(r) > gap_tol) continue;
+    s.in.closed.push_back(r);
+    // A rate is zero within rounding of its terms, or within what rounding
+    // of the state leaves in it: eps times the velocities and positions
+    // times the fastest frequency (a stiff spring grazing its stop).
+    const double rate_noise = 64.0 * kEps * m.E.row(r).cwiseAbs().sum() *
+                              (v.cwiseAbs().maxCoeff() + rho_A_ * q.cwiseAbs().maxCoeff());
+    const double rate_tol = ldcp_.tol_rel * rate_scale(r) + ldcp_.tol_abs + rate_noise;
+    if (std::abs(s.rate(r)) <= rate_tol) s.resting.push_back(r);
+    if (s.rate(r) < -rate_tol) {
+      s.approaching = true;
+      // The resolution of this impact's time: the gap's rounding over the
+      // approach rate, and the event time's few ulp.
+      time_noise(r) =
+          64.0 * kEps * (m.E.row(r).cwiseAbs().dot(q.cwiseAbs()) + std::abs(m.g(r))) / -s.rate(r) +
+          time_resolution(t);
+      const GeometricTail g =
+          limit_taken ? GeometricTail{} : accumulation_time(r, t, time_noise(r));
+      if (g.t_star >= t && g.t_star >= s.tail.t_star) {
+        s.accumulating = r;
+        s.tail = g;
+      }
+    }
+  }
+  return s;
+}
+
+// One application of the impact law to the approaching contacts: xa takes
+// the velocities after, out the impulses; false (out.message) on failure.
+bool EventDriven::impact_round(double t, ContactScan& scan, bool limit_taken,
+                               const VectorXd& time_noise, VectorXd& xa, EventResult& out) {
+  impact::ImpactInput& in = scan.in;
+  in.restitution = limit_taken ? VectorXd::Zero(k_) : VectorXd(restitution_);
+  const impact::ImpactResult ir = impact_->apply(in, *solver_);
+  out.lcp_solves += ir.lcp_solves;
+  if (!ir.ok()) {
+    out.message = "impact at t = " + std::to_string(t) + ": " + ir.message;
+    return false;
+  }
+  if (!ir.admissible)
+    count_warning(out.warnings, "impact-not-admissible", t,
+                  "impact law '" + impact_->name() + "' at t = " + std::to_string(t) +
+                      " gave a non-admissible jump (negative impulse or E_J v+ < 0)" +
+                      (ir.message.empty() ? "" : ": " + ir.message));
+  if (ir.energy_gain) count_warning(out.warnings, "impact-energy-gain", t, ir.message);
+  // The last round's stick / slip / no-impulse per contact: stick leaves a
+  // sliding velocity zero to the law's tolerance (friction_modes.cpp).
+  if (!ir.outcome.empty()) outcome_ = ir.outcome;
+  xa.segment(N_, N_) = ir.v_after;
+  out.impulse += ir.impulse;
+  if (ir.friction_impulse.size() == k_)
+    for (size_t f = 0; f < friction_contacts_.size(); ++f)
+      out.friction_impulse(static_cast<Eigen::Index>(f)) +=
+          ir.friction_impulse(friction_contacts_[f]);
+  out.jumped = true;
+  record_impacts(in.closed, ir.impulse, t, time_noise);
+  return true;
+}
+
+// The regular state's mode: the closed gaps and resting rates put at exactly
+// zero, mode selection at acceleration level and above, and the friction
+// modes; false (out.message) on failure.
+bool EventDriven::select_regular_mode(double t, const ContactScan& scan, VectorXd& xa,
+                                      EventResult& out) {
+  // Put the closed gaps and the resting rates at exactly zero: they are zero
+  // up to the state's rounding, and mode selection must see them so.
+  project_onto(scan.in.closed, xa, true);
+  project_onto(scan.resting, xa, false);
+  lcs::LdcpOptions o = ldcp_;
+  o.regular_only = true;  // the state is now regular: contact forces and higher
+  const lcs::ModeSelection sel = lcs::select_mode(sys_, xa, o);
+  out.lcp_solves += sel.lcp_solves;
+  if (!sel.ok()) {
+    out.message = "mode selection at t = " + std::to_string(t) + ": " + sel.message;
+    return false;
+  }
+  out.mode = sel.mode;
+  if (model_.mechanical->has_friction()) {
+    if (std::string why = select_friction(t, sel.undetermined, xa, out); !why.empty()) {
+      out.message = why;
+      return false;
+    }
+  }
+  ldcp_undetermined_ = sel.undetermined;
+  return true;
+}
+
 EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0,
                                             const lcs::IndexSet& held) {
   EventResult out;
   out.impulse = VectorXd::Zero(k_);
   out.friction_impulse = VectorXd::Zero(static_cast<Eigen::Index>(friction_contacts_.size()));
   VectorXd xa = xa0;
-  const mech::MechanicalModel& m = *model_.mechanical;
-  std::vector<int> closed, resting;          // zero gap; zero gap and zero rate
+  ContactScan scan;
   VectorXd time_noise = VectorXd::Zero(k_);  // per approaching contact
   bool limit_taken = false;                  // an accumulation's limit is being taken
   std::fill(outcome_.begin(), outcome_.end(), impact::ContactOutcome::kNone);
   for (int iter = 0; iter < 100; ++iter) {
-    closed.clear();
-    resting.clear();
-    const VectorXd q = xa.head(N_), v = xa.segment(N_, N_);
-    const VectorXd gap = m.E * q + m.g;
-    const VectorXd gap_scale = m.E.cwiseAbs() * q.cwiseAbs() + m.g.cwiseAbs();
-    const VectorXd rate = m.E * v;
-    const VectorXd rate_scale = m.E.cwiseAbs() * v.cwiseAbs();
-    impact::ImpactInput in;
-    in.model = &m;
-    in.q = q;
-    in.v = v;
-    bool approaching = false;
-    int accumulating = -1;  // a contact whose impacts accumulate at tail.t_star
-    GeometricTail tail;
-    for (int r = 0; r < k_; ++r) {
-      // Zero within rounding, or within what the event time's resolution
-      // (a few ulp of t times the rate) leaves in the gap.
-      double gap_tol =
-          ldcp_.tol_rel * gap_scale(r) + ldcp_.tol_abs + time_resolution(t) * std::abs(rate(r));
-      // A constraint the ending phase held closed has a zero gap by
-      // construction; what it shows is the phase's drift, the rounding of
-      // the whole state carried through the coupling (its own entries may be
-      // tiny: a light finger on a heavy arm, gap 4e-13 at q ~ 1). Closed
-      // within sqrt(eps) of the state's scale, so that the impact law sees
-      // it: left open, an impact elsewhere can drive it into its stop.
-      if (std::find(held.begin(), held.end(), r) != held.end())
-        gap_tol +=
-            kSqrtEps * (m.E.row(r).cwiseAbs().sum() * q.cwiseAbs().maxCoeff() + std::abs(m.g(r)));
-      if (gap(r) < -gap_tol) {
-        std::ostringstream msg;
-        msg.precision(6);
-        msg << "constraint '" << m.constraints[r] << "' is violated at t = " << t
-            << " (gap = " << gap(r)
-            << "): the state is infeasible, E q + g >= 0 must hold (thesis §3.8)";
-        out.message = msg.str();
-        return out;
-      }
-      if (gap(r) > gap_tol) continue;
-      in.closed.push_back(r);
-      closed.push_back(r);
-      // A rate is zero within rounding of its terms, or within what rounding
-      // of the state leaves in it: eps times the velocities and positions
-      // times the fastest frequency (a stiff spring grazing its stop).
-      const double rate_noise = 64.0 * kEps * m.E.row(r).cwiseAbs().sum() *
-                                (v.cwiseAbs().maxCoeff() + rho_A_ * q.cwiseAbs().maxCoeff());
-      const double rate_tol = ldcp_.tol_rel * rate_scale(r) + ldcp_.tol_abs + rate_noise;
-      if (std::abs(rate(r)) <= rate_tol) resting.push_back(r);
-      if (rate(r) < -rate_tol) {
-        approaching = true;
-        // The resolution of this impact's time: the gap's rounding over the
-        // approach rate, and the event time's few ulp.
-        time_noise(r) =
-            64.0 * kEps * (m.E.row(r).cwiseAbs().dot(q.cwiseAbs()) + std::abs(m.g(r))) / -rate(r) +
-            time_resolution(t);
-        const GeometricTail g =
-            limit_taken ? GeometricTail{} : accumulation_time(r, t, time_noise(r));
-        if (g.t_star >= t && g.t_star >= tail.t_star) {
-          accumulating = r;
-          tail = g;
-        }
-      }
+    scan = scan_contacts(t, xa, held, limit_taken, time_noise);
+    if (!scan.violation.empty()) {
+      out.message = scan.violation;
+      return out;
     }
-    if (accumulating >= 0) {
+    if (scan.accumulating >= 0) {
       // Right-accumulation of impacts (Remark 3.4.11): the limit state has
       // every contact that takes part in the accumulation closed (with
       // alternating impacts the others are open by a gap of the order of the
@@ -94,63 +164,22 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0,
       // inelastic impact; the run continues from t_star in the limit mode.
       limit_taken = true;
       out.accumulation = true;
-      out.t_star = tail.t_star;
-      out.note = take_accumulation_limit(accumulating, t, tail, gap, gap_scale, rate, xa);
+      out.t_star = scan.tail.t_star;
+      out.note = take_accumulation_limit(scan.accumulating, t, scan.tail, scan.gap, scan.gap_scale,
+                                         scan.rate, xa);
       continue;
     }
-    if (!approaching) break;
-    in.restitution = limit_taken ? VectorXd::Zero(k_) : VectorXd(restitution_);
-    const impact::ImpactResult ir = impact_->apply(in, *solver_);
-    out.lcp_solves += ir.lcp_solves;
-    if (!ir.ok()) {
-      out.message = "impact at t = " + std::to_string(t) + ": " + ir.message;
-      return out;
-    }
-    if (!ir.admissible)
-      count_warning(out.warnings, "impact-not-admissible", t,
-                    "impact law '" + impact_->name() + "' at t = " + std::to_string(t) +
-                        " gave a non-admissible jump (negative impulse or E_J v+ < 0)" +
-                        (ir.message.empty() ? "" : ": " + ir.message));
-    if (ir.energy_gain) count_warning(out.warnings, "impact-energy-gain", t, ir.message);
-    // The last round's stick / slip / no-impulse per contact: stick leaves a
-    // sliding velocity zero to the law's tolerance (friction_modes.cpp).
-    if (!ir.outcome.empty()) outcome_ = ir.outcome;
-    xa.segment(N_, N_) = ir.v_after;
-    out.impulse += ir.impulse;
-    if (ir.friction_impulse.size() == k_)
-      for (size_t f = 0; f < friction_contacts_.size(); ++f)
-        out.friction_impulse(static_cast<Eigen::Index>(f)) +=
-            ir.friction_impulse(friction_contacts_[f]);
-    out.jumped = true;
-    record_impacts(in.closed, ir.impulse, t, time_noise);
+    if (!scan.approaching) break;
+    if (!impact_round(t, scan, limit_taken, time_noise, xa, out)) return out;
     if (iter == 99) {
       out.message =
           "impacts at t = " + std::to_string(t) + " did not end after 100 rounds of the impact law";
       return out;
     }
   }
-  // Put the closed gaps and the resting rates at exactly zero: they are zero
-  // up to the state's rounding, and mode selection must see them so.
-  project_onto(closed, xa, true);
-  project_onto(resting, xa, false);
-  lcs::LdcpOptions o = ldcp_;
-  o.regular_only = true;  // the state is now regular: contact forces and higher
-  const lcs::ModeSelection sel = lcs::select_mode(sys_, xa, o);
-  out.lcp_solves += sel.lcp_solves;
-  if (!sel.ok()) {
-    out.message = "mode selection at t = " + std::to_string(t) + ": " + sel.message;
-    return out;
-  }
-  out.mode = sel.mode;
-  if (m.has_friction()) {
-    if (std::string why = select_friction(t, sel.undetermined, xa, out); !why.empty()) {
-      out.message = why;
-      return out;
-    }
-  }
+  if (!select_regular_mode(t, scan, xa, out)) return out;
   out.x_plus = xa;
   out.status = Status::kOk;
-  ldcp_undetermined_ = sel.undetermined;
   return out;
 }
 

@@ -1,6 +1,11 @@
 // Backward Euler, Algorithm 7.3.1 of the thesis, on sys = model.as_lcs() (the
 // augmented state (q, v, 1) of (3.65) for mechanical models): one LCP per
 // step on the fixed grid of time_stepping.cpp's description.
+//
+// run_euler is the driver; its stages are the members of EulerRun: set_up
+// (the LCS and the solver), refusal (the consistency guard of §7.3), factor
+// (one factorisation per step size), record, step (steps 4 and 5 of the
+// algorithm) and advance (the divergence guard, the sample).
 #include <algorithm>
 #include <lcsim/sim/sim.hpp>
 #include <memory>
@@ -45,135 +50,205 @@ EulerFactors euler_factors(const lcs::Lcs& sys, double h) {
   return f;
 }
 
-}  // namespace
-
-Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Options& opt) {
-  Trajectory tr;
-  tr.method = "euler";
-  tr.t_end = *opt.t_end;
-  // Backward Euler's step LCP acts on positions: every impact is inelastic.
-  if (model.is_mechanical()) tr.impact_law = "inelastic (restitution ignored)";
-  const bool mech = model.is_mechanical();
-  const int N = mech ? model.mechanical->dofs() : 0;
-  auto user = [&](const VectorXd& xa) -> VectorXd { return mech ? VectorXd(xa.head(2 * N)) : xa; };
-  auto energy = [&](const VectorXd& xa) {
-    return mech ? mech::total_energy(*model.mechanical, xa.head(N), xa.segment(N, N)) : 0.0;
-  };
-  auto finish = [&](const VectorXd& xa) {
-    tr.final_state = user(xa);
-    tr.energy_final = energy(xa);
-    return std::move(tr);  // only ever returned from the run: no copy of the samples
-  };
-  auto fail = [&](const std::string& msg, const VectorXd& xa) {
-    tr.status = RunStatus::kNumericalFailure;
-    tr.message = msg;
-    return finish(xa);
-  };
-
-  lcs::Lcs sys;
-  std::unique_ptr<lcp::Solver> solver;
-  try {  // set-up, before the loop: invalid names or data end the run cleanly
-    sys = model.as_lcs();
-    solver = lcp::make_solver(opt.lcp_solver);
-  } catch (const std::exception& e) {
-    tr.status = RunStatus::kNumericalFailure;
-    tr.message = std::string("euler: ") + e.what();
-    tr.final_state = x0_user;
-    return tr;
+// One backward Euler run: the trajectory it builds and what its steps share.
+class EulerRun {
+ public:
+  EulerRun(const mech::Model& model, const Options& opt)
+      : model_(model),
+        opt_(opt),
+        mech_(model.is_mechanical()),
+        N_(mech_ ? model.mechanical->dofs() : 0) {
+    tr_.method = "euler";
+    tr_.t_end = *opt.t_end;
+    // Backward Euler's step LCP acts on positions: every impact is inelastic.
+    if (mech_) tr_.impact_law = "inelastic (restitution ignored)";
   }
-  const int n = sys.n(), k = sys.k();
-  VectorXd x(n);
-  if (mech)
-    x << x0_user, 1.0;
-  else
-    x = x0_user;
-  tr.energy_initial = energy(x);
+
+  // The LCS and the solver; false ends the run (Trajectory returned by
+  // set_up_failure).
+  bool set_up() {
+    try {  // set-up, before the loop: invalid names or data end the run cleanly
+      sys_ = model_.as_lcs();
+      solver_ = lcp::make_solver(opt_.lcp_solver);
+    } catch (const std::exception& e) {
+      tr_.status = RunStatus::kNumericalFailure;
+      tr_.message = std::string("euler: ") + e.what();
+      return false;
+    }
+    n_ = sys_.n();
+    k_ = sys_.k();
+    return true;
+  }
+  Trajectory set_up_failure(const VectorXd& x0_user) {
+    tr_.final_state = x0_user;
+    return std::move(tr_);
+  }
+
+  // The augmented start (q, v, 1) of a mechanical model, the state of an LCS.
+  VectorXd start(const VectorXd& x0_user) {
+    VectorXd x(n_);
+    if (mech_)
+      x << x0_user, 1.0;
+    else
+      x = x0_user;
+    tr_.energy_initial = energy(x);
+    return x;
+  }
 
   // Consistency guard (§7.3, Example 7.3.3): with a leading row index
   // rho_i >= 3 backward Euler produces impulses of order h^{1-rho_i} and does
-  // not converge. Refuse unless forced.
-  {
-    const std::vector<int> rho = lcs::leading_row_indices(sys);
-    for (int i = 0; i < k; ++i) {
+  // not converge. Refuse unless forced: the failure message, or "".
+  std::string refusal() {
+    const std::vector<int> rho = lcs::leading_row_indices(sys_);
+    for (int i = 0; i < k_; ++i) {
       if (rho[i] >= 3) {
         const std::string msg = "leading row index rho_" + std::to_string(i + 1) + " = " +
                                 std::to_string(rho[i]) +
                                 " >= 3: backward Euler is not consistent here (thesis §7.3, "
                                 "Example 7.3.3: the outputs blow up as h -> 0)";
-        if (!opt.force)
-          return fail("euler: refused: " + msg + "; set Options::force to run anyway", x);
-        tr.warn("forced", 0.0, "forced despite " + msg);
+        if (!opt_.force) return "euler: refused: " + msg + "; set Options::force to run anyway";
+        tr_.warn("forced", 0.0, "forced despite " + msg);
         break;
       }
     }
-  }
-  if (mech && model.mechanical->restitution.size() > 0 &&
-      model.mechanical->restitution.maxCoeff() > 0.0)
-    tr.warn("restitution-ignored", 0.0,
-            "backward Euler ignores restitution: every impact is inelastic");
-
-  const StepGrid grid = StepGrid::of(*opt.t_end, opt.h);
-  EulerFactors F = euler_factors(sys, grid.h);
-  if (!F.ok()) return fail("euler: " + F.message, x);
-  EulerFactors F_last;
-  if (grid.h_last != grid.h) {
-    F_last = euler_factors(sys, grid.h_last);
-    if (!F_last.ok()) return fail("euler: last step: " + F_last.message, x);
+    return "";
   }
 
-  OutputSampler sampler(opt.dt_out);
-  DivergenceGuard guard(model, x0_user, *opt.t_end);
-  VectorXd u = VectorXd::Zero(k);
-  auto record = [&](double t, const VectorXd& xa, const VectorXd& uu) {
-    const VectorXd y = sys.C * xa + sys.D * uu;
-    if (k > 0) tr.max_violation = std::min(tr.max_violation, std::min(0.0, y.minCoeff()));
-    if (!opt.record_samples) return;
+  void warn_restitution() {
+    if (mech_ && model_.mechanical->restitution.size() > 0 &&
+        model_.mechanical->restitution.maxCoeff() > 0.0)
+      tr_.warn("restitution-ignored", 0.0,
+               "backward Euler ignores restitution: every impact is inelastic");
+  }
+
+  // The factors of the grid's step and of its shortened last step: the
+  // failure message, or "".
+  std::string factor(const StepGrid& grid) {
+    F_ = euler_factors(sys_, grid.h);
+    if (!F_.ok()) return "euler: " + F_.message;
+    if (grid.h_last != grid.h) {
+      F_last_ = euler_factors(sys_, grid.h_last);
+      if (!F_last_.ok()) return "euler: last step: " + F_last_.message;
+    }
+    return "";
+  }
+
+  // The steps from the sample at t = 0 to t_end, or to the first failure.
+  Trajectory march(const StepGrid& grid, const VectorXd& x0_user, VectorXd& x) {
+    OutputSampler sampler(opt_.dt_out);
+    DivergenceGuard guard(model_, x0_user, *opt_.t_end);
+    u_ = VectorXd::Zero(k_);
+    record(0.0, x, u_);
+    xb_.resize(n_);
+    q_.resize(k_);
+    x_next_.resize(n_);
+    for (long j = 1; j <= grid.n; ++j) {
+      const bool last = j == grid.n;
+      if (opt_.progress && j % Options::kProgressSteps == 0) opt_.progress(j * grid.h);
+      const EulerFactors& f = (last && grid.h_last != grid.h) ? F_last_ : F_;
+      if (!step(f, x, (j - 1) * grid.h)) return fail(failure_, x);
+      if (std::string why = guard.check(last ? *opt_.t_end : j * grid.h, x_next_, last);
+          !why.empty()) {
+        tr_.t_end = (j - 1) * grid.h;  // the time reached: the last sane state's
+        return fail("euler: " + why, x);
+      }
+      x = x_next_;
+      ++tr_.steps;
+      const double t = last ? *opt_.t_end : j * grid.h;
+      sample(sampler.want(t, grid.h, last), t, x);
+    }
+    return finish(x);
+  }
+
+  Trajectory fail(const std::string& msg, const VectorXd& xa) {
+    tr_.status = RunStatus::kNumericalFailure;
+    tr_.message = msg;
+    return finish(xa);
+  }
+
+ private:
+  VectorXd user(const VectorXd& xa) const { return mech_ ? VectorXd(xa.head(2 * N_)) : xa; }
+  double energy(const VectorXd& xa) const {
+    return mech_ ? mech::total_energy(*model_.mechanical, xa.head(N_), xa.segment(N_, N_)) : 0.0;
+  }
+  Trajectory finish(const VectorXd& xa) {
+    tr_.final_state = user(xa);
+    tr_.energy_final = energy(xa);
+    return std::move(tr_);  // only ever returned from the run: no copy of the samples
+  }
+
+  // Steps 4 and 5 of Algorithm 7.3.1 from x (the step starting at t0) into
+  // x_next_; false (failure_ says why) when the LCP fails.
+  bool step(const EulerFactors& f, const VectorXd& x, double t0) {
+    xb_.noalias() = f.Phi * x;  // free step (I - hA)^{-1} x_k
+    if (k_ == 0) {
+      x_next_ = xb_;
+      return true;
+    }
+    q_.noalias() = sys_.C * xb_;  // step 4 of Algorithm 7.3.1
+    int attempts = 0;             // dependent constraints: pivoting fails, Lemke does not
+    // Scaled: G = h C (I - hA)^{-1} B is h^2 E M^{-1} E' for a gap, 1e-16 at
+    // h = 1e-8, and an unscaled tolerance would accept any u within 1e4 of it.
+    const lcp::Result r = lcp::solve_scaled(*solver_, f.G, q_, lopt_, &attempts);
+    tr_.lcp_solves += attempts;
+    if (!r.ok()) {
+      failure_ = lcp_failure("euler", t0, r);
+      return false;
+    }
+    u_ = r.z;
+    x_next_.noalias() = xb_ + f.PhiB * u_;  // step 5
+    return true;
+  }
+
+  // The sample at t when `wanted`; the worst gap in any case.
+  void sample(bool wanted, double t, const VectorXd& x) {
+    if (wanted) {
+      record(t, x, u_);  // also updates max_violation
+    } else if (k_ > 0) {
+      const VectorXd y = sys_.C * x + sys_.D * u_;
+      tr_.max_violation = std::min(tr_.max_violation, std::min(0.0, y.minCoeff()));
+    }
+  }
+
+  void record(double t, const VectorXd& xa, const VectorXd& uu) {
+    const VectorXd y = sys_.C * xa + sys_.D * uu;
+    if (k_ > 0) tr_.max_violation = std::min(tr_.max_violation, std::min(0.0, y.minCoeff()));
+    if (!opt_.record_samples) return;
     Sample s;
     s.t = t;
     s.x = user(xa);
     s.u = uu;
     s.y = y;
-    for (int i = 0; i < k; ++i)
+    for (int i = 0; i < k_; ++i)
       if (uu(i) > 0.0) s.mode.push_back(i);
-    tr.record_sample(std::move(s), opt);
-  };
-  record(0.0, x, u);
-
-  lcp::Options lopt;
-  VectorXd xb(n), q(k), x_next(n);
-  for (long j = 1; j <= grid.n; ++j) {
-    const bool last = j == grid.n;
-    if (opt.progress && j % Options::kProgressSteps == 0) opt.progress(j * grid.h);
-    const EulerFactors& f = (last && grid.h_last != grid.h) ? F_last : F;
-    xb.noalias() = f.Phi * x;  // free step (I - hA)^{-1} x_k
-    if (k > 0) {
-      q.noalias() = sys.C * xb;  // step 4 of Algorithm 7.3.1
-      int attempts = 0;          // dependent constraints: pivoting fails, Lemke does not
-      // Scaled: G = h C (I - hA)^{-1} B is h^2 E M^{-1} E' for a gap, 1e-16 at
-      // h = 1e-8, and an unscaled tolerance would accept any u within 1e4 of it.
-      const lcp::Result r = lcp::solve_scaled(*solver, f.G, q, lopt, &attempts);
-      tr.lcp_solves += attempts;
-      if (!r.ok()) return fail(lcp_failure("euler", (j - 1) * grid.h, r), x);
-      u = r.z;
-      x_next.noalias() = xb + f.PhiB * u;  // step 5
-    } else {
-      x_next = xb;
-    }
-    if (std::string why = guard.check(last ? *opt.t_end : j * grid.h, x_next, last); !why.empty()) {
-      tr.t_end = (j - 1) * grid.h;  // the time reached: the last sane state's
-      return fail("euler: " + why, x);
-    }
-    x = x_next;
-    ++tr.steps;
-    const double t = last ? *opt.t_end : j * grid.h;
-    if (sampler.want(t, grid.h, last)) {
-      record(t, x, u);  // also updates max_violation
-    } else if (k > 0) {
-      const VectorXd y = sys.C * x + sys.D * u;
-      tr.max_violation = std::min(tr.max_violation, std::min(0.0, y.minCoeff()));
-    }
+    tr_.record_sample(std::move(s), opt_);
   }
-  return finish(x);
+
+  const mech::Model& model_;
+  const Options& opt_;
+  const bool mech_;
+  const int N_;
+  Trajectory tr_;
+  lcs::Lcs sys_;
+  std::unique_ptr<lcp::Solver> solver_;
+  int n_ = 0, k_ = 0;
+  EulerFactors F_, F_last_;
+  lcp::Options lopt_;
+  VectorXd u_, xb_, q_, x_next_;
+  std::string failure_;  // why step() failed
+};
+
+}  // namespace
+
+Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Options& opt) {
+  EulerRun run(model, opt);
+  if (!run.set_up()) return run.set_up_failure(x0_user);
+  VectorXd x = run.start(x0_user);
+  if (std::string why = run.refusal(); !why.empty()) return run.fail(why, x);
+  run.warn_restitution();
+  const StepGrid grid = StepGrid::of(*opt.t_end, opt.h);
+  if (std::string why = run.factor(grid); !why.empty()) return run.fail(why, x);
+  return run.march(grid, x0_user, x);
 }
 
 }  // namespace lcsim::sim::detail

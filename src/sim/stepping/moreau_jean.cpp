@@ -61,6 +61,13 @@
 //   W^{-1} t_f', the Delassus matrix over [E_A; T_F] assembled from them and
 //   kept while A stays, the dense friction LCP (warm-started on the previous
 //   basis) up to pivot_max_active rows, block Gauss–Seidel above.
+//
+// run_moreau_jean is the driver and MjRun::step the step, in the stages named
+// for what they do: free_velocity, select_active, clear_step_outputs,
+// active_columns, then friction_step or contact_step (the velocity LCP,
+// solve_dense or solve_sparse, keep_impulses), and advance (the positions,
+// the divergence guard, the sample). The run's state lives in MjRun, so no
+// stage allocates once the active set has been seen.
 #include <algorithm>
 #include <lcsim/lcp/sparse.hpp>
 #include <lcsim/sim/sim.hpp>
@@ -96,260 +103,393 @@ FrictionMode friction_mode_after_step(const mech::FrictionalContact& fc, const V
   return s > 0.0 ? FrictionMode::kSlipPositive : FrictionMode::kSlipNegative;
 }
 
-}  // namespace
-
-Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const Options& opt) {
-  Trajectory tr;
-  tr.method = "moreau-jean";
-  tr.t_end = *opt.t_end;
-  tr.impact_law = "moreau-restitution";  // the law inside the velocity LCP
-  const mech::MechanicalModel& m = *model.mechanical;
-  const int N = m.dofs(), k = m.num_constraints();
-  const MjOperators ops(m, N > opt.sparse_dofs_threshold);
-  VectorXd q = x0.head(N), v = x0.tail(N);
-  tr.energy_initial = ops.energy(q, v);
-  auto finish = [&]() {
-    tr.final_state.resize(2 * N);
-    tr.final_state << q, v;
-    tr.energy_final = ops.energy(q, v);
-    return std::move(tr);  // only ever returned from the run: no copy of the samples
-  };
-  auto fail = [&](const std::string& msg) {
-    tr.status = RunStatus::kNumericalFailure;
-    tr.message = msg;
-    return finish();
-  };
-  std::unique_ptr<lcp::Solver> solver;
-  try {
-    solver = lcp::make_solver(opt.lcp_solver);
-  } catch (const std::exception& e) {
-    return fail(std::string("moreau-jean: ") + e.what());
+// One Moreau–Jean run: the trajectory it builds, the state (q, v) and what
+// the steps keep from one to the next (active set, impulses, the Delassus
+// matrix, scratch vectors).
+class MjRun {
+ public:
+  MjRun(const mech::Model& model, const VectorXd& x0, const Options& opt)
+      : opt_(opt),
+        m_(*model.mechanical),
+        N_(m_.dofs()),
+        k_(m_.num_constraints()),
+        ops_(m_, N_ > opt.sparse_dofs_threshold),
+        Ec_(ops_.E_by_columns()),
+        theta_(opt.theta),
+        warm_pivot_(opt.lcp_solver == "pivot"),
+        grid_(StepGrid::of(*opt.t_end, opt.h)),
+        sampler_(opt.dt_out),
+        guard_(model, x0, *opt.t_end) {
+    tr_.method = "moreau-jean";
+    tr_.t_end = *opt.t_end;
+    tr_.impact_law = "moreau-restitution";  // the law inside the velocity LCP
+    q_ = x0.head(N_);
+    v_ = x0.tail(N_);
+    tr_.energy_initial = ops_.energy(q_, v_);
   }
-  const double theta = opt.theta;
-  const StepGrid grid = StepGrid::of(*opt.t_end, opt.h);
-  MjIteration F, F_last;
-  if (!F.factor(ops, grid.h, theta)) return fail("moreau-jean: " + F.message());
-  if (grid.h_last != grid.h && !F_last.factor(ops, grid.h_last, theta))
-    return fail("moreau-jean: last step: " + F_last.message());
-  const VectorXd e = m.restitution.size() == k ? m.restitution : VectorXd::Zero(k);
 
-  // Friction (issue 17): steps whose active set holds a frictional contact
-  // solve the friction LCP (mj_friction.hpp); the others are the
-  // frictionless step below, unchanged.
-  std::unique_ptr<MjFriction> friction;
-  if (m.has_friction()) friction = std::make_unique<MjFriction>(m, ops);
-  std::string friction_warning;
-  VectorXd lambda_T = VectorXd::Zero(m.has_friction() ? k : 0);
+  // The solver and the iteration matrices; false: failure_ says why.
+  bool set_up() {
+    try {
+      solver_ = lcp::make_solver(opt_.lcp_solver);
+    } catch (const std::exception& e) {
+      failure_ = std::string("moreau-jean: ") + e.what();
+      return false;
+    }
+    if (!F_.factor(ops_, grid_.h, theta_)) {
+      failure_ = "moreau-jean: " + F_.message();
+      return false;
+    }
+    if (grid_.h_last != grid_.h && !F_last_.factor(ops_, grid_.h_last, theta_)) {
+      failure_ = "moreau-jean: last step: " + F_last_.message();
+      return false;
+    }
+    return true;
+  }
+
+  // What the loop keeps, and the sample at t = 0.
+  void begin() {
+    e_ = m_.restitution.size() == k_ ? m_.restitution : VectorXd::Zero(k_);
+    // Friction (issue 17): steps whose active set holds a frictional contact
+    // solve the friction LCP (mj_friction.hpp); the others are the
+    // frictionless step, unchanged.
+    if (m_.has_friction()) friction_ = std::make_unique<MjFriction>(m_, ops_);
+    lambda_T_ = VectorXd::Zero(m_.has_friction() ? k_ : 0);
+    u_t_ = VectorXd::Zero(static_cast<Eigen::Index>(m_.friction.size()));
+    fmode_.assign(m_.friction.size(), FrictionMode::kOpen);
+    y_.resize(k_);
+    ops_.E_times(q_, y_);
+    y_ += m_.g;
+    if (k_ > 0) tr_.max_violation = std::min(0.0, y_.minCoeff());
+    u_ = VectorXd::Zero(k_);
+    record(0.0);
+    pgs_opt_.tolerance = kPgsTolerance;
+    pgs_opt_.max_iterations = kPgsMaxSweeps;
+    pos_.assign(k_, -1);
+    lambda_prev_ = VectorXd::Zero(k_);
+    rhs_.resize(N_);
+    dv_.resize(N_);
+    v_next_.resize(N_);
+    q_next_.resize(N_);
+    Ev_.resize(k_);
+    Evf_.resize(k_);
+  }
+
+  // Every step of the grid, or up to the first failure.
+  Trajectory march() {
+    for (long j = 1; j <= grid_.n; ++j) {
+      if (opt_.progress && j % Options::kProgressSteps == 0) opt_.progress(j * grid_.h);
+      if (!step(j)) return fail(failure_);
+    }
+    return finish();
+  }
+
+  Trajectory fail(const std::string& msg) {
+    tr_.status = RunStatus::kNumericalFailure;
+    tr_.message = msg;
+    return finish();
+  }
+  const std::string& failure() const { return failure_; }
+
+ private:
+  Trajectory finish() {
+    tr_.final_state.resize(2 * N_);
+    tr_.final_state << q_, v_;
+    tr_.energy_final = ops_.energy(q_, v_);
+    return std::move(tr_);  // only ever returned from the run: no copy of the samples
+  }
+
+  // Step j of the grid; false: failure_ says why.
+  bool step(long j) {
+    const bool last = j == grid_.n;
+    const double h = last ? grid_.h_last : grid_.h;
+    MjIteration& f = (last && grid_.h_last != grid_.h) ? F_last_ : F_;
+    const double t0 = (j - 1) * grid_.h;  // the step's start, for messages
+    free_velocity(f, h);
+    select_active(h);
+    clear_step_outputs();
+    if (!active_columns(f, h)) return false;
+    if (friction_ && friction_->any_in(A_)) {
+      if (!friction_step(f, h, t0)) return false;
+    } else if (!A_.empty()) {
+      if (!contact_step(f, h, t0)) return false;
+    }
+    return advance(j, last, h);
+  }
+
+  // v_next_ = v + h W^{-1} (f - D v - K (q + h theta v)): the free velocity.
+  void free_velocity(const MjIteration& f, double h) {
+    ops_.step_force(q_, v_, h, theta_, rhs_);
+    f.solve(rhs_, dv_);
+    v_next_ = v_ + h * dv_;  // v_free
+  }
+
+  // Active set: predicted gap E_i (q + h theta v) + g_i <= kActivationGap.
+  void select_active(double h) {
+    for (int i : A_) pos_[i] = -1;
+    A_.clear();
+    if (k_ > 0) {
+      ops_.E_times(v_, Ev_);
+      for (int i = 0; i < k_; ++i)
+        if (y_(i) + h * theta_ * Ev_(i) <= kActivationGap) {
+          pos_[i] = static_cast<int>(A_.size());
+          A_.push_back(i);
+        }
+    }
+  }
+
+  // The last step's forces and modes cleared; z_ the warm start (the last
+  // step's impulses on this step's active set).
+  void clear_step_outputs() {
+    for (int i : u_set_) u_(i) = 0.0;
+    if (friction_) {
+      lambda_T_.setZero();
+      u_t_.setZero();
+      std::fill(fmode_.begin(), fmode_.end(), FrictionMode::kOpen);
+    }
+    u_set_.clear();
+    mode_.clear();
+    z_.resize(static_cast<Eigen::Index>(A_.size()));  // warm start: last step's impulses
+    for (size_t a = 0; a < A_.size(); ++a) z_(static_cast<Eigen::Index>(a)) = lambda_prev_(A_[a]);
+    for (int i : A_prev_) lambda_prev_(i) = 0.0;  // set again below for this step's A
+    A_prev_ = A_;
+  }
+
+  // The columns W^{-1} E_a' of the active set, for either LCP.
+  bool active_columns(MjIteration& f, double h) {
+    const int na = static_cast<int>(A_.size());
+    cols_.resize(na);
+    for (int a = 0; a < na; ++a)
+      if (!f.column(A_[a], cols_[a])) {
+        failure_ = "moreau-jean: iteration matrix too ill-conditioned at h = " + short_number(h);
+        return false;
+      }
+    return true;
+  }
+
+  // The friction LCP over [E_A; T_F] (mj_friction.hpp); v_next_ becomes the
+  // post-step velocity.
+  bool friction_step(MjIteration& f, double h, double t0) {
+    if (!friction_->step(f, A_, cols_, Ev_, e_, *solver_, opt_.pivot_max_active, v_next_, z_,
+                         lambda_T_, tr_.lcp_solves, failed_, friction_warning_)) {
+      failure_ = lcp_failure("moreau-jean", t0, failed_);
+      return false;
+    }
+    if (!friction_warning_.empty()) {
+      tr_.warn("pgs-not-converged", t0, friction_warning_ + " at t = " + short_number(t0));
+      friction_warning_.clear();
+    }
+    for (size_t fi = 0; fi < m_.friction.size(); ++fi) {
+      const mech::FrictionalContact& fc = m_.friction[fi];
+      u_t_(static_cast<Eigen::Index>(fi)) = lambda_T_(fc.contact) / h;
+      if (const int p = pos_[static_cast<size_t>(fc.contact)]; p >= 0 && z_(p) > 0.0)
+        fmode_[fi] = friction_mode_after_step(fc, v_next_);
+    }
+    keep_impulses(h, false);
+    return true;
+  }
+
+  // The frictionless velocity LCP over the active set; its impulses added to
+  // v_next_.
+  bool contact_step(const MjIteration& f, double h, double t0) {
+    const int na = static_cast<int>(A_.size());
+    ops_.E_times(v_next_, Evf_);  // v_next is still v_free here
+    b_.resize(na);
+    for (int a = 0; a < na; ++a) b_(a) = Evf_(A_[a]) + e_(A_[a]) * Ev_(A_[a]);
+    const bool solved = na <= opt_.pivot_max_active ? solve_dense(f, na) : solve_sparse(na, t0);
+    if (!solved) {
+      failure_ = lcp_failure("moreau-jean", t0, failed_);
+      return false;
+    }
+    keep_impulses(h, true);
+    return true;
+  }
+
+  // Delassus matrix E_A W^{-1} E_A' from the cached columns W^{-1} E_a':
+  // entry (p, a) sums E_p,r (W^{-1} E_a')_r over the column's rows r in
+  // this order, dense or sparse alike.
+  template <class Add>
+  void for_each_delassus_entry(int na, Add&& add) const {
+    for (int a = 0; a < na; ++a)
+      for (SparseCol::InnerIterator it(*cols_[a], 0); it; ++it)
+        for (SparseCol::InnerIterator e_it(Ec_, static_cast<int>(it.row())); e_it; ++e_it) {
+          const int p = pos_[e_it.row()];
+          if (p >= 0) add(p, a, e_it.value() * it.value());
+        }
+  }
+
+  // Up to pivot_max_active rows: the dense Delassus matrix, kept while A and
+  // the iteration matrix stay, by the warm pivot, else the solver.
+  bool solve_dense(const MjIteration& f, int na) {
+    if (Gd_f_ != &f || Gd_A_ != A_) {
+      Gd_.setZero(na, na);
+      for_each_delassus_entry(na, [&](int p, int a, double x) { Gd_(p, a) += x; });
+      Gd_A_ = A_;
+      Gd_f_ = &f;
+      ++Gd_version_;
+    }
+    if (warm_pivot_) {
+      const lcp::Result& r = warm_.solve(Gd_, Gd_version_, b_, z_, lopt_);
+      if (r.ok()) {
+        z_ = r.z;
+        ++tr_.lcp_solves;
+        return true;
+      }
+    }
+    return solve_exact(Gd_);
+  }
+
+  // Above pivot_max_active rows: projected Gauss–Seidel on the sparse
+  // Delassus matrix, warm-started; the pivoting solver when it does not
+  // converge (up to kPivotFallbackMax rows; above, the iterate and a warning).
+  bool solve_sparse(int na, double t0) {
+    trip_.clear();
+    for_each_delassus_entry(na, [&](int p, int a, double x) { trip_.emplace_back(p, a, x); });
+    SparseRow G(na, na);
+    G.setFromTriplets(trip_.begin(), trip_.end());
+    pgs_opt_.warm_start = &z_;
+    lcp::Result r = lcp::solve_sparse_pgs(G, b_, pgs_opt_);
+    ++tr_.lcp_solves;
+    bool solved = r.ok() && all_finite(r.z);
+    if (!solved && na > kPivotFallbackMax && r.status == lcp::Status::kIterationLimit &&
+        all_finite(r.z)) {
+      tr_.warn("pgs-not-converged", t0,
+               "moreau-jean: PGS stopped at residual " + short_number(r.residual) + " after " +
+                   std::to_string(r.iterations) + " sweeps at t = " + short_number(t0));
+      solved = true;
+    }
+    if (solved) z_.swap(r.z);
+    return solved || solve_exact(MatrixXd(G));
+  }
+
+  // The step's LCP G z + b by the configured solver and its fallbacks
+  // (dependent constraints: pivoting fails, Lemke does not); false leaves the
+  // result in failed_.
+  bool solve_exact(const MatrixXd& G) {
+    int attempts = 0;
+    lcp::Result r = lcp::solve_with_fallbacks(*solver_, G, b_, lopt_, &attempts);
+    tr_.lcp_solves += attempts;
+    if (!r.ok()) {
+      failed_ = std::move(r);
+      return false;
+    }
+    z_ = r.z;
+    return true;
+  }
+
+  // The impulses z_ of the active set: the next step's warm start, the mode,
+  // the mean forces over the step; added to v_next_ when `apply` (the
+  // friction step has applied them itself).
+  void keep_impulses(double h, bool apply) {
+    const int na = static_cast<int>(A_.size());
+    for (int a = 0; a < na; ++a) {
+      lambda_prev_(A_[a]) = z_(a);
+      if (z_(a) > 0.0) {
+        if (apply)
+          for (SparseCol::InnerIterator it(*cols_[a], 0); it; ++it)
+            v_next_(it.row()) += it.value() * z_(a);
+        mode_.push_back(A_[a]);
+      }
+      u_(A_[a]) = z_(a) / h;  // mean force over the step
+      u_set_.push_back(A_[a]);
+    }
+  }
+
+  // q+ = q + h v_theta, the divergence guard, the state taken, the gaps and
+  // the sample.
+  bool advance(long j, bool last, double h) {
+    q_next_ = q_ + h * ((1.0 - theta_) * v_ + theta_ * v_next_);
+    if (std::string why = guard_.check(last ? *opt_.t_end : j * grid_.h, q_next_, v_next_, last);
+        !why.empty()) {
+      tr_.t_end = (j - 1) * grid_.h;  // the time reached: the last sane state's
+      failure_ = "moreau-jean: " + why;
+      return false;
+    }
+    q_.swap(q_next_);
+    v_.swap(v_next_);
+    ++tr_.steps;
+    if (k_ > 0) {
+      ops_.E_times(q_, y_);
+      y_ += m_.g;
+      tr_.max_violation = std::min(tr_.max_violation, std::min(0.0, y_.minCoeff()));
+    }
+    const double t = last ? *opt_.t_end : j * grid_.h;
+    if (sampler_.want(t, grid_.h, last)) record(t);
+    return true;
+  }
+
+  void record(double t) {
+    if (!opt_.record_samples) return;
+    Sample s;
+    s.t = t;
+    s.x.resize(2 * N_);
+    s.x << q_, v_;
+    s.u = u_;
+    s.y = y_;
+    s.mode = mode_;
+    if (friction_) {
+      s.u_t = u_t_;
+      s.friction_mode = fmode_;
+    }
+    tr_.record_sample(std::move(s), opt_);
+  }
+
+  const Options& opt_;
+  const mech::MechanicalModel& m_;
+  const int N_, k_;
+  const MjOperators ops_;
+  const SparseCol& Ec_;
+  const double theta_;
+  // The warm start reproduces the "pivot" solver's own computation
+  // (WarmPivot); other solvers are called on every step.
+  const bool warm_pivot_;
+  const StepGrid grid_;
+  OutputSampler sampler_;
+  DivergenceGuard guard_;
+  Trajectory tr_;
+  VectorXd q_, v_;
+  std::unique_ptr<lcp::Solver> solver_;
+  MjIteration F_, F_last_;
+  VectorXd e_;  // restitution per constraint
+  std::unique_ptr<MjFriction> friction_;
+  std::string friction_warning_;
+  VectorXd lambda_T_;
   // Mean friction force over the step (N), per entry of m.friction: the
   // samples' u_t.
-  VectorXd u_t = VectorXd::Zero(static_cast<Eigen::Index>(m.friction.size()));
+  VectorXd u_t_;
   // Their modes over the step (the samples' friction_mode): open unless the
   // normal impulse is positive; then stick when the sliding velocity at the
   // step's end is zero to rounding, else slip along its sign.
-  std::vector<FrictionMode> fmode(m.friction.size(), FrictionMode::kOpen);
-  OutputSampler sampler(opt.dt_out);
-  DivergenceGuard guard(model, x0, *opt.t_end);
-  auto record = [&](double t, const VectorXd& y, const VectorXd& uu, const IndexSet& mode) {
-    if (!opt.record_samples) return;
-    Sample s;
-    s.t = t;
-    s.x.resize(2 * N);
-    s.x << q, v;
-    s.u = uu;
-    s.y = y;
-    s.mode = mode;
-    if (friction) {
-      s.u_t = u_t;
-      s.friction_mode = fmode;
-    }
-    tr.record_sample(std::move(s), opt);
-  };
-  VectorXd y(k);
-  ops.E_times(q, y);
-  y += m.g;
-  if (k > 0) tr.max_violation = std::min(0.0, y.minCoeff());
-  VectorXd u = VectorXd::Zero(k);
-  record(0.0, y, u, {});
-
-  const SparseCol& Ec = ops.E_by_columns();
-  lcp::Options lopt;
-  lcp::Options pgs_opt;  // the sparse sweep for active sets above pivot_max_active
-  pgs_opt.tolerance = kPgsTolerance;
-  pgs_opt.max_iterations = kPgsMaxSweeps;
-  // The warm start reproduces the "pivot" solver's own computation (WarmPivot);
-  // other solvers are called on every step.
-  const bool warm_pivot = opt.lcp_solver == "pivot";
-  lcp::WarmPivot warm;
-  IndexSet A, A_prev, mode, u_set;
-  std::vector<int> pos(k, -1);               // position of constraint i in A, or -1
-  VectorXd lambda_prev = VectorXd::Zero(k);  // last step's impulses (warm start)
-  std::vector<const SparseCol*> cols;
-  std::vector<Eigen::Triplet<double>> trip;
+  std::vector<FrictionMode> fmode_;
+  VectorXd y_;  // gaps E q + g
+  VectorXd u_;  // mean contact forces over the step
+  lcp::Options lopt_;
+  lcp::Options pgs_opt_;  // the sparse sweep for active sets above pivot_max_active
+  lcp::WarmPivot warm_;
+  IndexSet A_, A_prev_, mode_, u_set_;
+  std::vector<int> pos_;  // position of constraint i in A, or -1
+  VectorXd lambda_prev_;  // last step's impulses (warm start)
+  std::vector<const SparseCol*> cols_;
+  std::vector<Eigen::Triplet<double>> trip_;
   // The dense Delassus matrix E_A W^{-1} E_A' of an active set of at most
   // pivot_max_active rows, kept while A and the iteration matrix stay.
-  MatrixXd Gd;
-  IndexSet Gd_A;
-  const MjIteration* Gd_f = nullptr;
-  long Gd_version = 0;
-  // v_next holds the free velocity v + h W^{-1} rhs until the impulses are added.
-  VectorXd rhs(N), dv(N), v_next(N), q_next(N), Ev(k), Evf(k), b, z;
-  // The step's LCP G z + b by the configured solver and its fallbacks
-  // (dependent constraints: pivoting fails, Lemke does not); false leaves the
-  // result in `failed`.
-  lcp::Result failed;
-  auto solve_exact = [&](const MatrixXd& G) {
-    int attempts = 0;
-    lcp::Result r = lcp::solve_with_fallbacks(*solver, G, b, lopt, &attempts);
-    tr.lcp_solves += attempts;
-    if (!r.ok()) {
-      failed = std::move(r);
-      return false;
-    }
-    z = r.z;
-    return true;
-  };
-  for (long j = 1; j <= grid.n; ++j) {
-    const bool last = j == grid.n;
-    if (opt.progress && j % Options::kProgressSteps == 0) opt.progress(j * grid.h);
-    const double h = last ? grid.h_last : grid.h;
-    MjIteration& f = (last && grid.h_last != grid.h) ? F_last : F;
-    ops.step_force(q, v, h, theta, rhs);
-    f.solve(rhs, dv);
-    v_next = v + h * dv;  // v_free
-    // Active set: predicted gap E_i (q + h theta v) + g_i <= kActivationGap.
-    for (int i : A) pos[i] = -1;
-    A.clear();
-    if (k > 0) {
-      ops.E_times(v, Ev);
-      for (int i = 0; i < k; ++i)
-        if (y(i) + h * theta * Ev(i) <= kActivationGap) {
-          pos[i] = static_cast<int>(A.size());
-          A.push_back(i);
-        }
-    }
-    for (int i : u_set) u(i) = 0.0;
-    if (friction) {
-      lambda_T.setZero();
-      u_t.setZero();
-      std::fill(fmode.begin(), fmode.end(), FrictionMode::kOpen);
-    }
-    u_set.clear();
-    mode.clear();
-    z.resize(static_cast<Eigen::Index>(A.size()));  // warm start: last step's impulses
-    for (size_t a = 0; a < A.size(); ++a) z(static_cast<Eigen::Index>(a)) = lambda_prev(A[a]);
-    for (int i : A_prev) lambda_prev(i) = 0.0;  // set again below for this step's A
-    A_prev = A;
-    // The columns W^{-1} E_a' of the active set, for either LCP below.
-    const int na = static_cast<int>(A.size());
-    cols.resize(na);
-    for (int a = 0; a < na; ++a)
-      if (!f.column(A[a], cols[a]))
-        return fail("moreau-jean: iteration matrix too ill-conditioned at h = " + short_number(h));
-    if (friction && friction->any_in(A)) {
-      if (!friction->step(f, A, cols, Ev, e, *solver, opt.pivot_max_active, v_next, z, lambda_T,
-                          tr.lcp_solves, failed, friction_warning))
-        return fail(lcp_failure("moreau-jean", (j - 1) * grid.h, failed));
-      if (!friction_warning.empty()) {
-        tr.warn("pgs-not-converged", (j - 1) * grid.h,
-                friction_warning + " at t = " + short_number((j - 1) * grid.h));
-        friction_warning.clear();
-      }
-      for (size_t fi = 0; fi < m.friction.size(); ++fi) {
-        const mech::FrictionalContact& fc = m.friction[fi];
-        u_t(static_cast<Eigen::Index>(fi)) = lambda_T(fc.contact) / h;
-        if (const int p = pos[static_cast<size_t>(fc.contact)]; p >= 0 && z(p) > 0.0)
-          fmode[fi] = friction_mode_after_step(fc, v_next);
-      }
-      for (int a = 0; a < na; ++a) {
-        lambda_prev(A[a]) = z(a);
-        if (z(a) > 0.0) mode.push_back(A[a]);
-        u(A[a]) = z(a) / h;
-        u_set.push_back(A[a]);
-      }
-    } else if (!A.empty()) {
-      ops.E_times(v_next, Evf);  // v_next is still v_free here
-      b.resize(na);
-      for (int a = 0; a < na; ++a) b(a) = Evf(A[a]) + e(A[a]) * Ev(A[a]);
-      // Delassus matrix E_A W^{-1} E_A' from the cached columns W^{-1} E_a':
-      // entry (p, a) sums E_p,r (W^{-1} E_a')_r over the column's rows r in
-      // this order, dense or sparse alike.
-      auto for_each_entry = [&](auto&& add) {
-        for (int a = 0; a < na; ++a)
-          for (SparseCol::InnerIterator it(*cols[a], 0); it; ++it)
-            for (SparseCol::InnerIterator e_it(Ec, static_cast<int>(it.row())); e_it; ++e_it) {
-              const int p = pos[e_it.row()];
-              if (p >= 0) add(p, a, e_it.value() * it.value());
-            }
-      };
-      bool solved = false;
-      if (na <= opt.pivot_max_active) {
-        if (Gd_f != &f || Gd_A != A) {
-          Gd.setZero(na, na);
-          for_each_entry([&](int p, int a, double x) { Gd(p, a) += x; });
-          Gd_A = A;
-          Gd_f = &f;
-          ++Gd_version;
-        }
-        if (warm_pivot) {
-          const lcp::Result& r = warm.solve(Gd, Gd_version, b, z, lopt);
-          if (r.ok()) {
-            z = r.z;
-            ++tr.lcp_solves;
-            solved = true;
-          }
-        }
-        if (!solved && !solve_exact(Gd))
-          return fail(lcp_failure("moreau-jean", (j - 1) * grid.h, failed));
-      } else {
-        trip.clear();
-        for_each_entry([&](int p, int a, double x) { trip.emplace_back(p, a, x); });
-        SparseRow G(na, na);
-        G.setFromTriplets(trip.begin(), trip.end());
-        pgs_opt.warm_start = &z;
-        lcp::Result r = lcp::solve_sparse_pgs(G, b, pgs_opt);
-        ++tr.lcp_solves;
-        solved = r.ok() && all_finite(r.z);
-        if (!solved && na > kPivotFallbackMax && r.status == lcp::Status::kIterationLimit &&
-            all_finite(r.z)) {
-          tr.warn("pgs-not-converged", (j - 1) * grid.h,
-                  "moreau-jean: PGS stopped at residual " + short_number(r.residual) + " after " +
-                      std::to_string(r.iterations) +
-                      " sweeps at t = " + short_number((j - 1) * grid.h));
-          solved = true;
-        }
-        if (solved) z.swap(r.z);
-        if (!solved && !solve_exact(MatrixXd(G)))
-          return fail(lcp_failure("moreau-jean", (j - 1) * grid.h, failed));
-      }
-      for (int a = 0; a < na; ++a) {
-        lambda_prev(A[a]) = z(a);
-        if (z(a) > 0.0) {
-          for (SparseCol::InnerIterator it(*cols[a], 0); it; ++it)
-            v_next(it.row()) += it.value() * z(a);
-          mode.push_back(A[a]);
-        }
-        u(A[a]) = z(a) / h;  // mean force over the step
-        u_set.push_back(A[a]);
-      }
-    }
-    q_next = q + h * ((1.0 - theta) * v + theta * v_next);
-    if (std::string why = guard.check(last ? *opt.t_end : j * grid.h, q_next, v_next, last);
-        !why.empty()) {
-      tr.t_end = (j - 1) * grid.h;  // the time reached: the last sane state's
-      return fail("moreau-jean: " + why);
-    }
-    q.swap(q_next);
-    v.swap(v_next);
-    ++tr.steps;
-    if (k > 0) {
-      ops.E_times(q, y);
-      y += m.g;
-      tr.max_violation = std::min(tr.max_violation, std::min(0.0, y.minCoeff()));
-    }
-    const double t = last ? *opt.t_end : j * grid.h;
-    if (sampler.want(t, grid.h, last)) record(t, y, u, mode);
-  }
-  return finish();
+  MatrixXd Gd_;
+  IndexSet Gd_A_;
+  const MjIteration* Gd_f_ = nullptr;
+  long Gd_version_ = 0;
+  // v_next_ holds the free velocity v + h W^{-1} rhs until the impulses are added.
+  VectorXd rhs_, dv_, v_next_, q_next_, Ev_, Evf_, b_, z_;
+  lcp::Result failed_;   // the failed LCP
+  std::string failure_;  // why the run ends
+};
+
+}  // namespace
+
+Trajectory run_moreau_jean(const mech::Model& model, const VectorXd& x0, const Options& opt) {
+  MjRun run(model, x0, opt);
+  if (!run.set_up()) return run.fail(run.failure());
+  run.begin();
+  return run.march();
 }
 
 }  // namespace lcsim::sim::detail
