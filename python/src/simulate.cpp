@@ -200,14 +200,10 @@ void bind_event(py::module_& m) {
   });
 }
 
-}  // namespace
+using RunClass = py::class_<Run, std::shared_ptr<Run>>;
 
-void bind_simulate(py::module_& m) {
-  bind_event(m);
-  py::class_<Run, std::shared_ptr<Run>> r(m, "Trajectory", R"(The result of lcsim.simulate.
-Samples as numpy arrays (t, x, u, y; q and v are views of x for mechanical models;
-at a jump two samples share t), events, status and diagnostics. A numerical failure
-is a status ('numerical failure', 'event limit', ...) with a message, not an exception.)");
+// Trajectory's samples: numpy arrays, one row per sample.
+void bind_samples(RunClass& r) {
   r.def_readonly("t", &Run::t, "Sample times (s), shape (n,).");
   r.def_readonly("u_t", &Run::u_t,
                  "Tangential multipliers of the frictional contacts (model order), shape "
@@ -222,6 +218,10 @@ is a status ('numerical failure', 'event limit', ...) with a message, not an exc
   r.def_readonly("y", &Run::y, "Gaps / outputs, shape (n, constraints); NaN where not recorded.");
   r.def_readonly("modes", &Run::modes,
                  "Modes, shape (n, constraints), bool: True where a constraint is active.");
+}
+
+// Trajectory's events, status and diagnostics: the library's sim::Trajectory.
+void bind_summary(RunClass& r) {
   r.def_property_readonly(
       "events", [](const Run& run) { return run.traj.events; }, "The recorded events.");
   r.def_property_readonly(
@@ -275,6 +275,10 @@ is a status ('numerical failure', 'event limit', ...) with a message, not an exc
       "wall_time_s", [](const Run& run) { return run.traj.wall_time_s; }, "Wall time (s).");
   r.def_property_readonly(
       "model", [](const Run& run) { return run.model; }, "The model that was run.");
+}
+
+// Trajectory's writers: what the CLI's `simulate --out` and `--json` write.
+void bind_writers(RunClass& r) {
   r.def(
       "to_csv",
       [](const Run& run, std::optional<std::filesystem::path> path) -> std::optional<std::string> {
@@ -297,6 +301,19 @@ is a status ('numerical failure', 'event limit', ...) with a message, not an exc
       py::arg("path") = py::none(),
       "The run summary as the CLI's `simulate --json` prints it (io::trajectory_json): "
       "written to `path`, or returned as text.");
+}
+
+}  // namespace
+
+void bind_simulate(py::module_& m) {
+  bind_event(m);
+  RunClass r(m, "Trajectory", R"(The result of lcsim.simulate.
+Samples as numpy arrays (t, x, u, y; q and v are views of x for mechanical models;
+at a jump two samples share t), events, status and diagnostics. A numerical failure
+is a status ('numerical failure', 'event limit', ...) with a message, not an exception.)");
+  bind_samples(r);
+  bind_summary(r);
+  bind_writers(r);
   m.def("simulate", &simulate, py::arg("model"), py::arg("x0") = py::none(),
         py::arg("t_end") = py::none(), py::arg("method") = "event", py::arg("h") = py::none(),
         py::arg("theta") = py::none(), py::arg("impact") = py::none(), py::arg("dt_out") = 0.0,
