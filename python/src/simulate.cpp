@@ -1,10 +1,10 @@
 // lcsim.simulate and lcsim.Trajectory: one run of the library
-// (sim::simulate), its samples streamed into buffers that numpy then owns,
-// so a long trajectory is stored once, never copied.
+// (app::run_model, as `lcsim simulate`), its samples streamed into buffers
+// that numpy then owns, so a long trajectory is stored once, never copied.
 #include <cmath>
 #include <cstdint>
 #include <exception>
-#include <lcsim/scene/linearisation.hpp>
+#include <lcsim/app/run.hpp>
 #include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <optional>
@@ -70,6 +70,8 @@ struct SampleBuffers {
 struct Run {
   ModelHandle model;
   sim::Trajectory traj;
+  // A scene's check of its linear model at the recorded states (app::run_model).
+  std::optional<scene::LinearisationCheck> linearisation;
   py::array_t<double> t, x, u, y;
   py::array_t<double> u_t;                  // tangential multipliers, n x frictional contacts
   py::array_t<std::int8_t> friction_modes;  // n x frictional contacts (SampleBuffers)
@@ -102,19 +104,9 @@ struct Run {
     for (py::ssize_t i = 0; i < t.shape(0); ++i) tr.samples.push_back(sample(i));
     return tr;
   }
-  // io::trajectory_json as the CLI's `simulate --json` prints it, with the
-  // scene's linearisation check over the recorded states.
+  // What the CLI's `simulate --json` prints (app::run_json).
   std::string json_text() const {
-    nlohmann::json j = io::trajectory_json(model->model, traj);
-    std::optional<scene::LinearisationCheck> lin;
-    if (model->scene) {
-      scene::LinearisationStates visited;  // as `lcsim simulate` thins them
-      for (py::ssize_t i = 0; i < t.shape(0); ++i) visited.add(sample(i).x);
-      lin = scene::check_linearisation(*model->scene, visited.states());
-    }
-    j["linearisation_error"] = lin ? nlohmann::json(lin->error) : nlohmann::json(nullptr);
-    j["linearisation_check"] = lin ? scene::to_json(*lin) : nlohmann::json(nullptr);
-    return j.dump(2) + "\n";
+    return app::run_json(model->model, traj, linearisation).dump(2) + "\n";
   }
 };
 
@@ -124,7 +116,10 @@ std::shared_ptr<Run> simulate(const ModelHandle& model, const std::optional<Vect
                               std::optional<std::string> impact, double dt_out,
                               std::optional<std::string> lcp_solver, bool force,
                               std::optional<double> max_output, const py::object& progress) {
-  sim::Options opt;
+  app::RunRequest req;
+  req.method = method;
+  req.x0 = x0;  // unset: the model's
+  sim::Options& opt = req.options;
   opt.t_end = t_end;
   opt.dt_out = dt_out;
   if (h) opt.h = *h;
@@ -142,7 +137,7 @@ std::shared_ptr<Run> simulate(const ModelHandle& model, const std::optional<Vect
       8.0 * (1 + model->model.state_size() + 2 * model->model.num_constraints());
   if (dt_out > 0.0 && horizon > 0.0 && horizon / dt_out * row_bytes < 64e6)
     buf.reserve(static_cast<std::size_t>(horizon / dt_out) + 16);
-  opt.sample_sink = [&buf](const sim::Sample& s) { buf.add(s); };
+  req.sample_sink = [&buf](const sim::Sample& s) { buf.add(s); };
   std::exception_ptr progress_error;
   if (!progress.is_none())
     opt.progress = [&progress, &progress_error](double t) {
@@ -158,8 +153,9 @@ std::shared_ptr<Run> simulate(const ModelHandle& model, const std::optional<Vect
   run->model = model;
   {
     py::gil_scoped_release release;
-    run->traj = x0 ? sim::simulate(model->model, *x0, opt, method)
-                   : sim::simulate(model->model, opt, method);  // the model's x0
+    app::ModelRun r = app::run_model(*model, req);
+    run->traj = std::move(r.trajectory);
+    run->linearisation = std::move(r.linearisation);
   }
   if (progress_error) std::rethrow_exception(progress_error);
   if (run->traj.status == sim::RunStatus::kInvalidInput) throw io::InputError(run->traj.message);
@@ -204,14 +200,10 @@ void bind_event(py::module_& m) {
   });
 }
 
-}  // namespace
+using RunClass = py::class_<Run, std::shared_ptr<Run>>;
 
-void bind_simulate(py::module_& m) {
-  bind_event(m);
-  py::class_<Run, std::shared_ptr<Run>> r(m, "Trajectory", R"(The result of lcsim.simulate.
-Samples as numpy arrays (t, x, u, y; q and v are views of x for mechanical models;
-at a jump two samples share t), events, status and diagnostics. A numerical failure
-is a status ('numerical failure', 'event limit', ...) with a message, not an exception.)");
+// Trajectory's samples: numpy arrays, one row per sample.
+void bind_samples(RunClass& r) {
   r.def_readonly("t", &Run::t, "Sample times (s), shape (n,).");
   r.def_readonly("u_t", &Run::u_t,
                  "Tangential multipliers of the frictional contacts (model order), shape "
@@ -226,6 +218,10 @@ is a status ('numerical failure', 'event limit', ...) with a message, not an exc
   r.def_readonly("y", &Run::y, "Gaps / outputs, shape (n, constraints); NaN where not recorded.");
   r.def_readonly("modes", &Run::modes,
                  "Modes, shape (n, constraints), bool: True where a constraint is active.");
+}
+
+// Trajectory's events, status and diagnostics: the library's sim::Trajectory.
+void bind_summary(RunClass& r) {
   r.def_property_readonly(
       "events", [](const Run& run) { return run.traj.events; }, "The recorded events.");
   r.def_property_readonly(
@@ -279,6 +275,10 @@ is a status ('numerical failure', 'event limit', ...) with a message, not an exc
       "wall_time_s", [](const Run& run) { return run.traj.wall_time_s; }, "Wall time (s).");
   r.def_property_readonly(
       "model", [](const Run& run) { return run.model; }, "The model that was run.");
+}
+
+// Trajectory's writers: what the CLI's `simulate --out` and `--json` write.
+void bind_writers(RunClass& r) {
   r.def(
       "to_csv",
       [](const Run& run, std::optional<std::filesystem::path> path) -> std::optional<std::string> {
@@ -301,6 +301,19 @@ is a status ('numerical failure', 'event limit', ...) with a message, not an exc
       py::arg("path") = py::none(),
       "The run summary as the CLI's `simulate --json` prints it (io::trajectory_json): "
       "written to `path`, or returned as text.");
+}
+
+}  // namespace
+
+void bind_simulate(py::module_& m) {
+  bind_event(m);
+  RunClass r(m, "Trajectory", R"(The result of lcsim.simulate.
+Samples as numpy arrays (t, x, u, y; q and v are views of x for mechanical models;
+at a jump two samples share t), events, status and diagnostics. A numerical failure
+is a status ('numerical failure', 'event limit', ...) with a message, not an exception.)");
+  bind_samples(r);
+  bind_summary(r);
+  bind_writers(r);
   m.def("simulate", &simulate, py::arg("model"), py::arg("x0") = py::none(),
         py::arg("t_end") = py::none(), py::arg("method") = "event", py::arg("h") = py::none(),
         py::arg("theta") = py::none(), py::arg("impact") = py::none(), py::arg("dt_out") = 0.0,

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <lcsim/app/run.hpp>
 #include <lcsim/app/sweep.hpp>
 #include <lcsim/impact/impact.hpp>
 #include <lcsim/io/io.hpp>
@@ -141,11 +142,6 @@ double timed(const sim::Integrator& integ, const mech::Model& model, const Eigen
   std::vector<double> times;
   for (int r = 0; r < repeat; ++r) times.push_back(integ.run(model, x0, opt).wall_time_s);
   return median(times);
-}
-
-// The comparison grid of a step h: a multiple of h, at most ~2000 points.
-double comparison_grid(double t_end, double h) {
-  return std::max(1.0, std::round(t_end / (2000.0 * h))) * h;
 }
 
 // A stepping run compared as it goes (Options::sample_sink, every step):

@@ -18,7 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
-#include <lcsim/app/sweep.hpp>
+#include <lcsim/app/run.hpp>
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
 #include <lcsim/scene/linearisation.hpp>
@@ -29,6 +29,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/command.hpp"
+#include "cli/flag_names.hpp"
 #include "cli/output.hpp"
 #include "cli/run_inputs.hpp"
 
@@ -87,97 +88,59 @@ void print_friction(const mech::Model& model, const CompareArgs& a,
               c.min_contact_points);
 }
 
-void run_compare(const CompareArgs& a) {
-  const scene::LoadedModel loaded = scene::load_model_and_scene(a.model);
-  const mech::Model& model = loaded.model;
-  const bool friction = model.is_mechanical() && !model.mechanical->friction.empty();
-  if (!friction) bullet::check_expressible(model);  // invalid_argument naming it: exit 2
-  const Eigen::VectorXd x0 = resolve_initial_state(model, a.model, a.x0);
-  sim::Options opt;
-  opt.t_end = resolve_horizon(model, a.model, a.t_end_given, a.t_end);
-  opt.h = a.h;  // checked by the runs (sim::check_run)
-  // Comparison grid: a multiple of h, at most ~2000 points (as lcsim sweep);
-  // left at 0 for an h the runs will refuse.
-  if (std::isfinite(a.h) && a.h > 0.0)
-    opt.dt_out = std::max(1.0, std::round(*opt.t_end / (2000.0 * a.h))) * a.h;
+// What is printed of Bullet's run beside the comparison.
+struct BulletRun {
+  const sim::Trajectory& trajectory;
+  std::string solver;  // bullet::solver_description
+  double stop_erp = 0.0;
+  double t_end = 0.0;  // the horizon (s)
+  double per_step() const {
+    return trajectory.steps ? trajectory.wall_time_s / trajectory.steps : 0.0;
+  }
+};
 
-  // Like with like (issue 13): Bullet loses restitution at the scene's stop
-  // ERP, so its exact counterpart is the nearest exact law (sim::reference_law).
-  const sim::ReferenceLaw law = sim::reference_law("bullet", opt.impact, model);
-  const sim::Trajectory exact = sim::run_reference(model, x0, law, opt);
-  check_status(exact.status, "compare: the exact event-driven run failed: " + exact.message);
-  // A scene's linear model checked at the exact run's states, as `simulate`
-  // checks its run (scene::check_linearisation, default threshold).
-  if (loaded.scene) {
-    scene::LinearisationStates visited;
-    for (const auto& s : exact.samples) visited.add(s.x);
-    const std::string w =
-        scene::linearisation_warning(scene::check_linearisation(*loaded.scene, visited.states()),
-                                     scene::kLinearisationThreshold);
-    if (!w.empty()) std::cerr << "lcsim: warning: " << w << "\n";
-  }
-  if (friction) {
-    bullet::FrictionBoxSettings fs;
-    fs.h = a.h;
-    fs.solver_iterations = a.iterations;
-    const bullet::FrictionComparison c =
-        bullet::compare_friction_box(model, x0, exact, fs, 1e-9 * a.h);
-    check_status(c.status, "compare: " + c.message);
-    print_friction(model, a, c);
-    return;
-  }
-  bullet::WorldSettings ws;
-  ws.stop_erp = a.stop_erp;
-  ws.solver_iterations = a.iterations;
-  if (std::string why = bullet::settings_error(ws); !why.empty()) throw io::InputError(why);
-  const std::string bullet_solver = bullet::solver_description(model, ws);
-  const sim::Trajectory bt = bullet::simulate_bullet(model, x0, opt, ws);
-  check_status(bt.status, "compare: the Bullet run failed: " + bt.message);
-  const bullet::Comparison c = bullet::compare_trajectories(exact, bt, 1e-9 * a.h);
-  // What the Bullet scene does differently (lost restitution, explicit
-  // springs, a scene run as rb6), as `simulate` prints it.
-  print_warnings(bt);
-  const double per_step = bt.steps ? bt.wall_time_s / bt.steps : 0.0;
+void print_comparison_json(const mech::Model& model, const CompareArgs& a, const BulletRun& bt,
+                           const sim::ReferenceLaw& law, const bullet::Comparison& c) {
+  nlohmann::json j;
+  j["model"] = model.name;
+  j["h"] = a.h;
+  j["t_end"] = bt.t_end;
+  j["deviation_max"] = num(c.deviation_max);
+  j["deviation_t"] = c.deviation_t;
+  j["error_final"] = num(c.error_final);
+  nlohmann::json shifts = nlohmann::json::array();
+  for (const auto& s : c.event_shifts)
+    shifts.push_back({{"constraint", model.mechanical->constraints[s.constraint]},
+                      {"kind", s.activation ? "activation" : "release"},
+                      {"t_exact", s.t_exact},
+                      {"t_bullet", num(s.t_other)},
+                      {"shift", num(s.shift)}});
+  j["event_shifts"] = std::move(shifts);
+  j["unmatched_bullet_switches"] = c.unmatched_other;
+  j["energy_drift"] = c.energy_drift;
+  j["max_violation"] = c.max_violation;
+  j["reference_law"] = law.label();
+  j["reference_reason"] = law.reason;
+  j["bullet_solver"] = bt.solver;
+  j["stop_erp"] = bt.stop_erp;
+  j["bullet_version"] = bullet::version_string();
+  j["steps"] = bt.trajectory.steps;
+  j["wall_time_per_step_s"] = bt.per_step();
+  std::printf("%s\n", j.dump(2).c_str());
+}
 
-  if (a.json) {
-    nlohmann::json j;
-    j["model"] = model.name;
-    j["h"] = a.h;
-    j["t_end"] = *opt.t_end;
-    j["deviation_max"] = num(c.deviation_max);
-    j["deviation_t"] = c.deviation_t;
-    j["error_final"] = num(c.error_final);
-    nlohmann::json shifts = nlohmann::json::array();
-    for (const auto& s : c.event_shifts)
-      shifts.push_back({{"constraint", model.mechanical->constraints[s.constraint]},
-                        {"kind", s.activation ? "activation" : "release"},
-                        {"t_exact", s.t_exact},
-                        {"t_bullet", num(s.t_other)},
-                        {"shift", num(s.shift)}});
-    j["event_shifts"] = std::move(shifts);
-    j["unmatched_bullet_switches"] = c.unmatched_other;
-    j["energy_drift"] = c.energy_drift;
-    j["max_violation"] = c.max_violation;
-    j["reference_law"] = law.label();
-    j["reference_reason"] = law.reason;
-    j["bullet_solver"] = bullet_solver;
-    j["stop_erp"] = ws.stop_erp;
-    j["bullet_version"] = bullet::version_string();
-    j["steps"] = bt.steps;
-    j["wall_time_per_step_s"] = per_step;
-    std::printf("%s\n", j.dump(2).c_str());
-    return;
-  }
+void print_comparison_text(const mech::Model& model, const CompareArgs& a, const BulletRun& bt,
+                           const sim::ReferenceLaw& law, const bullet::Comparison& c) {
   // The scene's own ERP (rb6's stop ERP, the multibody's limit ERP) is in
   // bullet_solver.
-  std::printf("model %s, t_end %g, h %g: %s, %s\n", model.name.c_str(), *opt.t_end, a.h,
-              bullet::version_string().c_str(), bullet_solver.c_str());
+  std::printf("model %s, t_end %g, h %g: %s, %s\n", model.name.c_str(), bt.t_end, a.h,
+              bullet::version_string().c_str(), bt.solver.c_str());
   std::printf("reference      exact run, %s (%s)\n", law.label().c_str(), law.reason.c_str());
   std::printf("deviation max  %.3e (at t = %.6g)\n", c.deviation_max, c.deviation_t);
   std::printf("error final    %.3e\n", c.error_final);
   std::printf("energy drift   %.3e J (Bullet's change minus the exact change)\n", c.energy_drift);
   std::printf("max violation  %.3e\n", c.max_violation);
-  std::printf("time per step  %.3g s (%ld steps)\n", per_step, bt.steps);
+  std::printf("time per step  %.3g s (%ld steps)\n", bt.per_step(), bt.trajectory.steps);
   std::printf("event shifts (t_bullet - t_exact):\n");
   for (const auto& s : c.event_shifts) {
     std::printf("  %-10s %-10s t_exact %-14.9g ",
@@ -190,6 +153,80 @@ void run_compare(const CompareArgs& a) {
   }
   if (c.unmatched_other)
     std::printf("  (%d Bullet switches match no exact switch)\n", c.unmatched_other);
+}
+
+// The runs' options: the horizon, Bullet's h, and the comparison grid (left
+// at 0 for an h the runs will refuse; h is checked by them, sim::check_run).
+sim::Options compare_options(const CompareArgs& a, const mech::Model& model) {
+  sim::Options opt;
+  opt.t_end = resolve_horizon(model, a.model, a.t_end_given, a.t_end);
+  opt.h = a.h;
+  if (std::isfinite(a.h) && a.h > 0.0) opt.dt_out = app::comparison_grid(*opt.t_end, a.h);
+  return opt;
+}
+
+// One run of the pair (app::run_model), its samples on the comparison grid
+// kept for the pairing; exits (check_status) unless it completed.
+sim::Trajectory compare_run(const scene::LoadedModel& loaded, app::RunRequest req,
+                            const std::string& what) {
+  req.keep_samples = true;
+  app::ModelRun run = app::run_model(loaded, req);
+  check_status(run.trajectory.status,
+               "compare: the " + what + " run failed: " + with_flag_names(run.trajectory.message));
+  // A scene's linear model checked at the run's states, as `simulate`
+  // checks its run (default threshold).
+  if (!run.linearisation_warning.empty())
+    std::cerr << "lcsim: warning: " << run.linearisation_warning << "\n";
+  return std::move(run.trajectory);
+}
+
+// Bullet's run on the comparison grid, paired with the exact run.
+void compare_bullet(const scene::LoadedModel& loaded, const CompareArgs& a, app::RunRequest req,
+                    const sim::ReferenceLaw& law, const sim::Trajectory& exact) {
+  const mech::Model& model = loaded.model;
+  bullet::WorldSettings ws;
+  ws.stop_erp = a.stop_erp;
+  ws.solver_iterations = a.iterations;
+  if (std::string why = bullet::settings_error(ws); !why.empty()) throw io::InputError(why);
+  const std::string bullet_solver = bullet::solver_description(model, ws);
+  req.runner = [&ws](const mech::Model& m, const Eigen::VectorXd& x0, const sim::Options& opt) {
+    return bullet::simulate_bullet(m, x0, opt, ws);
+  };
+  req.check_linearisation = false;  // the exact run's states are checked
+  const sim::Trajectory bt = compare_run(loaded, req, "Bullet");
+  const bullet::Comparison c = bullet::compare_trajectories(exact, bt, 1e-9 * a.h);
+  // What the Bullet scene does differently (lost restitution, explicit
+  // springs, a scene run as rb6), as `simulate` prints it.
+  print_warnings(bt);
+  const BulletRun run{bt, bullet_solver, ws.stop_erp, *req.options.t_end};
+  if (a.json)
+    print_comparison_json(model, a, run, law, c);
+  else
+    print_comparison_text(model, a, run, law, c);
+}
+
+void run_compare(const CompareArgs& a) {
+  const scene::LoadedModel loaded = scene::load_model_and_scene(a.model);
+  const mech::Model& model = loaded.model;
+  const bool friction = model.is_mechanical() && !model.mechanical->friction.empty();
+  if (!friction) bullet::check_expressible(model);  // invalid_argument naming it: exit 2
+  app::RunRequest req;
+  req.x0 = resolve_initial_state(model, a.model, a.x0);
+  req.options = compare_options(a, model);
+  // Like with like (issue 13): Bullet loses restitution at the scene's stop
+  // ERP, so its exact counterpart is the nearest exact law (sim::reference_law).
+  const sim::ReferenceLaw law = sim::reference_law("bullet", req.options.impact, model);
+  app::RunRequest exact_req = req;
+  exact_req.runner = app::reference_runner(law);
+  const sim::Trajectory exact = compare_run(loaded, exact_req, "exact event-driven");
+  if (!friction) return compare_bullet(loaded, a, req, law, exact);
+  bullet::FrictionBoxSettings fs;
+  fs.h = a.h;
+  fs.solver_iterations = a.iterations;
+  const bullet::FrictionComparison c =
+      bullet::compare_friction_box(model, *req.x0, exact, fs, 1e-9 * a.h);
+  check_status(c.status, "compare: " + c.message);
+  print_friction(model, a, c);
 }
 
 void setup(CLI::App& app) {

@@ -2,6 +2,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <lcsim/app/run.hpp>
 #include <lcsim/impact/impact.hpp>
 #include <lcsim/io/io.hpp>
 #include <lcsim/scene/linearisation.hpp>
@@ -9,6 +10,7 @@
 #include <lcsim/sim/sim.hpp>
 #include <memory>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 #include "cli/command.hpp"
@@ -101,79 +103,72 @@ void print_summary(const SimulateArgs& a, const mech::Model& model, const sim::T
   if (written) std::printf("trajectory written to %s\n", a.out.c_str());
 }
 
+// --project: an infeasible q0 moved onto E q + g >= 0 (documented in README:
+// positions move to the nearest feasible ones in the kinetic metric;
+// velocities are kept).
+void project_start(const mech::Model& model, Eigen::VectorXd& x0) {
+  if (!model.is_mechanical() || sim::infeasible_start(model, x0).empty()) return;
+  const mech::MechanicalModel& m = *model.mechanical;
+  const Eigen::VectorXd q = x0.head(m.dofs());
+  const Eigen::VectorXd p = mech::project_feasible(m, q);
+  const double moved = std::sqrt((p - q).dot(m.M * (p - q)));
+  x0.head(m.dofs()) = p;
+  std::cerr << "lcsim: note: --project moved the initial positions onto E q + g >= 0 "
+            << "(kinetic-metric distance " << moved << ")\n";
+}
+
+// The library names fields; the user typed flags. linearisation_threshold is
+// not in flag_names.cpp's table yet (the lead adds it there; then this is
+// with_flag_names alone).
+std::string flag_text(std::string message) {
+  constexpr std::string_view field = "linearisation_threshold";
+  if (message.rfind(field, 0) == 0) message.replace(0, field.size(), "--linearisation-threshold");
+  return with_flag_names(message);
+}
+
 void run_simulate(const SimulateArgs& a) {
-  scene::check_linearisation_threshold(a.linearisation_threshold);
-  const scene::LoadedModel loaded = scene::load_model_and_scene(a.model);
-  const std::optional<scene::Scene>& scene = loaded.scene;
-  const mech::Model& model = loaded.model;
-  if (scene)  // what loading repaired (balance_inertia)
-    for (const auto& n : scene->notes) std::cerr << "lcsim: note: " << n << "\n";
-  auto integrator = sim::make_integrator(a.method);
-
-  Eigen::VectorXd x0 = resolve_initial_state(model, a.model, a.x0);
-  if (a.project && model.is_mechanical() && !sim::infeasible_start(model, x0).empty()) {
-    // Documented in README: positions move to the nearest feasible ones in
-    // the kinetic metric; velocities are kept.
-    const mech::MechanicalModel& m = *model.mechanical;
-    const Eigen::VectorXd q = x0.head(m.dofs());
-    const Eigen::VectorXd p = mech::project_feasible(m, q);
-    const double moved = std::sqrt((p - q).dot(m.M * (p - q)));
-    x0.head(m.dofs()) = p;
-    std::cerr << "lcsim: note: --project moved the initial positions onto E q + g >= 0 "
-              << "(kinetic-metric distance " << moved << ")\n";
+  try {  // checked first, before the model is read
+    scene::check_linearisation_threshold(a.linearisation_threshold);
+  } catch (const io::InputError& e) {
+    throw io::InputError(flag_text(e.what()));
   }
-  sim::Options opt = run_options(a, model);
-  // Samples feed only the CSV, streamed to disk as the run goes, and a
-  // scene's check of its linear model (scene::check_linearisation) at the
-  // visited states, thinned as they pass: nothing is kept in
-  // Trajectory::samples. Without --out a scene's states are taken on a grid
-  // of scene::kLinearisationStates points unless an output grid was asked for.
-  opt.record_samples = !a.out.empty() || scene.has_value();
-  if (scene && opt.dt_out == 0.0 && a.out.empty())
-    opt.dt_out = *opt.t_end / static_cast<double>(scene::kLinearisationStates);
-  // An unwritable --out fails now, not after the run.
-  std::optional<io::TrajectoryCsvWriter> csv;
-  if (!a.out.empty()) csv.emplace(a.out, model);
-  scene::LinearisationStates visited;
-  if (opt.record_samples)
-    opt.sample_sink = [&csv, &visited, &scene](const sim::Sample& s) {
-      if (csv) csv->write(s);
-      if (scene) visited.add(s.x);
-    };
-
-  ProgressLine progress(*opt.t_end, a.no_progress ? ProgressLine::Mode::kNever
-                                    : a.progress  ? ProgressLine::Mode::kAlways
-                                                  : ProgressLine::Mode::kAuto);
-  opt.progress = [&progress](double t) { progress.update(t); };
-  const sim::Trajectory tr = integrator->run(model, x0, opt);
-  if (const std::string note = impact::laws().alias_note(opt.impact);
-      !note.empty() && !tr.impact_law.empty())
-    std::cerr << "lcsim: note: " << note << "\n";
+  const scene::LoadedModel loaded = scene::load_model_and_scene(a.model);
+  const mech::Model& model = loaded.model;
+  if (loaded.scene)  // what loading repaired (balance_inertia)
+    for (const auto& n : loaded.scene->notes) std::cerr << "lcsim: note: " << n << "\n";
+  (void)sim::make_integrator(a.method);  // an unknown method before the state
+  app::RunRequest req;
+  req.method = a.method;
+  req.x0 = resolve_initial_state(model, a.model, a.x0);
+  if (a.project) project_start(model, *req.x0);
+  req.options = run_options(a, model);
+  req.csv_path = a.out;
+  req.linearisation_threshold = a.linearisation_threshold;
+  std::optional<ProgressLine> progress;  // started with the run, once --out is open
+  req.on_start = [&progress, &a, t_end = *req.options.t_end] {
+    progress.emplace(t_end, a.no_progress ? ProgressLine::Mode::kNever
+                            : a.progress  ? ProgressLine::Mode::kAlways
+                                          : ProgressLine::Mode::kAuto);
+  };
+  req.options.progress = [&progress](double t) { progress->update(t); };
+  const app::ModelRun run = app::run_model(loaded, req);
+  const sim::Trajectory& tr = run.trajectory;
+  if (!run.impact_note.empty()) std::cerr << "lcsim: note: " << run.impact_note << "\n";
   // A refused run integrated nothing: the error line is all there is to say.
   if (tr.status == sim::RunStatus::kInvalidInput) {
-    if (!a.project && model.is_mechanical() && !sim::infeasible_start(model, x0).empty())
+    if (!a.project && model.is_mechanical() && !sim::infeasible_start(model, *req.x0).empty())
       std::cerr << "lcsim: hint: --project starts from the nearest feasible positions\n";
-    check_status(tr.status, with_flag_names(tr.message));
+    check_status(tr.status, flag_text(tr.message));
   }
-  if (tr.status == sim::RunStatus::kCompleted) progress.done();
-  const bool failed = tr.status != sim::RunStatus::kCompleted;
-  if (!failed && csv) csv->commit();
-  std::optional<scene::LinearisationCheck> lin;
-  if (scene) lin = scene::check_linearisation(*scene, visited.states());
-  if (a.json) {
-    nlohmann::json j = io::trajectory_json(model, tr);
-    j["linearisation_error"] = lin ? nlohmann::json(lin->error) : nlohmann::json(nullptr);
-    j["linearisation_check"] = lin ? scene::to_json(*lin) : nlohmann::json(nullptr);
-    std::cout << j.dump(2) << "\n";
-  } else {
-    print_summary(a, model, tr, lin, csv && !failed);
-  }
-  if (lin) {
-    const std::string w = scene::linearisation_warning(*lin, a.linearisation_threshold);
-    if (!w.empty()) std::cerr << "lcsim: warning: " << w << "\n";
-  }
+  if (tr.status == sim::RunStatus::kCompleted) progress->done();
+  if (a.json)
+    std::cout << app::run_json(model, tr, run.linearisation).dump(2) << "\n";
+  else
+    print_summary(a, model, tr, run.linearisation, run.csv_written);
+  if (!run.linearisation_warning.empty())
+    std::cerr << "lcsim: warning: " << run.linearisation_warning << "\n";
   print_warnings(tr);
-  check_status(tr.status, with_flag_names(tr.message));
+  check_status(tr.status, flag_text(tr.message));
 }
 
 void setup(CLI::App& app) {

@@ -57,7 +57,7 @@ struct Evaluator {
 
 void check_linearisation_threshold(double threshold) {
   if (!(threshold > 0.0) || !std::isfinite(threshold))
-    throw InputError("linearisation threshold: must be a finite number > 0 (got " +
+    throw InputError("linearisation_threshold must be a finite number > 0 (got " +
                      format_number(threshold) + ")");
 }
 

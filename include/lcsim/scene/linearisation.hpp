@@ -44,8 +44,8 @@ LinearisationCheck check_linearisation(const Scene& scene, const std::vector<Vec
 // The states of a run as they stream by (sim::Options::sample_sink), thinned
 // so that at most 2 * kLinearisationStates are kept, evenly spaced, plus the
 // last: what check_linearisation evaluates, in bounded memory however long
-// the run. The command line and the Python module check a scene's run with
-// it, so both report the same check.
+// the run. app::run_model checks a scene's run with it, for the command
+// line and the Python module alike.
 class LinearisationStates {
  public:
   void add(const VectorXd& x);
@@ -58,7 +58,8 @@ class LinearisationStates {
 };
 
 // "" when check.error <= threshold, else the warning line. InputError
-// ("--linearisation-threshold: ...") unless threshold is finite and > 0.
+// ("linearisation_threshold must be ...", naming the field, as the options'
+// messages do) unless threshold is finite and > 0.
 std::string linearisation_warning(const LinearisationCheck& check, double threshold);
 void check_linearisation_threshold(double threshold);
 
