@@ -24,7 +24,11 @@ struct AnalyzeArgs {
 };
 
 void run_analyze(const AnalyzeArgs& args) {
-  app::check_analysis_options(args.options);  // before the model is read, as the flags are
+  try {  // before the model is read, as the flags are
+    app::check_analysis_options(args.options);
+  } catch (const io::InputError& e) {
+    throw io::InputError(with_flag_names(e.what(), analyze_flags()));
+  }
   if (!args.model_out.empty()) check_writable(args.model_out);
   const scene::LoadedModel loaded = scene::load_model_and_scene(args.file);
   const app::AnalysisReport report = app::analysis_report(loaded, args.options);

@@ -117,20 +117,11 @@ void project_start(const mech::Model& model, Eigen::VectorXd& x0) {
             << "(kinetic-metric distance " << moved << ")\n";
 }
 
-// The library names fields; the user typed flags. linearisation_threshold is
-// not in flag_names.cpp's table yet (the lead adds it there; then this is
-// with_flag_names alone).
-std::string flag_text(std::string message) {
-  constexpr std::string_view field = "linearisation_threshold";
-  if (message.rfind(field, 0) == 0) message.replace(0, field.size(), "--linearisation-threshold");
-  return with_flag_names(message);
-}
-
 void run_simulate(const SimulateArgs& a) {
   try {  // checked first, before the model is read
     scene::check_linearisation_threshold(a.linearisation_threshold);
   } catch (const io::InputError& e) {
-    throw io::InputError(flag_text(e.what()));
+    throw io::InputError(with_flag_names(e.what()));
   }
   const scene::LoadedModel loaded = scene::load_model_and_scene(a.model);
   const mech::Model& model = loaded.model;
@@ -158,7 +149,7 @@ void run_simulate(const SimulateArgs& a) {
   if (tr.status == sim::RunStatus::kInvalidInput) {
     if (!a.project && model.is_mechanical() && !sim::infeasible_start(model, *req.x0).empty())
       std::cerr << "lcsim: hint: --project starts from the nearest feasible positions\n";
-    check_status(tr.status, flag_text(tr.message));
+    check_status(tr.status, with_flag_names(tr.message));
   }
   if (tr.status == sim::RunStatus::kCompleted) progress->done();
   if (a.json)
@@ -168,7 +159,7 @@ void run_simulate(const SimulateArgs& a) {
   if (!run.linearisation_warning.empty())
     std::cerr << "lcsim: warning: " << run.linearisation_warning << "\n";
   print_warnings(tr);
-  check_status(tr.status, flag_text(tr.message));
+  check_status(tr.status, with_flag_names(tr.message));
 }
 
 void setup(CLI::App& app) {

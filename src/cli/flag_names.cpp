@@ -18,11 +18,15 @@ constexpr FieldFlag kSimulateFlags[] = {
     {"Options::force", "--force"},
     {"Options::h", "--h"},
     {"max_output_bytes", "--max-output"},
+    {"linearisation_threshold", "--linearisation-threshold"},
     {"dt_out", "--dt-out"},
 };
 
 // The report's text says "full = true prints it" (app/analysis.hpp).
-constexpr FieldFlag kAnalyzeFlags[] = {{"full = true", "--full"}};
+constexpr FieldFlag kAnalyzeFlags[] = {
+    {"full = true", "--full"},
+    {"linearisation_threshold", "--linearisation-threshold"},
+};
 
 // app::ImpactsRequest's fields, as its messages name them.
 constexpr FieldFlag kImpactsFlags[] = {
