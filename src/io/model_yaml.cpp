@@ -1,5 +1,5 @@
-// Model files and LCP files (YAML, through yaml-cpp), and vectors given on the
-// command line. Format: docs/model-format.md. All validation happens here, so
+// Model files (YAML, through yaml-cpp), and vectors given on the command
+// line. Format: docs/model-format.md. All validation happens here, so
 // the layers below may assume well-formed models; every error names the file,
 // the key and the offending value.
 #include <yaml-cpp/yaml.h>
@@ -24,50 +24,16 @@ namespace lcsim::io {
 namespace {
 
 using yaml::describe;
+using yaml::dims;
+using yaml::expect_size;
 using yaml::fail;
 using yaml::join;
 using yaml::Keys;
 using yaml::load;
 using yaml::mapping;
+using yaml::matrix;
 using yaml::number;
 using yaml::vector;
-
-// A list of rows. `cols_if_empty` gives the column count of `[]` (0 rows).
-MatrixXd matrix(const YAML::Node& n, const std::string& source, const std::string& key,
-                Eigen::Index cols_if_empty) {
-  if (!n.IsSequence())
-    fail(source, key, "expected a matrix as a list of rows (got " + describe(n) + ")");
-  const auto rows = static_cast<Eigen::Index>(n.size());
-  if (rows == 0) return MatrixXd::Zero(0, cols_if_empty);
-  Eigen::Index cols = -1;
-  MatrixXd m;
-  for (Eigen::Index i = 0; i < rows; ++i) {
-    const YAML::Node row = n[static_cast<std::size_t>(i)];
-    const std::string rkey = key + "[" + std::to_string(i) + "]";
-    if (!row.IsSequence())
-      fail(source, rkey,
-           "expected a matrix row as a list of numbers (got " + describe(row) +
-               "); write a matrix as a list of rows, e.g. [[1, 0], [0, 1]]");
-    const auto c = static_cast<Eigen::Index>(row.size());
-    if (cols < 0) {
-      cols = c;
-      m.resize(rows, cols);
-    } else if (c != cols) {
-      fail(source, key,
-           "rows differ in length (row " + std::to_string(i) + " has " + std::to_string(c) +
-               " entries but row 0 has " + std::to_string(cols) + ")");
-    }
-    for (Eigen::Index j = 0; j < c; ++j)
-      m(i, j) =
-          number(row[static_cast<std::size_t>(j)], source, rkey + "[" + std::to_string(j) + "]");
-  }
-  return m;
-}
-
-template <class Mat>
-std::string dims(const Mat& m) {
-  return std::to_string(m.rows()) + " x " + std::to_string(m.cols());
-}
 
 template <class Mat>
 void expect_dims(const Mat& m, Eigen::Index rows, Eigen::Index cols, const std::string& source,
@@ -151,14 +117,6 @@ mech::SparseMatrix sparse_matrix(const YAML::Node& n, const std::string& source,
   }
   m.prune(0.0);
   return m;
-}
-
-void expect_size(const VectorXd& v, Eigen::Index size, const std::string& source,
-                 const std::string& key, const std::string& why) {
-  if (v.size() != size)
-    fail(source, key,
-         "expected " + std::to_string(size) + " entries " + why + " (got " +
-             std::to_string(v.size()) + ")");
 }
 
 std::vector<std::string> names(const YAML::Node& n, Eigen::Index size, const std::string& source,
@@ -455,24 +413,6 @@ std::vector<std::string> model_notes(const mech::Model& model) {
   if (model.initial.size() == 0) notes.push_back("no initial state in the file");
   if (std::isnan(model.t_end)) notes.push_back("no t_end in the file");
   return notes;
-}
-
-LcpProblem load_lcp(const std::filesystem::path& path) {
-  const std::string source = path.string();
-  const YAML::Node root = load(read_file(path), source);
-  if (root.IsNull() || !root.IsDefined())
-    throw InputError(source + ": empty file (expected `M` and `q`)");
-  const Keys keys = mapping(root, source, "", {"name", "M", "q"});
-  for (const char* k : {"M", "q"})
-    if (!keys.count(k)) fail(source, k, "missing (an LCP file gives M and q)");
-  LcpProblem p;
-  p.M = matrix(keys.at("M"), source, "M", 0);
-  if (p.M.rows() == 0) fail(source, "M", "empty");
-  if (p.M.rows() != p.M.cols())
-    fail(source, "M", "expected a square matrix (got " + dims(p.M) + ")");
-  p.q = vector(keys.at("q"), source, "q");
-  expect_size(p.q, p.M.rows(), source, "q", "(k, from M)");
-  return p;
 }
 
 VectorXd parse_vector(const std::string& text, const std::string& what) {
