@@ -350,57 +350,68 @@ mech::Model load_matrix_model(const std::filesystem::path& path) {
   return parse_matrix_model(read_file(path), path.string());
 }
 
+namespace {
+
+// What the rank of E says: dependent constraints, or rows that cannot be
+// active together (the two limits of one joint), or both, told apart when
+// there are few rows (k > 0).
+void add_rank_notes(const mech::MechanicalModel& m, std::vector<std::string>& notes) {
+  const int k = m.num_constraints();
+  const int rank = mech::constraint_rank(m);
+  // Rows that can never be active together (the two limits of one joint)
+  // lower the rank of E without being dependent constraints: checked on
+  // the sets that can be active together when there are few rows.
+  const bool deficit = rank < k;
+  // Beyond the enumeration bound (or an enumeration cut short without a
+  // dependent set found) the two causes are not told apart: said so,
+  // not called dependent.
+  bool judged = k <= mech::kMaxCoactiveConstraints, dependent = false;
+  if (deficit && judged) {
+    const mech::CoactiveSets sets = mech::coactive_sets(m);
+    const Eigen::MatrixXd E(m.E);
+    dependent = std::any_of(sets.maximal.begin(), sets.maximal.end(), [&](const auto& J) {
+      Eigen::MatrixXd EJ(J.size(), E.cols());
+      for (size_t i = 0; i < J.size(); ++i) EJ.row(i) = E.row(J[i]);
+      return lcs::numerical_rank(EJ) < static_cast<int>(J.size());
+    });
+    judged = sets.complete || dependent;
+    if (!dependent && judged)
+      notes.push_back("E (" + std::to_string(k) + " x " + std::to_string(m.dofs()) + ") has rank " +
+                      std::to_string(rank) + " < " + std::to_string(k) +
+                      " only through rows that cannot be active together (e.g. both limits "
+                      "of one joint): every set that can be active together has "
+                      "independent rows, so no constraints are dependent");
+  }
+  if (deficit && !judged)
+    notes.push_back("E (" + std::to_string(k) + " x " + std::to_string(m.dofs()) + ") has rank " +
+                    std::to_string(rank) + " < " + std::to_string(k) +
+                    ": dependent constraints or rows that cannot be active together (e.g. "
+                    "both limits of one joint), not told apart (" +
+                    (k > mech::kMaxCoactiveConstraints
+                         ? "the sets that can be active together are enumerated for k <= " +
+                               std::to_string(mech::kMaxCoactiveConstraints) + " only"
+                         : std::string("their enumeration was cut short")) +
+                    "); dependent constraints are legal (thesis §4.6.1): post-impact "
+                    "velocities are unique, impulses need not be");
+  else if (dependent)
+    notes.push_back("dependent constraints: E (" + std::to_string(k) + " x " +
+                    std::to_string(m.dofs()) + ") has rank " + std::to_string(rank) + " < " +
+                    std::to_string(k) +
+                    "; legal (thesis §4.6.1): post-impact velocities are unique, impulses "
+                    "need not be");
+}
+
+}  // namespace
+
 std::vector<std::string> model_notes(const mech::Model& model) {
   std::vector<std::string> notes;
   if (model.is_mechanical()) {
     const mech::MechanicalModel& m = *model.mechanical;
     const int k = m.num_constraints();
-    if (k == 0) {
+    if (k == 0)
       notes.push_back("no unilateral constraints: the model is a free linear system");
-    } else {
-      const int rank = mech::constraint_rank(m);
-      // Rows that can never be active together (the two limits of one joint)
-      // lower the rank of E without being dependent constraints: checked on
-      // the sets that can be active together when there are few rows.
-      const bool deficit = rank < k;
-      // Beyond the enumeration bound (or an enumeration cut short without a
-      // dependent set found) the two causes are not told apart: said so,
-      // not called dependent.
-      bool judged = k <= mech::kMaxCoactiveConstraints, dependent = false;
-      if (deficit && judged) {
-        const mech::CoactiveSets sets = mech::coactive_sets(m);
-        const Eigen::MatrixXd E(m.E);
-        dependent = std::any_of(sets.maximal.begin(), sets.maximal.end(), [&](const auto& J) {
-          Eigen::MatrixXd EJ(J.size(), E.cols());
-          for (size_t i = 0; i < J.size(); ++i) EJ.row(i) = E.row(J[i]);
-          return lcs::numerical_rank(EJ) < static_cast<int>(J.size());
-        });
-        judged = sets.complete || dependent;
-        if (!dependent && judged)
-          notes.push_back("E (" + std::to_string(k) + " x " + std::to_string(m.dofs()) +
-                          ") has rank " + std::to_string(rank) + " < " + std::to_string(k) +
-                          " only through rows that cannot be active together (e.g. both limits "
-                          "of one joint): every set that can be active together has "
-                          "independent rows, so no constraints are dependent");
-      }
-      if (deficit && !judged)
-        notes.push_back("E (" + std::to_string(k) + " x " + std::to_string(m.dofs()) +
-                        ") has rank " + std::to_string(rank) + " < " + std::to_string(k) +
-                        ": dependent constraints or rows that cannot be active together (e.g. "
-                        "both limits of one joint), not told apart (" +
-                        (k > mech::kMaxCoactiveConstraints
-                             ? "the sets that can be active together are enumerated for k <= " +
-                                   std::to_string(mech::kMaxCoactiveConstraints) + " only"
-                             : std::string("their enumeration was cut short")) +
-                        "); dependent constraints are legal (thesis §4.6.1): post-impact "
-                        "velocities are unique, impulses need not be");
-      else if (dependent)
-        notes.push_back("dependent constraints: E (" + std::to_string(k) + " x " +
-                        std::to_string(m.dofs()) + ") has rank " + std::to_string(rank) + " < " +
-                        std::to_string(k) +
-                        "; legal (thesis §4.6.1): post-impact velocities are unique, impulses "
-                        "need not be");
-    }
+    else
+      add_rank_notes(m, notes);
     if (model.initial.size() == model.state_size() && k > 0) {
       const VectorXd y = mech::gaps(m, model.initial.head(m.dofs()));
       for (int i = 0; i < k; ++i)
