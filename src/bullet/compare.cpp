@@ -37,31 +37,11 @@ std::vector<Switch> switches(const sim::Trajectory& tr) {
   return out;
 }
 
-}  // namespace
-
-Comparison compare_trajectories(const sim::Trajectory& exact, const sim::Trajectory& other,
-                                double time_tol) {
-  Comparison c;
+// Event shifts: each exact switch, in time order, matched with the other
+// run's switch of the same constraint and direction nearest in time and not
+// before the previous match of that kind; the other's switches left over.
+void match_events(const sim::Trajectory& exact, const sim::Trajectory& other, Comparison& c) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  if (exact.final_state.size() == other.final_state.size() && exact.final_state.size() > 0)
-    c.error_final = (other.final_state - exact.final_state).cwiseAbs().maxCoeff();
-  else
-    c.error_final = nan;
-  c.deviation_max = std::isnan(c.error_final) ? 0.0 : c.error_final;
-  c.deviation_t = other.t_end;
-
-  // Both sample lists are sorted by time; pair samples within time_tol.
-  detail::deviation_over(
-      exact.samples, other.samples, time_tol,
-      [](const sim::Sample& s, const sim::Sample& x) {
-        return x.x.size() == s.x.size() ? (s.x - x.x).cwiseAbs().maxCoeff()
-                                        : std::numeric_limits<double>::infinity();
-      },
-      c.deviation_max, c.deviation_t, c.samples_compared);
-
-  // Event shifts: each exact switch, in time order, matched with the other
-  // run's switch of the same constraint and direction nearest in time and not
-  // before the previous match of that kind.
   const std::vector<Switch> ex = switches(exact), ot = switches(other);
   std::vector<bool> used(ot.size(), false);
   std::vector<std::tuple<int, bool, double>> last;  // (constraint, activation, t of last match)
@@ -100,6 +80,31 @@ Comparison compare_trajectories(const sim::Trajectory& exact, const sim::Traject
   }
   for (bool u : used)
     if (!u) ++c.unmatched_other;
+}
+
+}  // namespace
+
+Comparison compare_trajectories(const sim::Trajectory& exact, const sim::Trajectory& other,
+                                double time_tol) {
+  Comparison c;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (exact.final_state.size() == other.final_state.size() && exact.final_state.size() > 0)
+    c.error_final = (other.final_state - exact.final_state).cwiseAbs().maxCoeff();
+  else
+    c.error_final = nan;
+  c.deviation_max = std::isnan(c.error_final) ? 0.0 : c.error_final;
+  c.deviation_t = other.t_end;
+
+  // Both sample lists are sorted by time; pair samples within time_tol.
+  detail::deviation_over(
+      exact.samples, other.samples, time_tol,
+      [](const sim::Sample& s, const sim::Sample& x) {
+        return x.x.size() == s.x.size() ? (s.x - x.x).cwiseAbs().maxCoeff()
+                                        : std::numeric_limits<double>::infinity();
+      },
+      c.deviation_max, c.deviation_t, c.samples_compared);
+
+  match_events(exact, other, c);
 
   c.energy_drift =
       (other.energy_final - other.energy_initial) - (exact.energy_final - exact.energy_initial);

@@ -1,6 +1,6 @@
 // A Bullet Featherstone btMultiBody built from a URDF, used to cross-check the
-// composite-rigid-body mass matrix of src/io. Deliberately independent of
-// src/io's kinematics: link poses, the merging of frozen links and the
+// composite-rigid-body mass matrix of src/scene. Deliberately independent of
+// src/scene's kinematics: link poses, the merging of frozen links and the
 // principal axes are computed here with Bullet's own types.
 #include <BulletDynamics/Featherstone/btMultiBody.h>
 #include <BulletDynamics/Featherstone/btMultiBodyLink.h>
@@ -80,73 +80,86 @@ void give_massless_bodies_a_speck(const urdf::ModelInterface& model,
   }
 }
 
-}  // namespace
+// A joint's position: q0, or for a mimic not in q0 a q_leader + b (the
+// mimic of a simulated joint is frozen there: see warn_frozen_mimics).
+double position_of(const urdf::ModelInterface& model, const std::map<std::string, double>& q0,
+                   const std::string& name) {
+  const auto it = q0.find(name);
+  if (it != q0.end()) return it->second;
+  const auto j = model.getJoint(name);
+  if (j && j->mimic && j->type != urdf::Joint::FIXED)
+    return j->mimic->multiplier * position_of(model, q0, j->mimic->joint_name) + j->mimic->offset;
+  return 0.0;
+}
 
-UrdfMultiBody build_urdf_multibody(const urdf::ModelInterface& model,
-                                   const std::vector<std::string>& joints,
-                                   const std::map<std::string, double>& q0) {
-  // A joint's position: q0, or for a mimic not in q0 a q_leader + b (the
-  // mimic of a simulated joint is frozen there: see warn_frozen_mimics).
-  std::function<double(const std::string&)> q_of = [&](const std::string& name) {
-    const auto it = q0.find(name);
-    if (it != q0.end()) return it->second;
-    const auto j = model.getJoint(name);
-    if (j && j->mimic && j->type != urdf::Joint::FIXED)
-      return j->mimic->multiplier * q_of(j->mimic->joint_name) + j->mimic->offset;
-    return 0.0;
-  };
-  const auto simulated_index = [&](const std::string& name) {
-    for (std::size_t i = 0; i < joints.size(); ++i)
-      if (joints[i] == name) return static_cast<int>(i);
-    return -1;
-  };
+// The index of joint `name` in `joints` (-1: frozen).
+int simulated_index(const std::vector<std::string>& joints, const std::string& name) {
+  for (std::size_t i = 0; i < joints.size(); ++i)
+    if (joints[i] == name) return static_cast<int>(i);
+  return -1;
+}
 
-  // World poses with simulated joints at 0, frozen joints at q0; bodies in
-  // depth-first order (Bullet wants parents before children).
+// The URDF tree cut into bodies, one per simulated joint: world poses with
+// simulated joints at 0 and frozen joints at q0, the body owning each link,
+// and the bodies in depth-first order (Bullet wants parents before
+// children).
+struct Tree {
   std::map<std::string, btTransform> X;
   std::map<std::string, int> owner;  // link -> Bullet link index (-1: base)
   std::vector<Body> bodies;
+};
+
+Tree cut_into_bodies(const urdf::ModelInterface& model, const std::vector<std::string>& joints,
+                     const std::map<std::string, double>& q0) {
+  Tree t;
   std::function<void(const urdf::Link&, int)> walk = [&](const urdf::Link& link, int own) {
-    owner[link.name] = own;
+    t.owner[link.name] = own;
     for (const auto& cj : link.child_joints) {
-      btTransform Xc = X[link.name] * to_bt(cj->parent_to_joint_origin_transform);
+      btTransform Xc = t.X[link.name] * to_bt(cj->parent_to_joint_origin_transform);
       int child_owner = own;
-      if (simulated_index(cj->name) >= 0) {
+      if (simulated_index(joints, cj->name) >= 0) {
         Body b;
         b.joint = cj->name;
         b.parent = own;
-        bodies.push_back(b);
-        child_owner = static_cast<int>(bodies.size()) - 1;
+        t.bodies.push_back(b);
+        child_owner = static_cast<int>(t.bodies.size()) - 1;
       } else {
-        Xc = Xc * frozen_motion(*cj, q_of(cj->name));
+        Xc = Xc * frozen_motion(*cj, position_of(model, q0, cj->name));
       }
-      X[cj->child_link_name] = Xc;
+      t.X[cj->child_link_name] = Xc;
       walk(*model.getLink(cj->child_link_name), child_owner);
     }
   };
-  X[model.getRoot()->name] = btTransform::getIdentity();
+  t.X[model.getRoot()->name] = btTransform::getIdentity();
   walk(*model.getRoot(), -1);
-  if (bodies.size() != joints.size())
+  if (t.bodies.size() != joints.size())
     throw std::invalid_argument("bullet: a simulated joint is not in the URDF tree");
+  return t;
+}
 
-  // Merge every link into its body: total mass, centre of mass, then the
-  // inertia about that centre (parallel-axis theorem), then principal axes.
-  for (const auto& [name, own] : owner) {
+// Each body's total mass and centre of mass (a massless one's speck).
+void merge_masses(const urdf::ModelInterface& model, Tree& t) {
+  for (const auto& [name, own] : t.owner) {
     const auto link = model.getLink(name);
     if (own < 0 || !link->inertial) continue;
-    Body& b = bodies[static_cast<std::size_t>(own)];
-    const btTransform Xi = X[name] * to_bt(link->inertial->origin);
+    Body& b = t.bodies[static_cast<std::size_t>(own)];
+    const btTransform Xi = t.X[name] * to_bt(link->inertial->origin);
     b.com += link->inertial->mass * Xi.getOrigin();
     b.mass += link->inertial->mass;
   }
-  give_massless_bodies_a_speck(model, X, bodies);
-  for (auto& b : bodies) b.inertia.setValue(0, 0, 0, 0, 0, 0, 0, 0, 0);
-  for (const auto& [name, own] : owner) {
+  give_massless_bodies_a_speck(model, t.X, t.bodies);
+}
+
+// Each body's inertia about its centre of mass (parallel-axis theorem), then
+// its principal axes.
+void merge_inertias(const urdf::ModelInterface& model, Tree& t) {
+  for (auto& b : t.bodies) b.inertia.setValue(0, 0, 0, 0, 0, 0, 0, 0, 0);
+  for (const auto& [name, own] : t.owner) {
     const auto link = model.getLink(name);
     if (own < 0 || !link->inertial) continue;
-    Body& b = bodies[static_cast<std::size_t>(own)];
+    Body& b = t.bodies[static_cast<std::size_t>(own)];
     const urdf::Inertial& in = *link->inertial;
-    const btTransform Xi = X[name] * to_bt(in.origin);
+    const btTransform Xi = t.X[name] * to_bt(in.origin);
     const btMatrix3x3 I(in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz);
     const btMatrix3x3& R = Xi.getBasis();
     const btVector3 d = Xi.getOrigin() - b.com;
@@ -155,44 +168,58 @@ UrdfMultiBody build_urdf_multibody(const urdf::ModelInterface& model,
                                -d.z() * d.x(), -d.z() * d.y(), d.dot(d) - d.z() * d.z());
     b.inertia = b.inertia + R * I * R.transpose() + parallel * in.mass;
   }
-  for (auto& b : bodies)
+  for (auto& b : t.bodies)
     if (b.speck > 0.0) b.inertia = b.inertia + btMatrix3x3::getIdentity() * b.speck;
-  for (auto& b : bodies) {
+  for (auto& b : t.bodies) {
     btMatrix3x3 rot;
     btMatrix3x3 diag = b.inertia;
     diag.diagonalize(rot, 1e-15, 200);  // inertia = rot * diag * rot^T
     b.principal = btVector3(diag[0][0], diag[1][1], diag[2][2]);
     b.com_frame = btTransform(rot, b.com);
   }
+}
 
-  const int n = static_cast<int>(bodies.size());
+// Bullet link i: body i on its joint (prismatic, else revolute), in its
+// parent's principal frame.
+void set_up_link(const urdf::ModelInterface& model, Tree& t, int i, btMultiBody& mb) {
+  const Body& b = t.bodies[static_cast<std::size_t>(i)];
+  const auto j = model.getJoint(b.joint);
+  const btTransform parent_frame = b.parent < 0
+                                       ? btTransform::getIdentity()
+                                       : t.bodies[static_cast<std::size_t>(b.parent)].com_frame;
+  const btMatrix3x3& Rp = parent_frame.getBasis();
+  const btMatrix3x3& Rc = b.com_frame.getBasis();
+  const btTransform& Xj = t.X[j->child_link_name];  // joint frame at q = 0
+  const btVector3 pivot = Xj.getOrigin();
+  const btVector3 axis = Rc.transpose() * (Xj.getBasis() * to_bt(j->axis).normalized());
+  btQuaternion rot_parent_to_this;
+  (Rc.transpose() * Rp).getRotation(rot_parent_to_this);
+  const btVector3 parent_com_to_pivot = Rp.transpose() * (pivot - parent_frame.getOrigin());
+  const btVector3 pivot_to_com = Rc.transpose() * (b.com - pivot);
+  if (j->type == urdf::Joint::PRISMATIC)
+    mb.setupPrismatic(i, b.mass, b.principal, b.parent, rot_parent_to_this, axis,
+                      parent_com_to_pivot, pivot_to_com, true);
+  else
+    mb.setupRevolute(i, b.mass, b.principal, b.parent, rot_parent_to_this, axis,
+                     parent_com_to_pivot, pivot_to_com, true);
+}
+
+}  // namespace
+
+UrdfMultiBody build_urdf_multibody(const urdf::ModelInterface& model,
+                                   const std::vector<std::string>& joints,
+                                   const std::map<std::string, double>& q0) {
+  Tree t = cut_into_bodies(model, joints, q0);
+  merge_masses(model, t);
+  merge_inertias(model, t);
+
+  const int n = static_cast<int>(t.bodies.size());
   UrdfMultiBody out;
   out.body = std::make_unique<btMultiBody>(n, 1.0, btVector3(1, 1, 1), /*fixedBase=*/true,
                                            /*canSleep=*/false);
   btMultiBody& mb = *out.body;
   mb.setBaseWorldTransform(btTransform::getIdentity());
-  for (int i = 0; i < n; ++i) {
-    const Body& b = bodies[static_cast<std::size_t>(i)];
-    const auto j = model.getJoint(b.joint);
-    const btTransform parent_frame = b.parent < 0
-                                         ? btTransform::getIdentity()
-                                         : bodies[static_cast<std::size_t>(b.parent)].com_frame;
-    const btMatrix3x3& Rp = parent_frame.getBasis();
-    const btMatrix3x3& Rc = b.com_frame.getBasis();
-    const btTransform& Xj = X[j->child_link_name];  // joint frame at q = 0
-    const btVector3 pivot = Xj.getOrigin();
-    const btVector3 axis = Rc.transpose() * (Xj.getBasis() * to_bt(j->axis).normalized());
-    btQuaternion rot_parent_to_this;
-    (Rc.transpose() * Rp).getRotation(rot_parent_to_this);
-    const btVector3 parent_com_to_pivot = Rp.transpose() * (pivot - parent_frame.getOrigin());
-    const btVector3 pivot_to_com = Rc.transpose() * (b.com - pivot);
-    if (j->type == urdf::Joint::PRISMATIC)
-      mb.setupPrismatic(i, b.mass, b.principal, b.parent, rot_parent_to_this, axis,
-                        parent_com_to_pivot, pivot_to_com, true);
-    else
-      mb.setupRevolute(i, b.mass, b.principal, b.parent, rot_parent_to_this, axis,
-                       parent_com_to_pivot, pivot_to_com, true);
-  }
+  for (int i = 0; i < n; ++i) set_up_link(model, t, i, mb);
   mb.finalizeMultiDof();
   // Pitfall (shared/notes/bullet.md): default damping 0.04.
   mb.setLinearDamping(0);
@@ -200,10 +227,11 @@ UrdfMultiBody build_urdf_multibody(const urdf::ModelInterface& model,
   out.coordinate.resize(static_cast<std::size_t>(n));
   out.link.resize(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) {
-    const int c = simulated_index(bodies[static_cast<std::size_t>(i)].joint);
+    const std::string& joint = t.bodies[static_cast<std::size_t>(i)].joint;
+    const int c = simulated_index(joints, joint);
     out.coordinate[static_cast<std::size_t>(i)] = c;
     out.link[static_cast<std::size_t>(c)] = i;
-    mb.setJointPos(i, q_of(bodies[static_cast<std::size_t>(i)].joint));
+    mb.setJointPos(i, position_of(model, q0, joint));
   }
   mb.clearForcesAndTorques();
   mb.clearVelocities();

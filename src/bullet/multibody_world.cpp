@@ -130,9 +130,9 @@ void set_state(btMultiBody& b, const UrdfMultiBody& mb, const std::vector<Follow
   b.updateCollisionObjectWorldTransforms(world_to_local, local_origin);
 }
 
-std::unique_ptr<MbWorld> build(const scene::Scene& setup, const mech::MechanicalModel& m,
-                               const std::vector<JointLimit>& limits, const VectorXd& q0,
-                               const VectorXd& v0, const WorldSettings& s) {
+// An empty world with the scene's gravity and the pinned settings (the
+// file's header comment).
+std::unique_ptr<MbWorld> make_world(const scene::Scene& setup, const WorldSettings& s) {
   auto w = std::make_unique<MbWorld>();
   w->config = std::make_unique<btDefaultCollisionConfiguration>();
   w->dispatcher = std::make_unique<btCollisionDispatcher>(w->config.get());
@@ -155,14 +155,19 @@ std::unique_ptr<MbWorld> build(const scene::Scene& setup, const mech::Mechanical
   info.m_splitImpulse = 0;
   info.m_leastSquaresResidualThreshold = 0.0;
   info.m_solverMode = SOLVER_USE_WARMSTARTING | SOLVER_SIMD;  // no articulated warm start
+  return w;
+}
 
-  w->mimics = following_mimics(setup, m.coordinates);
+// The multibody of the scene's URDF (the coordinates' joints, then their
+// mimics), each link with a collider that collides with nothing.
+void add_multibody(MbWorld& w, const scene::Scene& setup, const mech::MechanicalModel& m) {
+  w.mimics = following_mimics(setup, m.coordinates);
   std::vector<std::string> moving = m.coordinates;
-  for (const FollowingMimic& f : w->mimics) moving.push_back(f.joint);
-  w->mb = build_urdf_multibody(*setup.urdf, moving, setup.q0);
-  for (std::size_t i = 0; i < w->mimics.size(); ++i)
-    w->mimics[i].link = w->mb.link[m.coordinates.size() + i];
-  btMultiBody& b = *w->mb.body;
+  for (const FollowingMimic& f : w.mimics) moving.push_back(f.joint);
+  w.mb = build_urdf_multibody(*setup.urdf, moving, setup.q0);
+  for (std::size_t i = 0; i < w.mimics.size(); ++i)
+    w.mimics[i].link = w.mb.link[m.coordinates.size() + i];
+  btMultiBody& b = *w.mb.body;
   b.setLinearDamping(0);
   b.setAngularDamping(0);
   b.setUseGyroTerm(true);
@@ -170,24 +175,27 @@ std::unique_ptr<MbWorld> build(const scene::Scene& setup, const mech::Mechanical
   b.setCanSleep(false);
   b.setHasSelfCollision(false);
   b.useGlobalVelocities(false);
-  w->world->addMultiBody(&b, btBroadphaseProxy::DefaultFilter, 0);
-  w->shape = std::make_unique<btSphereShape>(0.01);
-  w->shape->setMargin(0.0);
+  w.world->addMultiBody(&b, btBroadphaseProxy::DefaultFilter, 0);
+  w.shape = std::make_unique<btSphereShape>(0.01);
+  w.shape->setMargin(0.0);
   for (int i = 0; i < b.getNumLinks(); ++i) {
     auto col = std::make_unique<btMultiBodyLinkCollider>(&b, i);
-    col->setCollisionShape(w->shape.get());
+    col->setCollisionShape(w.shape.get());
     col->setActivationState(DISABLE_DEACTIVATION);
     // Mask 0: the broadphase pairs this collider with nothing.
-    w->world->addCollisionObject(col.get(), btBroadphaseProxy::DefaultFilter, 0);
+    w.world->addCollisionObject(col.get(), btBroadphaseProxy::DefaultFilter, 0);
     b.getLink(i).m_collider = col.get();
-    w->colliders.push_back(std::move(col));
+    w.colliders.push_back(std::move(col));
   }
-  set_state(b, w->mb, w->mimics, q0, v0);
-  // The gear's row is v_m + r v_J = 0 (Jacobian 1 on link A, r on link B):
-  // r = -a. ERP 0: no position correction; the velocity equality, solved
-  // every step, keeps q_m - a q_J at b up to the solver's residual.
-  for (const FollowingMimic& f : w->mimics) {
-    const int leader = w->mb.link[static_cast<std::size_t>(f.leader)];
+}
+
+// The gear's row is v_m + r v_J = 0 (Jacobian 1 on link A, r on link B):
+// r = -a. ERP 0: no position correction; the velocity equality, solved
+// every step, keeps q_m - a q_J at b up to the solver's residual.
+void add_gears(MbWorld& w) {
+  btMultiBody& b = *w.mb.body;
+  for (const FollowingMimic& f : w.mimics) {
+    const int leader = w.mb.link[static_cast<std::size_t>(f.leader)];
     auto g = std::make_unique<btMultiBodyGearConstraint>(
         &b, f.link, &b, leader, btVector3(0, 0, 0), btVector3(0, 0, 0), btMatrix3x3::getIdentity(),
         btMatrix3x3::getIdentity());
@@ -195,21 +203,36 @@ std::unique_ptr<MbWorld> build(const scene::Scene& setup, const mech::Mechanical
     g->setErp(0.0);
     g->finalizeMultiDof();
     g->setMaxAppliedImpulse(1e30);
-    w->world->addMultiBodyConstraint(g.get());
-    w->gears.push_back(std::move(g));
+    w.world->addMultiBodyConstraint(g.get());
+    w.gears.push_back(std::move(g));
   }
+}
+
+// One btMultiBodyJointLimitConstraint per joint limit: the bound on its side,
+// the other side limit_range away.
+void add_limits(MbWorld& w, const std::vector<JointLimit>& limits, const WorldSettings& s) {
   for (const JointLimit& L : limits) {
     const double lo = L.lower ? L.bound : L.bound - s.limit_range;
     const double hi = L.lower ? L.bound + s.limit_range : L.bound;
     auto c = std::make_unique<btMultiBodyJointLimitConstraint>(
-        &b, w->mb.link[static_cast<std::size_t>(L.coordinate)], lo, hi);
+        w.mb.body.get(), w.mb.link[static_cast<std::size_t>(L.coordinate)], lo, hi);
     // Allocates the rows' storage (else done lazily in the first step, after
     // simulate_multibody has reset the applied impulses).
     c->finalizeMultiDof();
     c->setMaxAppliedImpulse(s.limit_max_impulse);
-    w->world->addMultiBodyConstraint(c.get());
-    w->limits.push_back(std::move(c));
+    w.world->addMultiBodyConstraint(c.get());
+    w.limits.push_back(std::move(c));
   }
+}
+
+std::unique_ptr<MbWorld> build(const scene::Scene& setup, const mech::MechanicalModel& m,
+                               const std::vector<JointLimit>& limits, const VectorXd& q0,
+                               const VectorXd& v0, const WorldSettings& s) {
+  std::unique_ptr<MbWorld> w = make_world(setup, s);
+  add_multibody(*w, setup, m);
+  set_state(*w->mb.body, w->mb, w->mimics, q0, v0);
+  add_gears(*w);
+  add_limits(*w, limits, s);
   return w;
 }
 
@@ -239,6 +262,57 @@ void warn(sim::Trajectory& tr, const mech::MechanicalModel& m, const MatrixXd& K
                   "' has e = " + fmt(m.restitution(i)));
       break;
     }
+}
+
+// The scene's own forces, tau = f_s - K_s q - D v: K and f without the
+// linearised gravity (Bullet's world has the nonlinear one).
+struct SceneForces {
+  MatrixXd K_s, D;
+  VectorXd f_s;
+};
+
+SceneForces scene_forces(const scene::Scene& setup, const mech::MechanicalModel& m) {
+  const int N = m.dofs();
+  const scene::UrdfLinearisation& lin = setup.lin;
+  VectorXd q_ref = VectorXd::Zero(N);
+  for (int j = 0; j < N; ++j)
+    if (const auto it = setup.q0.find(m.coordinates[static_cast<std::size_t>(j)]);
+        it != setup.q0.end())
+      q_ref(j) = it->second;
+  SceneForces out;
+  out.K_s = MatrixXd(m.K) - lin.K_g;
+  out.f_s = m.f - lin.tau_g - lin.K_g * q_ref;
+  out.D = MatrixXd(m.D);
+  return out;
+}
+
+// One Bullet step of length h under the joint torques tau; the state it
+// reached.
+void step(MbWorld& w, const VectorXd& tau, double h, VectorXd& q_next, VectorXd& v_next) {
+  btMultiBody& b = *w.mb.body;
+  const auto N = static_cast<int>(tau.size());
+  for (int c = 0; c < N; ++c) b.addJointTorque(w.mb.link[static_cast<std::size_t>(c)], tau(c));
+  // A limit row exists only in steps that start at or past its bound;
+  // its impulse from an earlier step would otherwise be read again.
+  for (auto& c : w.limits) {
+    c->internalSetAppliedImpulse(0, 0.0);
+    c->internalSetAppliedImpulse(1, 0.0);
+  }
+  // maxSubSteps = 0: exactly one step of length h (no interpolation).
+  w.world->stepSimulation(h, 0, h);
+  for (int c = 0; c < N; ++c) {
+    q_next(c) = b.getJointPos(w.mb.link[static_cast<std::size_t>(c)]);
+    v_next(c) = b.getJointVel(w.mb.link[static_cast<std::size_t>(c)]);
+  }
+}
+
+// The step's impulses by row of E. Row 0 of a limit pushes +q (the lower
+// bound), row 1 -q; lcsim's row is c e_j, so the impulse P on the joint is
+// |c| h u.
+void limit_impulses(const MbWorld& w, const std::vector<JointLimit>& limits, VectorXd& impulse) {
+  for (std::size_t i = 0; i < limits.size(); ++i)
+    impulse(limits[i].row) =
+        w.limits[i]->getAppliedImpulse(limits[i].lower ? 0 : 1) / std::abs(limits[i].c);
 }
 
 }  // namespace
@@ -291,16 +365,9 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene&
   const mech::MechanicalModel& m = *model.mechanical;
   const int N = m.dofs(), k = m.num_constraints();
 
-  // The scene's own forces: K and f without the linearised gravity.
-  const scene::UrdfLinearisation& lin = setup.lin;
-  VectorXd q_ref = VectorXd::Zero(N);
-  for (int j = 0; j < N; ++j)
-    if (const auto it = setup.q0.find(m.coordinates[static_cast<std::size_t>(j)]);
-        it != setup.q0.end())
-      q_ref(j) = it->second;
-  const MatrixXd K_s = MatrixXd(m.K) - lin.K_g;
-  const VectorXd f_s = m.f - lin.tau_g - lin.K_g * q_ref;
-  const MatrixXd D = MatrixXd(m.D);
+  const SceneForces forces = scene_forces(setup, m);
+  const MatrixXd &K_s = forces.K_s, &D = forces.D;
+  const VectorXd& f_s = forces.f_s;
   warn(tr, m, K_s, opt);
 
   VectorXd q = x0.head(N), v = x0.tail(N);
@@ -310,7 +377,6 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene&
   } catch (const std::exception& e) {
     return fail(std::string("bullet: ") + e.what());
   }
-  btMultiBody& b = *w->mb.body;
   RunRecorder rec(model, opt, tr, q, v);
   const sim::StepGrid grid = sim::StepGrid::of(*opt.t_end, opt.h);
   VectorXd tau(N), q_next(N), v_next(N), impulse(k);
@@ -319,24 +385,8 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene&
     if (opt.progress && j % sim::Options::kProgressSteps == 0) opt.progress(j * opt.h);
     const double h = last ? grid.h_last : grid.h;
     tau = f_s - K_s * q - D * v;
-    for (int c = 0; c < N; ++c) b.addJointTorque(w->mb.link[static_cast<std::size_t>(c)], tau(c));
-    // A limit row exists only in steps that start at or past its bound;
-    // its impulse from an earlier step would otherwise be read again.
-    for (auto& c : w->limits) {
-      c->internalSetAppliedImpulse(0, 0.0);
-      c->internalSetAppliedImpulse(1, 0.0);
-    }
-    // maxSubSteps = 0: exactly one step of length h (no interpolation).
-    w->world->stepSimulation(h, 0, h);
-    for (int c = 0; c < N; ++c) {
-      q_next(c) = b.getJointPos(w->mb.link[static_cast<std::size_t>(c)]);
-      v_next(c) = b.getJointVel(w->mb.link[static_cast<std::size_t>(c)]);
-    }
-    // Row 0 of a limit pushes +q (the lower bound), row 1 -q; lcsim's row is
-    // c e_j, so the impulse P on the joint is |c| h u.
-    for (std::size_t i = 0; i < limits.size(); ++i)
-      impulse(limits[i].row) =
-          w->limits[i]->getAppliedImpulse(limits[i].lower ? 0 : 1) / std::abs(limits[i].c);
+    step(*w, tau, h, q_next, v_next);
+    limit_impulses(*w, limits, impulse);
     // Round-off in an impulse is ~1e-16 of the momentum; real ones are O(h).
     const double tiny =
         1e-10 * (1.0 + (m.M * v).cwiseAbs().maxCoeff() + h * tau.cwiseAbs().maxCoeff());

@@ -156,8 +156,8 @@ struct World {
   }
 };
 
-std::unique_ptr<World> build(const mech::MechanicalModel& m, const std::vector<Limit>& limits,
-                             const VectorXd& q0, const VectorXd& v0, const WorldSettings& s) {
+// An empty world with the pinned settings (the file's header comment).
+std::unique_ptr<World> make_world(const WorldSettings& s) {
   auto w = std::make_unique<World>();
   w->config = std::make_unique<btDefaultCollisionConfiguration>();
   w->dispatcher = std::make_unique<btCollisionDispatcher>(w->config.get());
@@ -184,8 +184,13 @@ std::unique_ptr<World> build(const mech::MechanicalModel& m, const std::vector<L
   info.m_restitutionVelocityThreshold = 0.0;
   info.m_leastSquaresResidualThreshold = 0.0;
   info.m_solverMode = SOLVER_USE_WARMSTARTING | SOLVER_SIMD;
-  w->shape = std::make_unique<btSphereShape>(0.05);
-  w->shape->setMargin(0.0);
+  return w;
+}
+
+// One body per coordinate j, of mass M_jj, at x = q0_j moving at v0_j.
+void add_bodies(World& w, const mech::MechanicalModel& m, const VectorXd& q0, const VectorXd& v0) {
+  w.shape = std::make_unique<btSphereShape>(0.05);
+  w.shape->setMargin(0.0);
   for (int j = 0; j < m.dofs(); ++j) {
     btTransform tf;
     tf.setIdentity();
@@ -195,7 +200,7 @@ std::unique_ptr<World> build(const mech::MechanicalModel& m, const std::vector<L
     // walked and cached all N^2/2 overlapping pairs each step (mask 0 only
     // rejects them afterwards). y is free in every limit and never read back.
     tf.setOrigin(btVector3(q0(j), static_cast<double>(j), 0));
-    btRigidBody::btRigidBodyConstructionInfo ci(m.M.coeff(j, j), nullptr, w->shape.get(),
+    btRigidBody::btRigidBodyConstructionInfo ci(m.M.coeff(j, j), nullptr, w.shape.get(),
                                                 btVector3(1, 1, 1));
     ci.m_startWorldTransform = tf;
     ci.m_linearDamping = 0.0;
@@ -210,16 +215,21 @@ std::unique_ptr<World> build(const mech::MechanicalModel& m, const std::vector<L
     body->setSleepingThresholds(0.0, 0.0);
     body->setContactProcessingThreshold(0.0);
     // Mask 0: the broadphase pairs this body with nothing.
-    w->world->addRigidBody(body.get(), btBroadphaseProxy::DefaultFilter, 0);
-    w->bodies.push_back(std::move(body));
+    w.world->addRigidBody(body.get(), btBroadphaseProxy::DefaultFilter, 0);
+    w.bodies.push_back(std::move(body));
   }
+}
+
+// One 6DOF2 limit per row of E, on x only, bouncing with the row's e.
+void add_limits(World& w, const mech::MechanicalModel& m, const std::vector<Limit>& limits,
+                const WorldSettings& s) {
   const int k = static_cast<int>(limits.size());
   for (int i = 0; i < k; ++i) {
     const Limit& L = limits[i];
     btTransform id;
     id.setIdentity();
-    btRigidBody& A = L.a < 0 ? btTypedConstraint::getFixedBody() : *w->bodies[L.a];
-    auto c = std::make_unique<btGeneric6DofSpring2Constraint>(A, *w->bodies[L.b], id, id);
+    btRigidBody& A = L.a < 0 ? btTypedConstraint::getFixedBody() : *w.bodies[L.a];
+    auto c = std::make_unique<btGeneric6DofSpring2Constraint>(A, *w.bodies[L.b], id, id);
     c->setLinearLowerLimit(btVector3(L.lo, 1, 1));  // y, z free (lower > upper)
     c->setLinearUpperLimit(btVector3(L.hi, 0, 0));
     c->setAngularLowerLimit(btVector3(1, 1, 1));  // rotations free
@@ -228,9 +238,16 @@ std::unique_ptr<World> build(const mech::MechanicalModel& m, const std::vector<L
     c->setParam(BT_CONSTRAINT_STOP_CFM, s.stop_cfm, 0);
     const double e = m.restitution.size() == k ? m.restitution(i) : 0.0;
     c->setBounce(0, e);
-    w->world->addConstraint(c.get(), true);
-    w->constraints.push_back(std::move(c));
+    w.world->addConstraint(c.get(), true);
+    w.constraints.push_back(std::move(c));
   }
+}
+
+std::unique_ptr<World> build(const mech::MechanicalModel& m, const std::vector<Limit>& limits,
+                             const VectorXd& q0, const VectorXd& v0, const WorldSettings& s) {
+  std::unique_ptr<World> w = make_world(s);
+  add_bodies(*w, m, q0, v0);
+  add_limits(*w, m, limits, s);
   return w;
 }
 
@@ -284,6 +301,71 @@ void check_expressible(const mech::Model& model) { (void)plan_of(model, WorldSet
 
 namespace {
 
+// Springs are explicit forces too (symplectic Euler): stable for omega h <= 2
+// with omega the fastest frequency, bounded here by Gershgorin on M^-1 K
+// (M is diagonal in this scene).
+void warn_explicit_springs(sim::Trajectory& tr, const mech::MechanicalModel& m, double h) {
+  double w2 = 0.0;
+  for (int j = 0; j < m.dofs(); ++j) {
+    double row = 0.0;
+    for (mech::SparseMatrix::InnerIterator it(m.K, j); it; ++it) row += std::abs(it.value());
+    w2 = std::max(w2, row / m.M.coeff(j, j));  // K symmetric: column sums = row sums
+  }
+  if (std::sqrt(w2) * h > 2.0)
+    tr.warn("bullet-explicit-springs", 0.0,
+            "bullet: springs are explicit forces -K q, unstable for omega h > 2: omega <= " +
+                fmt(std::sqrt(w2)) + " rad/s gives omega h up to " + fmt(std::sqrt(w2) * h) +
+                " at h = " + fmt(h) + "; expect growth, or reduce h");
+}
+
+// Measured (a ball dropped on a 6DOF2 lower limit, e = 0.5, h = 1e-3,
+// Bullet 3.24 from Debian): no rebound at the pinned stop ERP 0.2 (nor at
+// e = 0.9 or 1), 1.71 m/s of the 2.22 expected at ERP 0.8, 2.11 at ERP 1.
+// lcsim keeps ERP 0.2 (what the comparisons were measured with) and says so.
+void warn_restitution_lost(sim::Trajectory& tr, const mech::MechanicalModel& m,
+                           const WorldSettings& s) {
+  for (int i = 0; i < m.num_constraints(); ++i)
+    if (m.restitution(i) > 0.0 && s.stop_erp < 1.0) {
+      tr.warn("bullet-restitution-lost", 0.0,
+              "bullet: restitution is lost or reduced: Bullet 3.24 applies a limit's bounce "
+              "only near stop ERP 1 (this scene uses " +
+                  fmt(s.stop_erp) + "; at 0.2 nothing rebounds); constraint '" + m.constraints[i] +
+                  "' has e = " + fmt(m.restitution(i)));
+      break;
+    }
+}
+
+// Multipliers from the momentum balance M (v+ - v) = h F + E' (h u):
+// h u = least-squares solution of E' x = M (v+ - v) - h F, exact when E has
+// full row rank (with dependent rows, one basic solution: the split of an
+// impulse among them is not unique). A sparse QR of E' (O(nnz) per step
+// for a chain); the dense decomposition it replaces cost O(N k) per step
+// and O(N k^2) to set up, and was most of the "Bullet" time at N = 1000.
+using TransposeQR = Eigen::SparseQR<mech::SparseMatrix, Eigen::COLAMDOrdering<int>>;
+
+// Factors E' into `Et` (nothing without constraints); false if it fails.
+bool factor_transpose(const mech::MechanicalModel& m, TransposeQR& Et) {
+  const int N = m.dofs(), k = m.num_constraints();
+  if (k == 0) return true;
+  const mech::SparseMatrix Etm = m.E.transpose();
+  Et.setPivotThreshold(static_cast<double>(std::max(N, k)) * 1e-12 *
+                       (m.E.norm() > 0.0 ? m.E.norm() : 1.0));
+  Et.compute(Etm);
+  return Et.info() == Eigen::Success;
+}
+
+// One Bullet step of length h under the forces F; the state it reached.
+void step(World& w, const VectorXd& F, double h, VectorXd& q_next, VectorXd& v_next) {
+  const auto N = static_cast<int>(F.size());
+  for (int i = 0; i < N; ++i) w.bodies[i]->applyCentralForce(btVector3(F(i), 0, 0));
+  // maxSubSteps = 0: exactly one step of length h (no interpolation).
+  w.world->stepSimulation(h, 0, h);
+  for (int i = 0; i < N; ++i) {
+    q_next(i) = w.bodies[i]->getCenterOfMassPosition().x();
+    v_next(i) = w.bodies[i]->getLinearVelocity().x();
+  }
+}
+
 sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>& limits,
                              const VectorXd& x0, const sim::Options& opt, const WorldSettings& s) {
   sim::Trajectory tr;
@@ -299,54 +381,15 @@ sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>&
   const int N = m.dofs(), k = m.num_constraints();
   VectorXd q = x0.head(N), v = x0.tail(N);
   warn_explicit_damping(tr, m, opt.h, "forces");
-  // Springs are explicit forces too (symplectic Euler): stable for omega h <= 2
-  // with omega the fastest frequency, bounded here by Gershgorin on M^-1 K
-  // (M is diagonal in this scene).
-  {
-    double w2 = 0.0;
-    for (int j = 0; j < N; ++j) {
-      double row = 0.0;
-      for (mech::SparseMatrix::InnerIterator it(m.K, j); it; ++it) row += std::abs(it.value());
-      w2 = std::max(w2, row / m.M.coeff(j, j));  // K symmetric: column sums = row sums
-    }
-    if (std::sqrt(w2) * opt.h > 2.0)
-      tr.warn("bullet-explicit-springs", 0.0,
-              "bullet: springs are explicit forces -K q, unstable for omega h > 2: omega <= " +
-                  fmt(std::sqrt(w2)) + " rad/s gives omega h up to " + fmt(std::sqrt(w2) * opt.h) +
-                  " at h = " + fmt(opt.h) + "; expect growth, or reduce h");
-  }
-  // Measured (a ball dropped on a 6DOF2 lower limit, e = 0.5, h = 1e-3,
-  // Bullet 3.24 from Debian): no rebound at the pinned stop ERP 0.2 (nor at
-  // e = 0.9 or 1), 1.71 m/s of the 2.22 expected at ERP 0.8, 2.11 at ERP 1.
-  // lcsim keeps ERP 0.2 (what the comparisons were measured with) and says so.
-  for (int i = 0; i < k; ++i)
-    if (m.restitution(i) > 0.0 && s.stop_erp < 1.0) {
-      tr.warn("bullet-restitution-lost", 0.0,
-              "bullet: restitution is lost or reduced: Bullet 3.24 applies a limit's bounce "
-              "only near stop ERP 1 (this scene uses " +
-                  fmt(s.stop_erp) + "; at 0.2 nothing rebounds); constraint '" + m.constraints[i] +
-                  "' has e = " + fmt(m.restitution(i)));
-      break;
-    }
+  warn_explicit_springs(tr, m, opt.h);
+  warn_restitution_lost(tr, m, s);
 
   // The grid of the time-stepping methods: n steps of h, the last shortened.
   const sim::StepGrid grid = sim::StepGrid::of(*opt.t_end, opt.h);
 
   std::unique_ptr<World> w = build(m, limits, q, v, s);
-  // Multipliers from the momentum balance M (v+ - v) = h F + E' (h u):
-  // h u = least-squares solution of E' x = M (v+ - v) - h F, exact when E has
-  // full row rank (with dependent rows, one basic solution: the split of an
-  // impulse among them is not unique). A sparse QR of E' (O(nnz) per step
-  // for a chain); the dense decomposition it replaces cost O(N k) per step
-  // and O(N k^2) to set up, and was most of the "Bullet" time at N = 1000.
-  Eigen::SparseQR<mech::SparseMatrix, Eigen::COLAMDOrdering<int>> Et;
-  if (k > 0) {
-    const mech::SparseMatrix Etm = m.E.transpose();
-    Et.setPivotThreshold(static_cast<double>(std::max(N, k)) * 1e-12 *
-                         (m.E.norm() > 0.0 ? m.E.norm() : 1.0));
-    Et.compute(Etm);
-    if (Et.info() != Eigen::Success) return fail("bullet: cannot factor E' for the multipliers");
-  }
+  TransposeQR Et;
+  if (!factor_transpose(m, Et)) return fail("bullet: cannot factor E' for the multipliers");
 
   RunRecorder rec(model, opt, tr, q, v);
   VectorXd F(N), q_next(N), v_next(N);
@@ -355,13 +398,7 @@ sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>&
     if (opt.progress && j % sim::Options::kProgressSteps == 0) opt.progress(j * opt.h);
     const double h = last ? grid.h_last : grid.h;
     F = m.f - m.K * q - m.D * v;
-    for (int i = 0; i < N; ++i) w->bodies[i]->applyCentralForce(btVector3(F(i), 0, 0));
-    // maxSubSteps = 0: exactly one step of length h (no interpolation).
-    w->world->stepSimulation(h, 0, h);
-    for (int i = 0; i < N; ++i) {
-      q_next(i) = w->bodies[i]->getCenterOfMassPosition().x();
-      v_next(i) = w->bodies[i]->getLinearVelocity().x();
-    }
+    step(*w, F, h, q_next, v_next);
     VectorXd impulse = VectorXd::Zero(k);
     if (k > 0) impulse = Et.solve(VectorXd(m.M * (v_next - v) - h * F));
     // Round-off in the momentum balance is ~1e-16 |M v|; impulses of real

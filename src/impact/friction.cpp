@@ -199,6 +199,47 @@ void set_outcomes(const mech::MechanicalModel& m, const ImpactInput& in, const C
   }
 }
 
+// The Delassus matrix of normal and tangential rows, [W, E_J M^-1 T'; T
+// M^-1 E_J', T M^-1 T'], from MinvTt = M^-1 T'.
+MatrixXd delassus(const detail::Setup& s, const ClosedFriction& c, const MatrixXd& MinvTt) {
+  const Eigen::Index nj = s.W.rows(), nf = c.mu.size();
+  MatrixXd Wg(nj + nf, nj + nf);
+  Wg.topLeftCorner(nj, nj) = s.W;
+  Wg.topRightCorner(nj, nf) = s.EJ * MinvTt;
+  Wg.bottomLeftCorner(nf, nj) = Wg.topRightCorner(nj, nf).transpose();
+  Wg.bottomRightCorner(nf, nf) = c.T * MinvTt;
+  return Wg;
+}
+
+// Mode threshold as moreau_newton's: rounding of the largest approach rate
+// through the diagonal of W.
+double mode_threshold(const detail::Setup& s) {
+  double tiny = 0.0;
+  for (Eigen::Index i = 0; i < s.W.rows(); ++i)
+    if (s.W(i, i) > 0.0) tiny = std::max(tiny, std::abs(s.a(i)) / s.W(i, i));
+  return tiny * kRelTol;
+}
+
+// Flags, and says in out.message, an impact that raised the kinetic energy
+// beyond the work of moving surfaces.
+void flag_energy_gain(const ClosedFriction& c, const VectorXd& lambda_T, ImpactResult& out) {
+  // T+ - T- = lambda' u+ - ½ dv' M dv (dv = v+ - v-), with u_T+ = T v+ the
+  // tangential rates; lambda_T (u_T+ - velocity) <= 0 and lambda_N u_N+ = 0
+  // for e = 0, so beyond the work of moving surfaces on the body
+  // (lambda_T' velocity, a belt) only restitution can make it positive.
+  // Beyond rounding: 1e-12 relative (a few hundred eps of the kinetic energy).
+  const double surface_work = c.velocity.dot(lambda_T);
+  if (out.energy_after - surface_work > out.energy_before * (1.0 + 1e-12) + 1e-300) {
+    out.energy_gain = true;
+    std::ostringstream msg;
+    msg.precision(6);
+    msg << "kinetic energy rose through the impact, " << out.energy_before << " -> "
+        << out.energy_after << " J: Newton restitution with coupled normal and tangential "
+        << "directions (W_NT != 0) can create energy (Kane's paradox)";
+    out.message = msg.str();
+  }
+}
+
 }  // namespace
 
 ImpactResult moreau_friction(const ImpactInput& in, const lcp::Solver& solver) {
@@ -215,11 +256,7 @@ ImpactResult moreau_friction(const ImpactInput& in, const lcp::Solver& solver) {
   MatrixXd MinvTt = c.T.transpose();
   s->L.triangularView<Eigen::Lower>().solveInPlace(MinvTt);
   s->L.transpose().triangularView<Eigen::Upper>().solveInPlace(MinvTt);
-  MatrixXd Wg(nj + nf, nj + nf);
-  Wg.topLeftCorner(nj, nj) = s->W;
-  Wg.topRightCorner(nj, nf) = s->EJ * MinvTt;
-  Wg.bottomLeftCorner(nf, nj) = Wg.topRightCorner(nj, nf).transpose();
-  Wg.bottomRightCorner(nf, nf) = c.T * MinvTt;
+  const MatrixXd Wg = delassus(*s, c, MinvTt);
   if (std::string p = painleve(m, in.closed, c, s->W, Wg.topRightCorner(nj, nf)); !p.empty()) {
     out.painleve = true;
     out.message = p;
@@ -242,30 +279,11 @@ ImpactResult moreau_friction(const ImpactInput& in, const lcp::Solver& solver) {
   VectorXd lambda_N, lambda_T;
   friction_impulses(*z, static_cast<int>(nj), c.normal_of, c.mu, lambda_N, lambda_T);
   const VectorXd v_after = in.v + s->MinvEt * lambda_N + MinvTt * lambda_T;
-  // Mode threshold as moreau_newton's: rounding of the largest approach rate
-  // through the diagonal of W.
-  double tiny = 0.0;
-  for (Eigen::Index i = 0; i < nj; ++i)
-    if (s->W(i, i) > 0.0) tiny = std::max(tiny, std::abs(s->a(i)) / s->W(i, i));
-  tiny *= kRelTol;
+  const double tiny = mode_threshold(*s);
   detail::finish(in, *s, lambda_N, v_after, tiny, out);
   set_outcomes(m, in, c, lambda_N, lambda_T, tiny, out);
   out.status = Status::kOk;
-  // T+ - T- = lambda' u+ - ½ dv' M dv (dv = v+ - v-), with u_T+ = T v+ the
-  // tangential rates; lambda_T (u_T+ - velocity) <= 0 and lambda_N u_N+ = 0
-  // for e = 0, so beyond the work of moving surfaces on the body
-  // (lambda_T' velocity, a belt) only restitution can make it positive.
-  // Beyond rounding: 1e-12 relative (a few hundred eps of the kinetic energy).
-  const double surface_work = c.velocity.dot(lambda_T);
-  if (out.energy_after - surface_work > out.energy_before * (1.0 + 1e-12) + 1e-300) {
-    out.energy_gain = true;
-    std::ostringstream msg;
-    msg.precision(6);
-    msg << "kinetic energy rose through the impact, " << out.energy_before << " -> "
-        << out.energy_after << " J: Newton restitution with coupled normal and tangential "
-        << "directions (W_NT != 0) can create energy (Kane's paradox)";
-    out.message = msg.str();
-  }
+  flag_energy_gain(c, lambda_T, out);
   return out;
 }
 

@@ -13,60 +13,46 @@ namespace lcsim::impact {
 
 namespace detail {
 
-std::optional<Setup> prepare(const ImpactInput& in, ImpactResult& out, bool handles_friction) {
-  out = ImpactResult{};
-  if (in.model == nullptr) {
-    out.message = "impact input has no model";
-    out.status = Status::kInvalidInput;
-    return std::nullopt;
-  }
+namespace {
+
+// Why `in` cannot be applied by a law (that handles friction or not); ""
+// when it can.
+std::string refusal(const ImpactInput& in, bool handles_friction) {
+  if (in.model == nullptr) return "impact input has no model";
   const mech::MechanicalModel& m = *in.model;
-  if (m.has_friction() && !handles_friction) {
-    out.message = "this impact law does not handle friction (the model has " +
-                  std::to_string(m.friction.size()) +
-                  " frictional contacts); the laws 'newton', 'inelastic' and "
-                  "'moreau-restitution' do";
-    out.status = Status::kInvalidInput;
-    return std::nullopt;
-  }
+  if (m.has_friction() && !handles_friction)
+    return "this impact law does not handle friction (the model has " +
+           std::to_string(m.friction.size()) +
+           " frictional contacts); the laws 'newton', 'inelastic' and "
+           "'moreau-restitution' do";
   const int N = m.dofs(), k = m.num_constraints();
-  if (in.v.size() != N) {
-    out.message = "pre-impact velocity has " + std::to_string(in.v.size()) +
-                  " entries, the model has " + std::to_string(N) + " coordinates";
-    out.status = Status::kInvalidInput;
-    return std::nullopt;
-  }
-  for (size_t i = 0; i < in.closed.size(); ++i) {
-    if (in.closed[i] < 0 || in.closed[i] >= k || (i > 0 && in.closed[i] <= in.closed[i - 1])) {
-      out.message = "closed set must be sorted distinct indices in [0, " + std::to_string(k) + ")";
-      out.status = Status::kInvalidInput;
-      return std::nullopt;
-    }
-  }
-  Setup s;
-  s.k = k;
-  if (in.restitution.size() == k)
-    s.e = in.restitution;
-  else if (in.restitution.size() == 0 && m.restitution.size() == k)
-    s.e = m.restitution;
-  else if (in.restitution.size() == 0)
-    s.e = VectorXd::Zero(k);
-  else {
-    out.message = "restitution has " + std::to_string(in.restitution.size()) +
-                  " entries, the model has " + std::to_string(k) + " constraints";
-    out.status = Status::kInvalidInput;
-    return std::nullopt;
-  }
-  out.v_after = in.v;
-  out.impulse = VectorXd::Zero(k);
-  out.energy_before = mech::kinetic_energy(m, in.v);
-  out.energy_after = out.energy_before;
-  if (in.closed.empty()) {
-    out.status = Status::kOk;
-    return std::nullopt;
-  }
+  if (in.v.size() != N)
+    return "pre-impact velocity has " + std::to_string(in.v.size()) + " entries, the model has " +
+           std::to_string(N) + " coordinates";
+  for (size_t i = 0; i < in.closed.size(); ++i)
+    if (in.closed[i] < 0 || in.closed[i] >= k || (i > 0 && in.closed[i] <= in.closed[i - 1]))
+      return "closed set must be sorted distinct indices in [0, " + std::to_string(k) + ")";
+  if (in.restitution.size() != k && in.restitution.size() != 0)
+    return "restitution has " + std::to_string(in.restitution.size()) + " entries, the model has " +
+           std::to_string(k) + " constraints";
+  return "";
+}
+
+// The coefficients: the input's, else the model's, else 0.
+VectorXd restitution_of(const ImpactInput& in) {
+  const mech::MechanicalModel& m = *in.model;
+  const int k = m.num_constraints();
+  if (in.restitution.size() == k) return in.restitution;
+  if (m.restitution.size() == k) return m.restitution;
+  return VectorXd::Zero(k);
+}
+
+// The closed rows' E_J, e_J, M^-1 E_J', W = E_J M^-1 E_J', a = E_J v, and
+// the Cholesky factor L of M.
+void set_up_closed(const ImpactInput& in, Setup& s) {
+  const mech::MechanicalModel& m = *in.model;
   const int nj = static_cast<int>(in.closed.size());
-  s.EJ.resize(nj, N);
+  s.EJ.resize(nj, m.dofs());
   s.e_J.resize(nj);
   for (int i = 0; i < nj; ++i) {
     s.EJ.row(i) = m.E.row(in.closed[i]);
@@ -77,6 +63,29 @@ std::optional<Setup> prepare(const ImpactInput& in, ImpactResult& out, bool hand
   s.W = s.EJ * s.MinvEt;
   s.a = s.EJ * in.v;
   s.L = llt.matrixL();
+}
+
+}  // namespace
+
+std::optional<Setup> prepare(const ImpactInput& in, ImpactResult& out, bool handles_friction) {
+  out = ImpactResult{};
+  out.message = refusal(in, handles_friction);
+  if (!out.message.empty()) {
+    out.status = Status::kInvalidInput;
+    return std::nullopt;
+  }
+  Setup s;
+  s.k = in.model->num_constraints();
+  s.e = restitution_of(in);
+  out.v_after = in.v;
+  out.impulse = VectorXd::Zero(s.k);
+  out.energy_before = mech::kinetic_energy(*in.model, in.v);
+  out.energy_after = out.energy_before;
+  if (in.closed.empty()) {
+    out.status = Status::kOk;
+    return std::nullopt;
+  }
+  set_up_closed(in, s);
   return s;
 }
 

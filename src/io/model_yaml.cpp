@@ -1,5 +1,5 @@
-// Model files and LCP files (YAML, through yaml-cpp), and vectors given on the
-// command line. Format: docs/model-format.md. All validation happens here, so
+// Model files (YAML, through yaml-cpp), and vectors given on the command
+// line. Format: docs/model-format.md. All validation happens here, so
 // the layers below may assume well-formed models; every error names the file,
 // the key and the offending value.
 #include <yaml-cpp/yaml.h>
@@ -24,50 +24,16 @@ namespace lcsim::io {
 namespace {
 
 using yaml::describe;
+using yaml::dims;
+using yaml::expect_size;
 using yaml::fail;
 using yaml::join;
 using yaml::Keys;
 using yaml::load;
 using yaml::mapping;
+using yaml::matrix;
 using yaml::number;
 using yaml::vector;
-
-// A list of rows. `cols_if_empty` gives the column count of `[]` (0 rows).
-MatrixXd matrix(const YAML::Node& n, const std::string& source, const std::string& key,
-                Eigen::Index cols_if_empty) {
-  if (!n.IsSequence())
-    fail(source, key, "expected a matrix as a list of rows (got " + describe(n) + ")");
-  const auto rows = static_cast<Eigen::Index>(n.size());
-  if (rows == 0) return MatrixXd::Zero(0, cols_if_empty);
-  Eigen::Index cols = -1;
-  MatrixXd m;
-  for (Eigen::Index i = 0; i < rows; ++i) {
-    const YAML::Node row = n[static_cast<std::size_t>(i)];
-    const std::string rkey = key + "[" + std::to_string(i) + "]";
-    if (!row.IsSequence())
-      fail(source, rkey,
-           "expected a matrix row as a list of numbers (got " + describe(row) +
-               "); write a matrix as a list of rows, e.g. [[1, 0], [0, 1]]");
-    const auto c = static_cast<Eigen::Index>(row.size());
-    if (cols < 0) {
-      cols = c;
-      m.resize(rows, cols);
-    } else if (c != cols) {
-      fail(source, key,
-           "rows differ in length (row " + std::to_string(i) + " has " + std::to_string(c) +
-               " entries but row 0 has " + std::to_string(cols) + ")");
-    }
-    for (Eigen::Index j = 0; j < c; ++j)
-      m(i, j) =
-          number(row[static_cast<std::size_t>(j)], source, rkey + "[" + std::to_string(j) + "]");
-  }
-  return m;
-}
-
-template <class Mat>
-std::string dims(const Mat& m) {
-  return std::to_string(m.rows()) + " x " + std::to_string(m.cols());
-}
 
 template <class Mat>
 void expect_dims(const Mat& m, Eigen::Index rows, Eigen::Index cols, const std::string& source,
@@ -151,14 +117,6 @@ mech::SparseMatrix sparse_matrix(const YAML::Node& n, const std::string& source,
   }
   m.prune(0.0);
   return m;
-}
-
-void expect_size(const VectorXd& v, Eigen::Index size, const std::string& source,
-                 const std::string& key, const std::string& why) {
-  if (v.size() != size)
-    fail(source, key,
-         "expected " + std::to_string(size) + " entries " + why + " (got " +
-             std::to_string(v.size()) + ")");
 }
 
 std::vector<std::string> names(const YAML::Node& n, Eigen::Index size, const std::string& source,
@@ -392,57 +350,68 @@ mech::Model load_matrix_model(const std::filesystem::path& path) {
   return parse_matrix_model(read_file(path), path.string());
 }
 
+namespace {
+
+// What the rank of E says: dependent constraints, or rows that cannot be
+// active together (the two limits of one joint), or both, told apart when
+// there are few rows (k > 0).
+void add_rank_notes(const mech::MechanicalModel& m, std::vector<std::string>& notes) {
+  const int k = m.num_constraints();
+  const int rank = mech::constraint_rank(m);
+  // Rows that can never be active together (the two limits of one joint)
+  // lower the rank of E without being dependent constraints: checked on
+  // the sets that can be active together when there are few rows.
+  const bool deficit = rank < k;
+  // Beyond the enumeration bound (or an enumeration cut short without a
+  // dependent set found) the two causes are not told apart: said so,
+  // not called dependent.
+  bool judged = k <= mech::kMaxCoactiveConstraints, dependent = false;
+  if (deficit && judged) {
+    const mech::CoactiveSets sets = mech::coactive_sets(m);
+    const Eigen::MatrixXd E(m.E);
+    dependent = std::any_of(sets.maximal.begin(), sets.maximal.end(), [&](const auto& J) {
+      Eigen::MatrixXd EJ(J.size(), E.cols());
+      for (size_t i = 0; i < J.size(); ++i) EJ.row(i) = E.row(J[i]);
+      return lcs::numerical_rank(EJ) < static_cast<int>(J.size());
+    });
+    judged = sets.complete || dependent;
+    if (!dependent && judged)
+      notes.push_back("E (" + std::to_string(k) + " x " + std::to_string(m.dofs()) + ") has rank " +
+                      std::to_string(rank) + " < " + std::to_string(k) +
+                      " only through rows that cannot be active together (e.g. both limits "
+                      "of one joint): every set that can be active together has "
+                      "independent rows, so no constraints are dependent");
+  }
+  if (deficit && !judged)
+    notes.push_back("E (" + std::to_string(k) + " x " + std::to_string(m.dofs()) + ") has rank " +
+                    std::to_string(rank) + " < " + std::to_string(k) +
+                    ": dependent constraints or rows that cannot be active together (e.g. "
+                    "both limits of one joint), not told apart (" +
+                    (k > mech::kMaxCoactiveConstraints
+                         ? "the sets that can be active together are enumerated for k <= " +
+                               std::to_string(mech::kMaxCoactiveConstraints) + " only"
+                         : std::string("their enumeration was cut short")) +
+                    "); dependent constraints are legal (thesis §4.6.1): post-impact "
+                    "velocities are unique, impulses need not be");
+  else if (dependent)
+    notes.push_back("dependent constraints: E (" + std::to_string(k) + " x " +
+                    std::to_string(m.dofs()) + ") has rank " + std::to_string(rank) + " < " +
+                    std::to_string(k) +
+                    "; legal (thesis §4.6.1): post-impact velocities are unique, impulses "
+                    "need not be");
+}
+
+}  // namespace
+
 std::vector<std::string> model_notes(const mech::Model& model) {
   std::vector<std::string> notes;
   if (model.is_mechanical()) {
     const mech::MechanicalModel& m = *model.mechanical;
     const int k = m.num_constraints();
-    if (k == 0) {
+    if (k == 0)
       notes.push_back("no unilateral constraints: the model is a free linear system");
-    } else {
-      const int rank = mech::constraint_rank(m);
-      // Rows that can never be active together (the two limits of one joint)
-      // lower the rank of E without being dependent constraints: checked on
-      // the sets that can be active together when there are few rows.
-      const bool deficit = rank < k;
-      // Beyond the enumeration bound (or an enumeration cut short without a
-      // dependent set found) the two causes are not told apart: said so,
-      // not called dependent.
-      bool judged = k <= mech::kMaxCoactiveConstraints, dependent = false;
-      if (deficit && judged) {
-        const mech::CoactiveSets sets = mech::coactive_sets(m);
-        const Eigen::MatrixXd E(m.E);
-        dependent = std::any_of(sets.maximal.begin(), sets.maximal.end(), [&](const auto& J) {
-          Eigen::MatrixXd EJ(J.size(), E.cols());
-          for (size_t i = 0; i < J.size(); ++i) EJ.row(i) = E.row(J[i]);
-          return lcs::numerical_rank(EJ) < static_cast<int>(J.size());
-        });
-        judged = sets.complete || dependent;
-        if (!dependent && judged)
-          notes.push_back("E (" + std::to_string(k) + " x " + std::to_string(m.dofs()) +
-                          ") has rank " + std::to_string(rank) + " < " + std::to_string(k) +
-                          " only through rows that cannot be active together (e.g. both limits "
-                          "of one joint): every set that can be active together has "
-                          "independent rows, so no constraints are dependent");
-      }
-      if (deficit && !judged)
-        notes.push_back("E (" + std::to_string(k) + " x " + std::to_string(m.dofs()) +
-                        ") has rank " + std::to_string(rank) + " < " + std::to_string(k) +
-                        ": dependent constraints or rows that cannot be active together (e.g. "
-                        "both limits of one joint), not told apart (" +
-                        (k > mech::kMaxCoactiveConstraints
-                             ? "the sets that can be active together are enumerated for k <= " +
-                                   std::to_string(mech::kMaxCoactiveConstraints) + " only"
-                             : std::string("their enumeration was cut short")) +
-                        "); dependent constraints are legal (thesis §4.6.1): post-impact "
-                        "velocities are unique, impulses need not be");
-      else if (dependent)
-        notes.push_back("dependent constraints: E (" + std::to_string(k) + " x " +
-                        std::to_string(m.dofs()) + ") has rank " + std::to_string(rank) + " < " +
-                        std::to_string(k) +
-                        "; legal (thesis §4.6.1): post-impact velocities are unique, impulses "
-                        "need not be");
-    }
+    else
+      add_rank_notes(m, notes);
     if (model.initial.size() == model.state_size() && k > 0) {
       const VectorXd y = mech::gaps(m, model.initial.head(m.dofs()));
       for (int i = 0; i < k; ++i)
@@ -455,24 +424,6 @@ std::vector<std::string> model_notes(const mech::Model& model) {
   if (model.initial.size() == 0) notes.push_back("no initial state in the file");
   if (std::isnan(model.t_end)) notes.push_back("no t_end in the file");
   return notes;
-}
-
-LcpProblem load_lcp(const std::filesystem::path& path) {
-  const std::string source = path.string();
-  const YAML::Node root = load(read_file(path), source);
-  if (root.IsNull() || !root.IsDefined())
-    throw InputError(source + ": empty file (expected `M` and `q`)");
-  const Keys keys = mapping(root, source, "", {"name", "M", "q"});
-  for (const char* k : {"M", "q"})
-    if (!keys.count(k)) fail(source, k, "missing (an LCP file gives M and q)");
-  LcpProblem p;
-  p.M = matrix(keys.at("M"), source, "M", 0);
-  if (p.M.rows() == 0) fail(source, "M", "empty");
-  if (p.M.rows() != p.M.cols())
-    fail(source, "M", "expected a square matrix (got " + dims(p.M) + ")");
-  p.q = vector(keys.at("q"), source, "q");
-  expect_size(p.q, p.M.rows(), source, "q", "(k, from M)");
-  return p;
 }
 
 VectorXd parse_vector(const std::string& text, const std::string& what) {

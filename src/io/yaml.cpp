@@ -1,4 +1,4 @@
-// The YAML reading helpers shared by model_yaml.cpp and scene.cpp
+// The YAML reading helpers shared by the model, LCP and scene readers
 // (lcsim/io/yaml.hpp).
 #include <algorithm>
 #include <cmath>
@@ -80,6 +80,45 @@ Eigen::VectorXd vector(const YAML::Node& n, const std::string& source, const std
   for (std::size_t i = 0; i < n.size(); ++i)
     v(static_cast<Eigen::Index>(i)) = number(n[i], source, key + "[" + std::to_string(i) + "]");
   return v;
+}
+
+Eigen::MatrixXd matrix(const YAML::Node& n, const std::string& source, const std::string& key,
+                       Eigen::Index cols_if_empty) {
+  if (!n.IsSequence())
+    fail(source, key, "expected a matrix as a list of rows (got " + describe(n) + ")");
+  const auto rows = static_cast<Eigen::Index>(n.size());
+  if (rows == 0) return Eigen::MatrixXd::Zero(0, cols_if_empty);
+  Eigen::Index cols = -1;
+  Eigen::MatrixXd m;
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    const YAML::Node row = n[static_cast<std::size_t>(i)];
+    const std::string rkey = key + "[" + std::to_string(i) + "]";
+    if (!row.IsSequence())
+      fail(source, rkey,
+           "expected a matrix row as a list of numbers (got " + describe(row) +
+               "); write a matrix as a list of rows, e.g. [[1, 0], [0, 1]]");
+    const auto c = static_cast<Eigen::Index>(row.size());
+    if (cols < 0) {
+      cols = c;
+      m.resize(rows, cols);
+    } else if (c != cols) {
+      fail(source, key,
+           "rows differ in length (row " + std::to_string(i) + " has " + std::to_string(c) +
+               " entries but row 0 has " + std::to_string(cols) + ")");
+    }
+    for (Eigen::Index j = 0; j < c; ++j)
+      m(i, j) =
+          number(row[static_cast<std::size_t>(j)], source, rkey + "[" + std::to_string(j) + "]");
+  }
+  return m;
+}
+
+void expect_size(const Eigen::VectorXd& v, Eigen::Index size, const std::string& source,
+                 const std::string& key, const std::string& why) {
+  if (v.size() != size)
+    fail(source, key,
+         "expected " + std::to_string(size) + " entries " + why + " (got " +
+             std::to_string(v.size()) + ")");
 }
 
 }  // namespace lcsim::io::yaml

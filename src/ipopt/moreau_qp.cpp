@@ -145,19 +145,8 @@ std::string status_name(Ipopt::ApplicationReturnStatus s) {
   }
 }
 
-}  // namespace
-
-ImpactResult moreau_qp(const ImpactInput& in) {
-  ImpactResult out;
-  const auto s = detail::prepare(in, out);
-  if (!s) return out;
-  const double vs = std::max(in.v.cwiseAbs().maxCoeff(), 1e-300);
-  if (in.v.cwiseAbs().maxCoeff() == 0.0) {  // at rest: nothing to project
-    detail::finish(in, *s, VectorXd::Zero(in.closed.size()), in.v, 0.0, out);
-    out.status = Status::kOk;
-    return out;
-  }
-  Ipopt::SmartPtr<ImpactQp> qp = new ImpactQp(in.model->M, s->EJ, in.v / vs);
+// Ipopt, silent, to the tolerances the minimisation 3.8.1 needs.
+Ipopt::SmartPtr<Ipopt::IpoptApplication> ipopt_application() {
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
   auto opts = app->Options();
   opts->SetStringValue("sb", "yes");  // no banner
@@ -173,6 +162,37 @@ ImpactResult moreau_qp(const ImpactInput& in) {
   opts->SetStringValue("jac_d_constant", "yes");
   opts->SetStringValue("mu_strategy", "adaptive");
   opts->SetIntegerValue("max_iter", 500);
+  return app;
+}
+
+// Search_Direction_Becomes_Too_Small: Ipopt's step vanished before its
+// tolerance was met, typically at the optimum of a degenerate problem
+// (dependent rows). Accept the point on its evidence: the KKT conditions
+// (3.66)-(3.67) hold to 1e-9 on the scaled problem (v / vs).
+bool kkt_holds(const ImpactInput& in, const detail::Setup& s, const ImpactQp& qp, double vs) {
+  if (qp.w.size() != in.v.size()) return false;
+  const VectorXd lam = (-qp.multipliers).cwiseMax(0.0);
+  const VectorXd rate = s.EJ * qp.w;
+  const VectorXd stat = in.model->M * (qp.w - in.v / vs) - s.EJ.transpose() * lam;
+  const double scale = 1.0 + (in.model->M * (in.v / vs)).cwiseAbs().maxCoeff();
+  return rate.minCoeff() >= -1e-9 && stat.cwiseAbs().maxCoeff() <= 1e-9 * scale &&
+         lam.cwiseProduct(rate).cwiseAbs().maxCoeff() <= 1e-9 * scale;
+}
+
+}  // namespace
+
+ImpactResult moreau_qp(const ImpactInput& in) {
+  ImpactResult out;
+  const auto s = detail::prepare(in, out);
+  if (!s) return out;
+  const double vs = std::max(in.v.cwiseAbs().maxCoeff(), 1e-300);
+  if (in.v.cwiseAbs().maxCoeff() == 0.0) {  // at rest: nothing to project
+    detail::finish(in, *s, VectorXd::Zero(in.closed.size()), in.v, 0.0, out);
+    out.status = Status::kOk;
+    return out;
+  }
+  Ipopt::SmartPtr<ImpactQp> qp = new ImpactQp(in.model->M, s->EJ, in.v / vs);
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = ipopt_application();
   Ipopt::ApplicationReturnStatus st = app->Initialize("");  // "": read no ipopt.opt
   if (st != Ipopt::Solve_Succeeded) {
     out.message = "moreau-qp: Ipopt failed to initialise: " + status_name(st);
@@ -181,19 +201,8 @@ ImpactResult moreau_qp(const ImpactInput& in) {
   st = app->OptimizeTNLP(qp);
   if (Ipopt::IsValid(app->Statistics())) out.iterations = app->Statistics()->IterationCount();
   const bool solved = st == Ipopt::Solve_Succeeded || st == Ipopt::Solved_To_Acceptable_Level;
-  // Search_Direction_Becomes_Too_Small: Ipopt's step vanished before its
-  // tolerance was met, typically at the optimum of a degenerate problem
-  // (dependent rows). Accept the point on its evidence: the KKT conditions
-  // (3.66)-(3.67) hold to 1e-9 on the scaled problem.
-  bool kkt = false;
-  if (!solved && st == Ipopt::Search_Direction_Becomes_Too_Small && qp->w.size() == in.v.size()) {
-    const VectorXd lam = (-qp->multipliers).cwiseMax(0.0);
-    const VectorXd rate = s->EJ * qp->w;
-    const VectorXd stat = in.model->M * (qp->w - in.v / vs) - s->EJ.transpose() * lam;
-    const double scale = 1.0 + (in.model->M * (in.v / vs)).cwiseAbs().maxCoeff();
-    kkt = rate.minCoeff() >= -1e-9 && stat.cwiseAbs().maxCoeff() <= 1e-9 * scale &&
-          lam.cwiseProduct(rate).cwiseAbs().maxCoeff() <= 1e-9 * scale;
-  }
+  const bool kkt =
+      !solved && st == Ipopt::Search_Direction_Becomes_Too_Small && kkt_holds(in, *s, *qp, vs);
   if (!solved && !kkt) {
     out.message = "moreau-qp: Ipopt did not solve the minimisation 3.8.1: " + status_name(st);
     return out;

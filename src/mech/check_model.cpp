@@ -133,7 +133,11 @@ std::optional<ModelProblem> check_mass_matrix(const SparseMatrix& M) {
   return std::nullopt;
 }
 
-std::optional<ModelProblem> check_mechanical(const MechanicalModel& m) {
+namespace {
+
+// The sizes of every matrix, vector and name list against N (the rows of M)
+// and k (the rows of E).
+std::optional<ModelProblem> check_dimensions(const MechanicalModel& m) {
   const Eigen::Index N = m.M.rows(), k = m.E.rows();
   if (N == 0) return ModelProblem{"mechanical.M", "empty (a model needs at least one coordinate)"};
   if (m.M.cols() != N)
@@ -170,6 +174,11 @@ std::optional<ModelProblem> check_mechanical(const MechanicalModel& m) {
     return ModelProblem{"mechanical.constraints", "expected " + std::to_string(k) + " names" + kk +
                                                       " (got " +
                                                       std::to_string(m.constraints.size()) + ")"};
+  return std::nullopt;
+}
+
+// Every entry finite, the matrices then the vectors.
+std::optional<ModelProblem> check_finite(const MechanicalModel& m) {
   const std::pair<const SparseMatrix*, const char*> mats[] = {{&m.M, "mechanical.M"},
                                                               {&m.D, "mechanical.D"},
                                                               {&m.K, "mechanical.K"},
@@ -180,6 +189,12 @@ std::optional<ModelProblem> check_mechanical(const MechanicalModel& m) {
       {&m.g, "mechanical.g"}, {&m.f, "mechanical.f"}, {&m.restitution, "mechanical.restitution"}};
   for (const auto& [v, field] : vecs)
     if (auto at = non_finite_vector(*v)) return ModelProblem{field + *at, "not finite"};
+  return std::nullopt;
+}
+
+// M symmetric positive definite, restitution in [0, 1], no all-zero row of E.
+std::optional<ModelProblem> check_values(const MechanicalModel& m) {
+  const Eigen::Index N = m.M.rows(), k = m.E.rows();
   if (auto p = check_mass_matrix(m.M)) return p;
   for (Eigen::Index i = 0; i < k; ++i)
     if (m.restitution(i) < 0.0 || m.restitution(i) > 1.0)
@@ -195,6 +210,15 @@ std::optional<ModelProblem> check_mechanical(const MechanicalModel& m) {
                             "constraint '" + m.constraints[i] +
                                 "' has an all-zero row (it constrains no coordinate)"};
   }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<ModelProblem> check_mechanical(const MechanicalModel& m) {
+  if (auto p = check_dimensions(m)) return p;
+  if (auto p = check_finite(m)) return p;
+  if (auto p = check_values(m)) return p;
   return check_friction(m);
 }
 

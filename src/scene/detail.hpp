@@ -1,8 +1,20 @@
 // Internal helpers of src/scene (not part of its public face, lcsim/scene/).
 #pragma once
 
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Dense>
+#include <functional>
+#include <lcsim/io/yaml.hpp>
+#include <lcsim/scene/urdf.hpp>
 #include <map>
+#include <memory>
 #include <string>
+#include <vector>
+
+namespace urdf {
+class Joint;
+}
 
 namespace lcsim::scene {
 
@@ -18,5 +30,116 @@ std::string without_geometry(const std::string& xml);
 // stops they would lock the joint at 0 (bullet3's Minitaur knees, whose
 // <limit> gives only effort and velocity), so a scene refuses them there.
 std::map<std::string, std::string> limits_without_bounds(const std::string& xml);
+
+// ---------------------------------------------------------------------------
+// Reading a scene file. read_scene (scene.cpp) is a driver that calls one
+// stage per top-level key, in the order the file is checked: a file with two
+// errors reports the one of the earlier stage. A new key gets a stage here
+// (declared below, defined in src/scene/scene_<key>.cpp when it is a concept
+// of its own), its name in read_scene's list of keys, and its call in
+// read_scene after the stages whose results it needs (a key that adds
+// constraints adds them to SceneConstraints before the names are checked).
+// Every stage throws InputError "<scene>: <key>: <what>" (io::yaml::fail).
+
+using io::yaml::Keys;
+
+// The values a scene's keys hold (scene_values.cpp).
+// A non-empty scalar.
+std::string name_of(const YAML::Node& n, const std::string& source, const std::string& key);
+// true or false (YAML 1.2's booleans only: yaml-cpp would also read yes,
+// on, y, which a typo can produce).
+bool boolean(const YAML::Node& n, const std::string& source, const std::string& key);
+// Why a name may not be used ("" when it may).
+using NameCheck = std::function<std::string(const std::string&)>;
+// {name: number} with every name passing `check` (a joint of the URDF for
+// q0, a simulated joint for springs and initial, a constraint for
+// restitution); a name that fails is an error at `key`.`name`.
+std::map<std::string, double> by_name(const YAML::Node& n, const std::string& source,
+                                      const std::string& key, const NameCheck& check);
+
+// `urdf:` and `balance_inertia:` (scene_urdf.cpp): the robot, its path
+// relative to the scene's directory, the joints whose <limit> lacks a bound
+// and what loading repaired.
+struct SceneUrdf {
+  std::shared_ptr<urdf::ModelInterface> model;
+  std::string path;                              // for messages
+  std::map<std::string, std::string> unbounded;  // limits_without_bounds
+  UrdfRepairs repairs;
+};
+SceneUrdf read_urdf(const Keys& keys, const std::string& source);
+
+// `joints:` (scene_joints.cpp): the simulated joints (the coordinates, in
+// file order), each with the stops it asked for ("lower", "upper") on its own
+// limits and on those of the joints that mimic it; and the URDF's mimic
+// joints that follow them.
+struct SceneJoints {
+  std::vector<std::string> names;
+  std::vector<std::vector<std::string>> stops, mimic_stops;  // per joint, as names
+  std::map<std::string, Mimic> mimics;
+  Eigen::Index size() const { return static_cast<Eigen::Index>(names.size()); }
+  // The coordinate of joint `name` (size() when it is not simulated).
+  Eigen::Index coord(const std::string& name) const;
+  // The joints' values in `values` as a vector over the coordinates (0 for
+  // a joint not named).
+  VectorXd vector_of(const std::map<std::string, double>& values) const;
+};
+// Revolute, continuous or prismatic: a joint with a position.
+bool has_position(const urdf::Joint& j);
+SceneJoints read_joints(const Keys& keys, const std::string& source, const SceneUrdf& urdf);
+// The check of a joint named where only simulated joints may be (springs,
+// constraints, initial): "" for a simulated joint, else why not.
+NameCheck simulated(const SceneJoints& joints, const SceneUrdf& urdf);
+
+// Stops (scene_stops.cpp): a joint's <limit> as unilateral constraints.
+// The `stops:` or `mimic_stops:` list at `key`.
+std::vector<std::string> stop_list(const YAML::Node& s, const std::string& source,
+                                   const std::string& key);
+// Whether joint j (entry `key` of joints:) can have the stops `st` (cleared
+// for a continuous joint without explicit ones); InputError if not.
+void check_stops(const urdf::Joint& j, bool explicit_stops, std::vector<std::string>& st,
+                 const std::string& source, const std::string& key, const SceneUrdf& urdf);
+
+// `q0:` (scene_state.cpp): the reference configuration the scene is
+// linearised about, by joint of the URDF (a mimic's value checked against
+// its leader's and dropped); `initial:`: the state a run starts from.
+std::map<std::string, double> read_q0(const Keys& keys, const std::string& source,
+                                      const SceneUrdf& urdf, const SceneJoints& joints);
+// x = (q, v): q0 at rest, but for the positions and velocities `initial`
+// names.
+VectorXd read_initial(const Keys& keys, const std::string& source, const SceneUrdf& urdf,
+                      const SceneJoints& joints, const VectorXd& q0);
+
+// The dynamics being assembled, dense (scenes are small: one coordinate per
+// simulated joint; stored sparse in mech::MechanicalModel at the end).
+struct SceneDynamics {
+  MatrixXd D, K;  // damping, stiffness
+  VectorXd f;     // constant generalised force
+};
+// `springs:` (scene_springs.cpp), added to K, D and f.
+void add_springs(const Keys& keys, const std::string& source, const SceneUrdf& urdf,
+                 const SceneJoints& joints, SceneDynamics& dyn);
+
+// The unilateral constraints E q + g >= 0 being assembled, one row each, in
+// the model's order: the joint stops first, then the scene's constraints.
+struct SceneConstraints {
+  std::vector<VectorXd> rows;
+  std::vector<double> gaps;
+  std::vector<std::string> names;
+  void add(VectorXd row, double gap, std::string name);
+  MatrixXd E(Eigen::Index coordinates) const;
+  VectorXd g() const;
+};
+// The stops of every simulated joint (joint order, lower before upper),
+// each followed by those on the joints that mimic it (scene_stops.cpp).
+SceneConstraints joint_stops(const std::string& source, const SceneUrdf& urdf,
+                             const SceneJoints& joints);
+// `constraints:` (scene_constraints.cpp), in file order; then the check that
+// no two constraints share a name.
+void add_constraints(const Keys& keys, const std::string& source, const SceneUrdf& urdf,
+                     const SceneJoints& joints, SceneConstraints& out);
+void check_unique_names(const SceneConstraints& c, const std::string& source);
+// `restitution:` by constraint name (0 for those not named).
+VectorXd read_restitution(const Keys& keys, const std::string& source,
+                          const std::vector<std::string>& constraints);
 
 }  // namespace lcsim::scene

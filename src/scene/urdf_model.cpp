@@ -183,9 +183,8 @@ std::string check_inertia(urdf::Inertial& in, bool balance, const std::string& s
          three(p) + " -> " + three(q) + " kg m^2 (principal axes and mass kept)";
 }
 
-// Checks what lcsim relies on (parse_urdf); inertias are repaired in `m`
-// instead of refused when repairs.balance_inertia, noted in repairs.notes.
-void check_urdf(urdf::ModelInterface& m, const std::string& source, UrdfRepairs& repairs) {
+// The joints form a tree.
+void check_tree(const urdf::ModelInterface& m, const std::string& source) {
   // urdfdom accepts a joint whose parent is its own child (it only looks for
   // a root): the link then lists itself among its children and every walk
   // down the tree recurses for ever. Refuse it, and any link reached twice.
@@ -206,6 +205,11 @@ void check_urdf(urdf::ModelInterface& m, const std::string& source, UrdfRepairs&
       for (const auto& c : l->child_links) todo.push_back(c.get());
     }
   }
+}
+
+// Every <inertial>: finite, mass >= 0, a tensor some rigid body has (or
+// repaired when repairs.balance_inertia, noted in repairs.notes).
+void check_links(urdf::ModelInterface& m, const std::string& source, UrdfRepairs& repairs) {
   for (const auto& [name, link] : m.links_) {
     if (!link->inertial) continue;
     urdf::Inertial& in = *link->inertial;
@@ -219,36 +223,46 @@ void check_urdf(urdf::ModelInterface& m, const std::string& source, UrdfRepairs&
         !note.empty())
       repairs.notes.push_back(one_line(note));
   }
-  for (const auto& [name, joint] : m.joints_) {
-    const std::string el = "joint '" + name + "'";
-    if (!finite_pose(joint->parent_to_joint_origin_transform))
-      fail(source, el + ": <origin>", "not finite");
-    const Vector3d a = vec(joint->axis);
-    if (moves(*joint) && (!a.allFinite() || a.norm() == 0.0))
-      fail(source, el + ": <axis xyz>",
-           "must be finite and non-zero (got " + num(a.x()) + " " + num(a.y()) + " " + num(a.z()) +
+}
+
+// Joint `name`: finite <origin>, a non-zero <axis> if it moves, finite
+// <limit>, <mimic> and <dynamics damping> >= 0.
+void check_joint(const std::string& name, const urdf::Joint& j, const std::string& source) {
+  const std::string el = "joint '" + name + "'";
+  if (!finite_pose(j.parent_to_joint_origin_transform))
+    fail(source, el + ": <origin>", "not finite");
+  const Vector3d a = vec(j.axis);
+  if (moves(j) && (!a.allFinite() || a.norm() == 0.0))
+    fail(source, el + ": <axis xyz>",
+         "must be finite and non-zero (got " + num(a.x()) + " " + num(a.y()) + " " + num(a.z()) +
+             ")");
+  if (j.limits) {
+    const urdf::JointLimits& l = *j.limits;
+    if (!std::isfinite(l.lower) || !std::isfinite(l.upper))
+      fail(source, el + ": <limit>",
+           "lower and upper must be finite (got lower=" + num(l.lower) + ", upper=" + num(l.upper) +
                ")");
-    if (joint->limits) {
-      const urdf::JointLimits& l = *joint->limits;
-      if (!std::isfinite(l.lower) || !std::isfinite(l.upper))
-        fail(source, el + ": <limit>",
-             "lower and upper must be finite (got lower=" + num(l.lower) +
-                 ", upper=" + num(l.upper) + ")");
-      // lower > upper (Bullet's data files use it for "no limit") is refused
-      // only where the limit becomes a stop (scene.cpp): a frozen joint's
-      // limits are never used.
-    }
-    if (joint->mimic &&
-        (!std::isfinite(joint->mimic->multiplier) || !std::isfinite(joint->mimic->offset)))
-      fail(source, el + ": <mimic>",
-           "multiplier and offset must be finite (got multiplier=" + num(joint->mimic->multiplier) +
-               ", offset=" + num(joint->mimic->offset) + ")");
-    if (joint->dynamics) {
-      const double d = joint->dynamics->damping;
-      if (!std::isfinite(d) || d < 0.0)
-        fail(source, el + ": <dynamics damping>", "must be finite and >= 0 (got " + num(d) + ")");
-    }
+    // lower > upper (Bullet's data files use it for "no limit") is refused
+    // only where the limit becomes a stop (scene_stops.cpp): a frozen joint's
+    // limits are never used.
   }
+  if (j.mimic && (!std::isfinite(j.mimic->multiplier) || !std::isfinite(j.mimic->offset)))
+    fail(source, el + ": <mimic>",
+         "multiplier and offset must be finite (got multiplier=" + num(j.mimic->multiplier) +
+             ", offset=" + num(j.mimic->offset) + ")");
+  if (j.dynamics) {
+    const double d = j.dynamics->damping;
+    if (!std::isfinite(d) || d < 0.0)
+      fail(source, el + ": <dynamics damping>", "must be finite and >= 0 (got " + num(d) + ")");
+  }
+}
+
+// Checks what lcsim relies on (parse_urdf); inertias are repaired in `m`
+// instead of refused when repairs.balance_inertia, noted in repairs.notes.
+void check_urdf(urdf::ModelInterface& m, const std::string& source, UrdfRepairs& repairs) {
+  check_tree(m, source);
+  check_links(m, source, repairs);
+  for (const auto& [name, joint] : m.joints_) check_joint(name, *joint, source);
   (void)mimic_joints(m, source);  // every leader exists, has a position, no cycles
 }
 

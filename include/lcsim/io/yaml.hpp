@@ -56,4 +56,20 @@ double number(const YAML::Node& n, const std::string& source, const std::string&
 // A list of finite numbers.
 Eigen::VectorXd vector(const YAML::Node& n, const std::string& source, const std::string& key);
 
+// A dense matrix as a list of rows of finite numbers, all of one length.
+// `cols_if_empty` gives the column count of `[]` (0 rows).
+Eigen::MatrixXd matrix(const YAML::Node& n, const std::string& source, const std::string& key,
+                       Eigen::Index cols_if_empty);
+
+// "R x C", a matrix's dimensions for "(got ...)" in messages.
+template <class Mat>
+std::string dims(const Mat& m) {
+  return std::to_string(m.rows()) + " x " + std::to_string(m.cols());
+}
+
+// That `v` has `size` entries; else "expected <size> entries <why> (got
+// <v.size()>)" at `key`.
+void expect_size(const Eigen::VectorXd& v, Eigen::Index size, const std::string& source,
+                 const std::string& key, const std::string& why);
+
 }  // namespace lcsim::io::yaml

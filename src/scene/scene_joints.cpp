@@ -1,0 +1,93 @@
+// A scene's `joints:` key: the joints to simulate (the coordinates), each a
+// name or {name, stops, mimic_stops}; every other joint is frozen.
+#include <urdf_model/model.h>
+
+#include <algorithm>
+#include <lcsim/io/yaml.hpp>
+
+#include "scene/detail.hpp"
+
+namespace lcsim::scene {
+
+using io::yaml::describe;
+using io::yaml::fail;
+
+namespace {
+
+// Entry `k` of joints:, added to `out` with its stops.
+void read_joint(const YAML::Node& n, const std::string& source, const std::string& k,
+                const SceneUrdf& urdf, SceneJoints& out) {
+  std::string name;
+  std::vector<std::string> st{"lower", "upper"}, mst{"lower", "upper"};
+  bool explicit_stops = false;
+  if (n.IsMap()) {
+    const Keys jk = io::yaml::mapping(n, source, k, {"name", "stops", "mimic_stops"});
+    if (!jk.count("name")) fail(source, k + ".name", "missing");
+    name = name_of(jk.at("name"), source, k + ".name");
+    explicit_stops = jk.count("stops") > 0;
+    if (explicit_stops) st = stop_list(jk.at("stops"), source, k + ".stops");
+    if (jk.count("mimic_stops")) mst = stop_list(jk.at("mimic_stops"), source, k + ".mimic_stops");
+  } else {
+    name = name_of(n, source, k);
+  }
+  const auto j = urdf.model->getJoint(name);
+  if (!j) fail(source, k, "no joint '" + name + "' in " + urdf.path);
+  if (!has_position(*j))
+    fail(source, k,
+         "joint '" + name +
+             "' is not revolute, continuous or prismatic (only those can be simulated; leave "
+             "it out to freeze it)");
+  if (std::count(out.names.begin(), out.names.end(), name))
+    fail(source, k, "duplicate joint '" + name + "'");
+  check_stops(*j, explicit_stops, st, source, k, urdf);
+  out.names.push_back(name);
+  out.stops.push_back(st);
+  out.mimic_stops.push_back(mst);
+}
+
+}  // namespace
+
+SceneJoints read_joints(const Keys& keys, const std::string& source, const SceneUrdf& urdf) {
+  if (!keys.count("joints")) fail(source, "joints", "missing (name the joints to simulate)");
+  const YAML::Node& jn = keys.at("joints");
+  if (!jn.IsSequence() || jn.size() == 0)
+    fail(source, "joints", "expected a non-empty list of joint names (got " + describe(jn) + ")");
+  SceneJoints out;
+  for (std::size_t i = 0; i < jn.size(); ++i)
+    read_joint(jn[i], source, "joints[" + std::to_string(i) + "]", urdf, out);
+  out.mimics = mimic_joints(*urdf.model, urdf.path, out.names);
+  return out;
+}
+
+bool has_position(const urdf::Joint& j) {
+  return j.type == urdf::Joint::REVOLUTE || j.type == urdf::Joint::PRISMATIC ||
+         j.type == urdf::Joint::CONTINUOUS;
+}
+
+Eigen::Index SceneJoints::coord(const std::string& name) const {
+  return std::find(names.begin(), names.end(), name) - names.begin();
+}
+
+VectorXd SceneJoints::vector_of(const std::map<std::string, double>& values) const {
+  VectorXd v = VectorXd::Zero(size());
+  for (Eigen::Index i = 0; i < size(); ++i)
+    if (values.count(names[static_cast<std::size_t>(i)]))
+      v(i) = values.at(names[static_cast<std::size_t>(i)]);
+  return v;
+}
+
+NameCheck simulated(const SceneJoints& joints, const SceneUrdf& urdf) {
+  return [&](const std::string& n) -> std::string {
+    if (!urdf.model->getJoint(n)) return "no joint '" + n + "' in " + urdf.path;
+    if (joints.mimics.count(n))
+      return "joint '" + n + "' mimics '" + joints.mimics.at(n).leader +
+             "' (it follows its leader and is not a coordinate)";
+    if (joints.coord(n) == joints.size())
+      return "joint '" + n +
+             "' is frozen (not in joints:); only simulated joints can carry springs, constraints "
+             "and initial values";
+    return "";
+  };
+}
+
+}  // namespace lcsim::scene
