@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 #include <functional>
+#include <lcsim/core/format.hpp>
 #include <lcsim/core/outcome.hpp>
 #include <lcsim/core/status.hpp>
 #include <lcsim/impact/impact.hpp>
@@ -347,8 +348,8 @@ class DivergenceGuard {
 void check_diverged(const mech::Model& model, const VectorXd& x0, Trajectory& tr);
 
 // A number with six significant digits, as the integrators' messages print it
-// ("0.001", "3.16228e+04").
-std::string short_number(double x);
+// ("0.001", "3.16228e+04"): lcsim::short_number (core/format.hpp).
+using lcsim::short_number;
 
 // Event-driven integration (Algorithm 3.7.1): exact matrix-exponential phases,
 // events as roots of Bohl functions, re-initialisation by the impact law
