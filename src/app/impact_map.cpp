@@ -114,10 +114,10 @@ std::vector<int> parse_constraint_list(const mech::MechanicalModel& m, const std
 impact::IndexSet closed_constraints(const mech::MechanicalModel& m, const Eigen::VectorXd& q,
                                     const std::string& what) {
   const Eigen::VectorXd gap = m.E * q + m.g;
-  const Eigen::VectorXd scale = m.E.cwiseAbs() * q.cwiseAbs() + m.g.cwiseAbs();
+  const Eigen::VectorXd scale = mech::gap_scale(m.E, q, m.g);
   impact::IndexSet closed;
   for (int i = 0; i < m.num_constraints(); ++i) {
-    const bool zero = std::abs(gap(i)) <= 1e-9 * scale(i) + 1e-13;
+    const bool zero = mech::gap_is_zero(gap(i), scale(i));
     if (!zero && gap(i) < 0.0)
       throw InputError(what + ": constraint '" + m.constraints[i] + "' (" + std::to_string(i) +
                        ") is violated at q = " + vec_text(q) + " (gap = " + format_number(gap(i)) +

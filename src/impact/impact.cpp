@@ -322,22 +322,18 @@ class NamedLaw : public ImpactLaw {
 }  // namespace
 
 Registry<ImpactLaw>& laws() {
-  static Registry<ImpactLaw>& r = *[] {
-    auto* reg = new Registry<ImpactLaw>("impact law");  // never destroyed: used at exit
+  return Registry<ImpactLaw>::instance("impact law", [](Registry<ImpactLaw>& reg) {
     for (const Rule& rule : kRules)
-      reg->add(rule.name, [rule] { return std::make_unique<NamedLaw>(rule); });
-    reg->add_alias("moreau", "newton", kMoreauAliasNote);
-    return reg;
-  }();
-  return r;
+      reg.add(rule.name, [rule] { return std::make_unique<NamedLaw>(rule); });
+    reg.add_alias("moreau", "newton", kMoreauAliasNote);
+  });
 }
 
 std::vector<std::string> impact_law_names() { return laws().names(); }
 
 std::unique_ptr<ImpactLaw> make_impact_law(std::string_view name) {
-  if (auto law = laws().make(name)) return law;
-  throw std::invalid_argument(laws().unknown_message(
-      name, name == "moreau-qp" ? "moreau-qp is in the component lcsim::ipopt; link it" : ""));
+  return laws().make_or_throw(
+      name, name == "moreau-qp" ? "moreau-qp is in the component lcsim::ipopt; link it" : "");
 }
 
 }  // namespace lcsim::impact

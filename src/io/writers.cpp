@@ -7,7 +7,6 @@
 
 #include <atomic>
 #include <cerrno>
-#include <charconv>
 #include <cstdio>
 #include <cstring>
 #include <lcsim/io/io.hpp>
@@ -15,12 +14,6 @@
 #include <stdexcept>
 
 namespace lcsim::io {
-
-std::string format_number(double x) {
-  char buf[64];
-  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, x);
-  return ec == std::errc() ? std::string(buf, end) : std::string("?");
-}
 
 std::string one_line(const std::string& text, std::size_t max_chars) {
   std::string out;
@@ -47,11 +40,7 @@ std::string one_line(const std::string& text, std::size_t max_chars) {
 namespace {
 
 // %.17g: enough significant digits that every double reads back exactly.
-void append_number(std::string& out, double x) {
-  char buf[32];
-  const int n = std::snprintf(buf, sizeof buf, "%.17g", x);
-  out.append(buf, static_cast<std::size_t>(n));
-}
+constexpr int kCsvDigits = 17;
 
 // RFC 4180 quoting for names that contain separators or quotes.
 std::string csv_field(const std::string& s) {
@@ -233,7 +222,7 @@ void append_csv_vector(std::string& out, const VectorXd& v, int size, const char
                            std::to_string(size));
   for (int j = 0; j < size; ++j) {
     out += ',';
-    if (v.size() != 0) append_number(out, v(j));
+    if (v.size() != 0) append_number(out, v(j), kCsvDigits);
   }
 }
 
@@ -260,7 +249,7 @@ void append_csv_row(std::string& out, const sim::Sample& s, int n, int k, int nf
   if (s.x.size() != n)
     throw std::logic_error("trajectory_csv: sample " + std::to_string(r) + " has a state of size " +
                            std::to_string(s.x.size()) + ", expected " + std::to_string(n));
-  append_number(out, s.t);
+  append_number(out, s.t, kCsvDigits);
   append_csv_vector(out, s.x, n, "x", r);
   append_csv_vector(out, s.u, k, "u", r);
   append_csv_vector(out, s.y, k, "y", r);

@@ -1,9 +1,9 @@
 // The acceptance test of every LCP solver: the row-scaled residual.
 #include <algorithm>
 #include <cmath>
+#include <lcsim/core/format.hpp>
 #include <lcsim/lcp/lcp.hpp>
 #include <limits>
-#include <sstream>
 #include <utility>
 
 #include "lcp/detail.hpp"
@@ -59,12 +59,10 @@ Result finish(const MatrixXd& M, const VectorXd& q, VectorXd z, Status claimed, 
   }
   if (claimed == Status::kSolved && !(r.scaled_residual <= opt.tolerance)) {
     const int i = r.worst_row;
-    std::ostringstream os;
-    os << "residual check failed at row " << i << ": z(" << i << ") = " << r.z(i) << ", w(" << i
-       << ") = " << r.w(i) << ", row-scaled residual " << r.scaled_residual << " > tolerance "
-       << opt.tolerance << " (natural residual " << r.residual << ")";
     r.status = Status::kNumericalFailure;
-    r.message = os.str();
+    r.message = text("residual check failed at row ", i, ": z(", i, ") = ", r.z(i), ", w(", i,
+                     ") = ", r.w(i), ", row-scaled residual ", r.scaled_residual, " > tolerance ",
+                     opt.tolerance, " (natural residual ", r.residual, ")");
   }
   return r;
 }

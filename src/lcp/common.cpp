@@ -2,26 +2,15 @@
 #include <cmath>
 #include <exception>
 #include <functional>
+#include <lcsim/core/format.hpp>
 #include <lcsim/lcp/lcp.hpp>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 #include <utility>
 
 #include "lcp/detail.hpp"
 
 namespace lcsim::lcp {
-
-namespace {
-// A message from its parts, formatted as by an ostringstream; built only on
-// the error path (an ostringstream per call cost Euler ~0.3 µs per step).
-template <class... T>
-std::string text(const T&... parts) {
-  std::ostringstream os;
-  (os << ... << parts);
-  return os.str();
-}
-}  // namespace
 
 std::string validate(const MatrixXd& M, const VectorXd& q) {
   if (M.rows() == 0 || M.cols() == 0)
@@ -128,20 +117,14 @@ constexpr Entry kSolvers[] = {
 }  // namespace
 
 Registry<Solver>& solvers() {
-  static Registry<Solver>& r = *[] {
-    auto* reg = new Registry<Solver>("LCP solver");  // never destroyed: used at exit
+  return Registry<Solver>::instance("LCP solver", [](Registry<Solver>& reg) {
     for (const auto& e : kSolvers)
-      reg->add(e.name, [e] { return std::make_unique<FnSolver>(e.name, e.fn); });
-    return reg;
-  }();
-  return r;
+      reg.add(e.name, [e] { return std::make_unique<FnSolver>(e.name, e.fn); });
+  });
 }
 
 std::vector<std::string> solver_names() { return solvers().names(); }
 
-std::unique_ptr<Solver> make_solver(std::string_view name) {
-  if (auto s = solvers().make(name)) return s;
-  throw std::invalid_argument(solvers().unknown_message(name));
-}
+std::unique_ptr<Solver> make_solver(std::string_view name) { return solvers().make_or_throw(name); }
 
 }  // namespace lcsim::lcp

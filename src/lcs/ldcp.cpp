@@ -16,9 +16,9 @@
 // x0 + sum_j A^j B u^{-j} (eq. (3.10)).
 #include <algorithm>
 #include <cmath>
+#include <lcsim/core/format.hpp>
 #include <lcsim/lcs/lcs.hpp>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -148,12 +148,9 @@ std::string free_level(Ldcp& s, const Level& l) {
     if (l.xi(r) > l.tol_y(r, s.opt)) {
       s.state[r] = RowState::kInactive;
     } else if (l.xi(r) < -l.tol_y(r, s.opt)) {
-      std::ostringstream msg;
-      msg.precision(6);
-      msg << "state is not regular: constraint " << r << " has coefficient y^"
-          << s.data.rho[r] + l.p << " = " << l.xi(r)
-          << " < 0 with no impulse allowed (Theorem 3.6.7, (3.40))";
-      return msg.str();
+      return text("state is not regular: constraint ", r, " has coefficient y^",
+                  s.data.rho[r] + l.p, " = ", l.xi(r),
+                  " < 0 with no impulse allowed (Theorem 3.6.7, (3.40))");
     }
   }
   return "";

@@ -26,8 +26,8 @@ VectorXd entries_of(const VectorXd& g, const std::vector<int>& J) {
 
 // Feasibility of { q : E_J q + g_J = 0, E_K q + g_K >= 0 } (K = the rest).
 // 1. E_J q = -g_J: a least-squares q_p by complete orthogonal decomposition;
-//    infeasible when its residual exceeds 1e-9 (|E_J||q_p| + |g_J|) (the
-//    integrator's zero test for a gap, with room for the SVD's rounding).
+//    infeasible when its residual is not zero by gap_is_zero (the
+//    integrator's zero test for a gap, mech/tolerances.hpp).
 // 2. q = q_p + Z z with Z a basis of Ker E_J: the inequalities A z + b >= 0,
 //    A = E_K Z, b = E_K q_p + g_K, are feasible iff the convex QP
 //    min |z|^2/2 s.t. A z + b >= 0 has a solution, iff its KKT LCP
@@ -48,9 +48,9 @@ bool feasible_exact(const MatrixXd& E, const VectorXd& g, const std::vector<int>
     svd.setThreshold(1e-12 * std::max<double>(EJ.rows(), EJ.cols()));
     qp = svd.solve(-gJ);
     const VectorXd res = EJ * qp + gJ;
-    const VectorXd scale = EJ.cwiseAbs() * qp.cwiseAbs() + gJ.cwiseAbs();
+    const VectorXd scale = gap_scale(EJ, qp, gJ);
     for (Eigen::Index i = 0; i < res.size(); ++i)
-      if (std::abs(res(i)) > 1e-9 * scale(i) + 1e-13) return false;
+      if (!gap_is_zero(res(i), scale(i))) return false;
     const int r = static_cast<int>(svd.rank());
     Z = svd.matrixV().rightCols(N - r);
   }

@@ -68,10 +68,11 @@ VectorXd project_feasible(const MechanicalModel& m, const VectorXd& q) {
   const SparseMatrix Et = m.E.transpose();
   const auto violated = [&](const VectorXd& p, std::vector<int>& rows) {
     const VectorXd gap = gaps(m, p);
-    const VectorXd scale = m.E.cwiseAbs() * p.cwiseAbs() + m.g.cwiseAbs();
+    const VectorXd scale = gap_scale(m.E, p, m.g);
     bool added = false;
     for (int i = 0; i < k; ++i)
-      if (gap(i) < -1e-12 * scale(i) && std::find(rows.begin(), rows.end(), i) == rows.end()) {
+      if (projection_violates(gap(i), scale(i)) &&
+          std::find(rows.begin(), rows.end(), i) == rows.end()) {
         rows.push_back(i);
         added = true;
       }

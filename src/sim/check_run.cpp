@@ -2,6 +2,7 @@
 // integrator — the CLI, the Python module, a study, a user's program — goes
 // through Integrator::run and so through this.
 #include <cmath>
+#include <lcsim/core/format.hpp>
 #include <lcsim/impact/impact.hpp>
 #include <lcsim/lcp/lcp.hpp>
 #include <lcsim/sim/sim.hpp>
@@ -10,12 +11,6 @@
 namespace lcsim::sim {
 
 namespace {
-
-const std::string& fmt_s(const std::string& s) { return s; }
-std::string fmt_s(double x) { return short_number(x); }
-std::string fmt_s(long x) { return std::to_string(x); }
-std::string fmt_s(int x) { return std::to_string(x); }
-std::string fmt_s(bool x) { return x ? "true" : "false"; }
 
 // Calls f(used, &Options::member, "member") for every option that some
 // method does not read (the groups of OptionsUsed).
@@ -43,7 +38,8 @@ std::string ignored_options(const Options& opt, std::string_view method, const O
   visit_method_options(u, [&](bool used, auto member, const char* name) {
     if (used || !message.empty() || opt.*member == defaults.*member) return;
     message = "method '" + std::string(method) + "' does not use Options::" + name + " (got " +
-              fmt_s(opt.*member) + "); leave it at its default (" + fmt_s(defaults.*member) + ")";
+              to_text(opt.*member) + "); leave it at its default (" + to_text(defaults.*member) +
+              ")";
   });
   return message;
 }

@@ -2,7 +2,6 @@
 #include <functional>
 #include <lcsim/sim/sim.hpp>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 #include <utility>
 
@@ -98,15 +97,6 @@ bool OutputSampler::want(double t, double h, bool last) {
   return true;
 }
 
-std::string short_number(double x) {
-  std::ostringstream s;
-  s.precision(6);
-  s << x;
-  return s.str();
-}
-
-namespace {}  // namespace
-
 // The methods themselves, on checked input (event_driven.cpp, time_stepping.cpp).
 Trajectory integrate_event_driven(const mech::Model& model, const VectorXd& x0, const Options& opt);
 
@@ -135,14 +125,11 @@ std::unique_ptr<Integrator> make_euler_integrator();
 std::unique_ptr<Integrator> make_moreau_jean_integrator();
 
 Registry<Integrator>& integrators() {
-  static Registry<Integrator>& r = *[] {
-    auto* reg = new Registry<Integrator>("method");  // never destroyed: used at exit
-    reg->add("event", [] { return std::make_unique<EventDrivenIntegrator>(); });
-    reg->add("euler", [] { return make_euler_integrator(); });
-    reg->add("moreau-jean", [] { return make_moreau_jean_integrator(); });
-    return reg;
-  }();
-  return r;
+  return Registry<Integrator>::instance("method", [](Registry<Integrator>& reg) {
+    reg.add("event", [] { return std::make_unique<EventDrivenIntegrator>(); });
+    reg.add("euler", [] { return make_euler_integrator(); });
+    reg.add("moreau-jean", [] { return make_moreau_jean_integrator(); });
+  });
 }
 
 Trajectory simulate_event_driven(const mech::Model& model, const VectorXd& x0, const Options& opt) {
@@ -152,9 +139,8 @@ Trajectory simulate_event_driven(const mech::Model& model, const VectorXd& x0, c
 std::vector<std::string> integrator_names() { return integrators().names(); }
 
 std::unique_ptr<Integrator> make_integrator(std::string_view name) {
-  if (auto m = integrators().make(name)) return m;
-  throw std::invalid_argument(integrators().unknown_message(
-      name, name == "bullet" ? "bullet is in the component lcsim::bullet; link it" : ""));
+  return integrators().make_or_throw(
+      name, name == "bullet" ? "bullet is in the component lcsim::bullet; link it" : "");
 }
 
 }  // namespace lcsim::sim

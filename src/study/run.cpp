@@ -1,6 +1,7 @@
 // One run of a study and its row (run.hpp).
 #include <array>
 #include <chrono>
+#include <lcsim/core/format.hpp>
 #include <lcsim/io/io.hpp>
 #include <lcsim/io/text.hpp>
 #include <lcsim/sim/reference.hpp>
@@ -89,8 +90,6 @@ Setup setup_of(const Study& s, const RunPoint& p) {
   return u;
 }
 
-std::string number(double x) { return io::format_number(x); }
-
 std::string status_word(const sim::Trajectory& t) {
   return std::string(to_string(t.status, "completed"));
 }
@@ -120,7 +119,7 @@ const std::array<std::pair<sim::EventType, const char*>, 4> kEventColumns = {
 void run_cells(std::vector<std::string>& c, const sim::Trajectory& t) {
   c.push_back(status_word(t));
   c.push_back(io::one_line(t.message));
-  c.push_back(number(t.t_end));
+  c.push_back(format_number(t.t_end));
   for (const auto& [type, name] : kEventColumns) {
     long count = 0;
     for (const auto& e : t.events) count += e.type == type;
@@ -128,8 +127,8 @@ void run_cells(std::vector<std::string>& c, const sim::Trajectory& t) {
   }
   c.push_back(std::to_string(t.events_not_recorded));
   const bool energy = t.status != sim::RunStatus::kInvalidInput;
-  c.push_back(energy ? number(t.energy_final - t.energy_initial) : "");
-  c.push_back(energy ? number(t.max_violation) : "");
+  c.push_back(energy ? format_number(t.energy_final - t.energy_initial) : "");
+  c.push_back(energy ? format_number(t.max_violation) : "");
   c.push_back(std::to_string(t.steps));
   c.push_back(std::to_string(t.lcp_solves));
   c.push_back(std::to_string(t.warning_count()));
@@ -154,7 +153,7 @@ void reference_cells(std::vector<std::string>& c, const Study& s, const Setup& u
   if (r.status != sim::RunStatus::kCompleted) completed = false;
   const bool both =
       t.status == sim::RunStatus::kCompleted && r.status == sim::RunStatus::kCompleted;
-  c.push_back(both ? number((t.final_state - r.final_state).cwiseAbs().maxCoeff()) : "");
+  c.push_back(both ? format_number((t.final_state - r.final_state).cwiseAbs().maxCoeff()) : "");
 }
 
 Row row_of(const Study& s, const RunPoint& p) {
@@ -164,7 +163,7 @@ Row row_of(const Study& s, const RunPoint& p) {
   c.push_back(std::to_string(p.index));
   const std::vector<Column> cols = columns(s);
   for (std::size_t i = 0; i < p.values.size(); ++i)
-    c.push_back(cols[1 + i].text ? p.values[i].name : number(p.values[i].number));
+    c.push_back(cols[1 + i].text ? p.values[i].name : format_number(p.values[i].number));
   const Setup u = setup_of(s, p);
   const auto integ = sim::make_integrator(u.method);
   const sim::Trajectory t = integ->run(u.model, u.x0, sim::keep_used(u.opt, integ->options_used()));
@@ -175,7 +174,7 @@ Row row_of(const Study& s, const RunPoint& p) {
   for (std::size_t i = 0; i < n; ++i)
     c.push_back(static_cast<Eigen::Index>(i) < t.final_state.size() &&
                         t.status != sim::RunStatus::kInvalidInput
-                    ? number(t.final_state(static_cast<Eigen::Index>(i)))
+                    ? format_number(t.final_state(static_cast<Eigen::Index>(i)))
                     : "");
   return row;
 }
@@ -211,7 +210,7 @@ Row run_one(const Study& s, std::size_t index) {
     row.cells.push_back(std::to_string(index));
     const std::vector<Column> cols = columns(s);
     for (std::size_t i = 0; i < p.values.size(); ++i)
-      row.cells.push_back(cols[1 + i].text ? p.values[i].name : number(p.values[i].number));
+      row.cells.push_back(cols[1 + i].text ? p.values[i].name : format_number(p.values[i].number));
     row.cells.push_back("error");
     row.cells.push_back(io::one_line(e.what()));
     row.cells.resize(cols.size());

@@ -207,9 +207,8 @@ struct FrictionBlock {
 std::string friction_block_error(const FrictionBlock& b);
 
 // A model read as a block on a floor, or why it is not one.
-struct FrictionBlockOf {
-  Status status = Status::kOk;  // kInvalidInput with `message` when not a block on a floor
-  std::string message;
+// kInvalidInput with the message when not a block on a floor.
+struct FrictionBlockOf : Outcome {
   FrictionBlock block;
 };
 // Reads the block from a mechanical model with two coordinates (q_t along
@@ -275,9 +274,8 @@ struct SlideStop {
 SlideStop slide_stop(const std::vector<double>& t, const std::vector<double>& x,
                      const std::vector<double>& v, double v_tol);
 
-struct FrictionBoxRun {
-  Status status = Status::kOk;  // kInvalidInput (nothing ran) or kNumericalFailure, with message
-  std::string message;
+// kInvalidInput (nothing ran) or kNumericalFailure, with the message.
+struct FrictionBoxRun : Outcome {
   FrictionBlock block;
   std::vector<FrictionBoxSample> samples;
   SlideStop stop;  // of the samples, with settings.stop_velocity
@@ -293,9 +291,8 @@ FrictionBoxRun simulate_friction_box(const mech::Model& model, const FrictionBox
 // `lcsim compare` on a block on a floor: the box run in Bullet beside an
 // exact run of the same model (the tangential coordinate and velocity only;
 // the box's own normal motion and tilt are Bullet's, reported apart).
-struct FrictionComparison {
-  Status status = Status::kOk;  // kInvalidInput / kNumericalFailure, with message
-  std::string message;
+// kInvalidInput / kNumericalFailure, with the message.
+struct FrictionComparison : Outcome {
   FrictionBlock block;    // as read from the model (t_end: the exact run's)
   SlideStop closed_form;  // block.stop_time(), block.slide_distance() (NaN: never sticks)
   SlideStop exact;        // slide_stop of the exact run's samples

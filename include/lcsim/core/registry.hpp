@@ -1,8 +1,9 @@
 // The one registry of named methods: LCP solvers, impact laws and
 // integrators are each chosen by name from a Registry<Interface>.
 //
-// A layer's registry holds its own methods from the start (the layer fills it
-// when it is first used); an optional component (lcsim::bullet,
+// A layer's registry holds its own methods from the start (the layer's
+// accessor, as lcp::solvers(), is Registry::instance with a fill function that
+// adds them when it is first used); an optional component (lcsim::bullet,
 // lcsim::ipopt) adds its methods with a namespace-scope Registrar in a source
 // file that CMake links into every program that links the component, so no
 // caller ever makes a registration call. Thread-safe.
@@ -11,6 +12,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -25,6 +27,20 @@ class Registry {
 
   // `kind` names the methods in messages ("LCP solver", "impact law", "method").
   explicit Registry(std::string kind) : kind_(std::move(kind)) {}
+
+  // The one registry of Interface's methods: made on the first call, when
+  // `fill` adds the layer's own methods, and the same one on every later call
+  // (thread-safe). Never destroyed: a component's Registrar adds to it before
+  // main, and code run at exit may still look a name up. A layer's accessor
+  // (lcp::solvers(), impact::laws(), sim::integrators()) is its only caller.
+  static Registry& instance(const char* kind, void (*fill)(Registry&)) {
+    static Registry& r = *[&] {
+      auto* reg = new Registry(kind);
+      fill(*reg);
+      return reg;
+    }();
+    return r;
+  }
 
   // Adds `name`, or replaces the factory of a name already present (the
   // position in names() is kept).
@@ -68,6 +84,13 @@ class Registry {
       if (const Factory* p = find(name)) f = *p;
     }
     return f ? f() : nullptr;
+  }
+
+  // make(name), or std::invalid_argument with unknown_message(name, hint).
+  std::unique_ptr<Interface> make_or_throw(std::string_view name,
+                                           std::string_view hint = {}) const {
+    if (auto m = make(name)) return m;
+    throw std::invalid_argument(unknown_message(name, hint));
   }
 
   // The names, in registration order.

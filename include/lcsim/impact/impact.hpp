@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <lcsim/core/outcome.hpp>
 #include <lcsim/core/registry.hpp>
 #include <lcsim/lcp/lcp.hpp>
 #include <lcsim/mech/mech.hpp>
@@ -29,10 +30,8 @@ enum class ContactOutcome {
 };
 const char* to_string(ContactOutcome o);  // "none", "no-impulse", "stick", "slip+", "slip-"
 
-struct ImpactResult {
-  Status status = Status::kNumericalFailure;  // kOk when computed; message says why not
-  bool ok() const { return status == Status::kOk; }
-  std::string message;
+// kOk when computed; the message says why not.
+struct ImpactResult : OutcomeStartingAs<Status::kNumericalFailure> {
   VectorXd v_after;  // post-impact velocity (N)
   VectorXd impulse;  // per constraint (k, zero outside the closed set)
   IndexSet mode;     // constraints with positive impulse

@@ -4,14 +4,16 @@
 
 #include <Eigen/Dense>
 #include <cstddef>
+#include <lcsim/core/format.hpp>
 #include <lcsim/io/input_error.hpp>
 #include <string>
 #include <vector>
 
 namespace lcsim::io {
 
-// Shortest text that reads back as the same double ("2", "0.1", "-1e-300").
-std::string format_number(double x);
+// Shortest text that reads back as the same double ("2", "0.1", "-1e-300"):
+// lcsim::format_number (core/format.hpp), under the name io's callers use.
+using lcsim::format_number;
 
 // `text` made fit for a one-line message: control characters (newlines from
 // a YAML scalar or a yaml-cpp message) become escapes such as \n or \x01,

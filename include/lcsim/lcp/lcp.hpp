@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <lcsim/core/outcome.hpp>
 #include <lcsim/core/registry.hpp>
 #include <lcsim/core/status.hpp>
 #include <memory>
@@ -24,8 +25,9 @@ using Eigen::VectorXd;
 using lcsim::Status;
 using lcsim::to_string;
 
-struct Result {
-  Status status = Status::kInvalidInput;
+// status and message (the Outcome): kInvalidInput until a solver sets it;
+// message is the human-readable detail ("" when solved cleanly).
+struct Result : OutcomeStartingAs<Status::kInvalidInput> {
   VectorXd z;             // the solution (size k); empty only on kInvalidInput
   VectorXd w;             // M z + q
   int pivots = 0;         // pivoting solvers: number of pivots
@@ -34,11 +36,9 @@ struct Result {
   // The acceptance measure: the worst row of scaled_residual() below, in
   // [0, 1]; "solved" means scaled_residual <= Options::tolerance.
   double scaled_residual = 0.0;
-  int worst_row = -1;   // the row attaining scaled_residual (-1 if k = 0)
-  double min_z = 0.0;   // most negative entry of z (0 if none negative)
-  double min_w = 0.0;   // most negative entry of w (0 if none negative)
-  std::string message;  // human-readable detail ("" when solved cleanly)
-  bool ok() const { return status == Status::kSolved; }
+  int worst_row = -1;  // the row attaining scaled_residual (-1 if k = 0)
+  double min_z = 0.0;  // most negative entry of z (0 if none negative)
+  double min_w = 0.0;  // most negative entry of w (0 if none negative)
 };
 
 // Diagnostics of a candidate z: fills w, residual, min_z, min_w.
@@ -108,10 +108,8 @@ Result solve_murty(const MatrixXd& M, const VectorXd& q, const Options& opt = {}
 Result solve_pgs(const MatrixXd& M, const VectorXd& q, const Options& opt = {});
 
 // Enumeration of all 2^k complementary bases (k <= 16): the test oracle.
-struct EnumerationResult {
-  Status status = Status::kInvalidInput;
+struct EnumerationResult : OutcomeStartingAs<Status::kInvalidInput> {
   std::vector<VectorXd> solutions;  // every distinct solution z found
-  std::string message;
 };
 EnumerationResult enumerate_solutions(const MatrixXd& M, const VectorXd& q,
                                       const Options& opt = {});

@@ -11,7 +11,7 @@
 #pragma once
 
 #include <Eigen/Dense>
-#include <lcsim/core/status.hpp>
+#include <lcsim/core/outcome.hpp>
 #include <lcsim/lcp/lcp.hpp>
 #include <string>
 #include <vector>
@@ -66,11 +66,9 @@ JumpSpace jump_space(const Lcs& sys, const IndexSet& I);
 
 // P_I: projection onto V_I along T_I. ok = false (with a message) when
 // V_I ⊕ T_I != R^n, i.e. mode I is not autonomous (Lemma 3.3.3).
-struct Projection {
+// kOk when computed; the message says why not.
+struct Projection : OutcomeStartingAs<Status::kNumericalFailure> {
   MatrixXd P;
-  Status status = Status::kNumericalFailure;  // kOk when computed; message says why not
-  bool ok() const { return status == Status::kOk; }
-  std::string message;
 };
 Projection projection(const Lcs& sys, const IndexSet& I);
 
@@ -78,11 +76,9 @@ Projection projection(const Lcs& sys, const IndexSet& I);
 // x' = (A + B_.I F_I) x. Built from leading rows: y_i^(rho_i) = C_i A^rho_i x
 // + (script M)_i u = 0 for i in I, so F_I = -(script M_II)^{-1} (C A^rho)_I.
 // ok = false when script M_II is singular.
-struct ModeFeedback {
+// kOk when computed; the message says why not.
+struct ModeFeedback : OutcomeStartingAs<Status::kNumericalFailure> {
   MatrixXd F;
-  Status status = Status::kNumericalFailure;  // kOk when computed; message says why not
-  bool ok() const { return status == Status::kOk; }
-  std::string message;
 };
 ModeFeedback mode_feedback(const Lcs& sys, const IndexSet& I);
 
@@ -123,10 +119,8 @@ std::vector<std::string> summary_left_out(const WellPosednessReport& r);
 // with Schur complements of the leading row coefficient matrix (proof of
 // Theorem 3.6.7, extended to the impulsive levels -n+1..0). Requires script M
 // to be a P-matrix for uniqueness; a failing LCP is reported, not hidden.
-struct ModeSelection {
-  Status status = Status::kNumericalFailure;  // kOk when computed; message says why not
-  bool ok() const { return status == Status::kOk; }
-  std::string message;
+// kOk when computed; the message says why not.
+struct ModeSelection : OutcomeStartingAs<Status::kNumericalFailure> {
   IndexSet mode;          // I: constraints with lexicographically positive u
   IndexSet undetermined;  // K: u and y identically zero so far (Remark 3.4.8)
   // Impulsive coefficients u^{-n+1..0}: impulse[j] multiplies delta^{(j)}.
@@ -210,12 +204,10 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
 //   Otherwise passive = "unknown"; passivity_reason says what was checked.
 namespace lcsim::lcs {
 
-struct PassivityCertificateCheck {
-  Status status = Status::kNumericalFailure;  // kOk when computed; message says why not
-  bool ok() const { return status == Status::kOk; }
+// kOk when computed; the message says why not.
+struct PassivityCertificateCheck : OutcomeStartingAs<Status::kNumericalFailure> {
   double lmi_max_eigenvalue = 0.0;  // largest eigenvalue of L(K) (must be <= ~0)
   double k_min_eigenvalue = 0.0;    // smallest eigenvalue of K (must be > 0)
-  std::string message;
 };
 // Verifies K = K' > 0 and L(K) <= 0 up to 1e-10 relative to the scale
 // ||K|| (||A|| + ||B||) + ||C|| + ||D|| of the entries of L(K).

@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
 #include <lcsim/lcs/lcs.hpp>
+#include <lcsim/mech/tolerances.hpp>  // the zero tests of a gap, for every user of a model
 #include <limits>
 #include <optional>
 #include <string>

@@ -7,6 +7,8 @@
 
 #include <Eigen/Dense>
 #include <functional>
+#include <lcsim/core/format.hpp>
+#include <lcsim/core/outcome.hpp>
 #include <lcsim/core/status.hpp>
 #include <lcsim/impact/impact.hpp>
 #include <lcsim/mech/mech.hpp>
@@ -69,13 +71,11 @@ struct Options;
 
 // A run ends kCompleted, kInvalidInput (nothing was integrated),
 // kNumericalFailure, kEventLimit or kInterrupted, with Trajectory::message
-// saying why and Trajectory::t_end the time reached.
+// saying why ("" when completed) and Trajectory::t_end the time reached.
 using RunStatus = lcsim::Status;
 
-struct Trajectory {
+struct Trajectory : Outcome {
   std::string method;
-  RunStatus status = RunStatus::kCompleted;
-  std::string message;           // why it failed, or "" when completed
   double t_end = 0.0;            // the time reached (the horizon when completed)
   std::vector<Sample> samples;   // at a jump two samples share t (before, after)
   std::vector<Event> events;     // the first Options::max_recorded_events of them
@@ -348,8 +348,8 @@ class DivergenceGuard {
 void check_diverged(const mech::Model& model, const VectorXd& x0, Trajectory& tr);
 
 // A number with six significant digits, as the integrators' messages print it
-// ("0.001", "3.16228e+04").
-std::string short_number(double x);
+// ("0.001", "3.16228e+04"): lcsim::short_number (core/format.hpp).
+using lcsim::short_number;
 
 // Event-driven integration (Algorithm 3.7.1): exact matrix-exponential phases,
 // events as roots of Bohl functions, re-initialisation by the impact law

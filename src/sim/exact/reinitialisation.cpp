@@ -31,9 +31,9 @@ EventDriven::ContactScan EventDriven::scan_contacts(double t, const VectorXd& xa
   s.in.v = v;
   for (int r = 0; r < k_; ++r) {
     // Zero within rounding, or within what the event time's resolution
-    // (a few ulp of t times the rate) leaves in the gap.
+    // leaves in the gap (mech/tolerances.hpp).
     double gap_tol =
-        ldcp_.tol_rel * s.gap_scale(r) + ldcp_.tol_abs + time_resolution(t) * std::abs(s.rate(r));
+        mech::event_gap_tolerance(s.gap_scale(r), s.rate(r), time_resolution(t), ldcp_);
     // A constraint the ending phase held closed has a zero gap by
     // construction; what it shows is the phase's drift, the rounding of
     // the whole state carried through the coupling (its own entries may be
