@@ -111,7 +111,8 @@ TEST(AnalysisReport, ABadThresholdIsAnInputError) {
       (void)analysis_report(scene, {.linearisation_threshold = t});
       ADD_FAILURE() << t << " accepted";
     } catch (const io::InputError& e) {
-      EXPECT_TRUE(contains(e.what(), "linearisation_threshold must be a finite number > 0")) << e.what();
+      EXPECT_TRUE(contains(e.what(), "linearisation_threshold must be a finite number > 0"))
+          << e.what();
     }
   }
 }
