@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <lcsim/app/analysis.hpp>
+#include <lcsim/core/format.hpp>
 #include <lcsim/io/json.hpp>
 #include <lcsim/lcp/lcp.hpp>
 #include <lcsim/lcs/lcs.hpp>
@@ -28,12 +29,6 @@ constexpr const char* kFullOption = "full = true";
 // What a summary leaves out (lcs::summary_left_out, mech::kSummarySets):
 // the JSON names, listed in the output with how to get them.
 using LeftOut = std::vector<std::string>;
-
-std::string num(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
 
 std::string matrix_text(const MatrixXd& m, const std::string& indent) {
   if (m.size() == 0)
@@ -226,8 +221,8 @@ std::optional<Coactive> mass_and_rank(Draft& d, const mech::Model& model) {
   d.out << "kind:        mechanical  M q'' + D q' + K q = f + E' u,  0 <= E q + g _|_ u >= 0\n"
         << "dimensions:  N = " << m.dofs() << " coordinates, k = " << m.num_constraints()
         << " constraints, state (q, v) of size " << model.state_size() << "\n"
-        << "M:           positive definite: smallest eigenvalue " << num(ev.minCoeff())
-        << ", largest " << num(ev.maxCoeff()) << "\n"
+        << "M:           positive definite: smallest eigenvalue " << short_number(ev.minCoeff())
+        << ", largest " << short_number(ev.maxCoeff()) << "\n"
         << "rank E:      " << rank_e << " of " << m.num_constraints();
   std::optional<Coactive> co;
   if (m.num_constraints() > 0 && m.num_constraints() <= mech::kMaxCoactiveConstraints)
@@ -379,11 +374,12 @@ void linear_ranges_section(Draft& d, const std::optional<scene::Scene>& scene) {
   const std::vector<scene::LinearRange> ranges = scene::linear_ranges(*scene, threshold);
   d.j["linear_ranges"] = scene::to_json(ranges);
   d.j["linearisation_threshold"] = threshold;
-  d.out << "linear model: error <= " << num(100.0 * threshold)
+  d.out << "linear model: error <= " << short_number(100.0 * threshold)
         << " % (mass and forces, docs/model-format.md) for q in, each joint alone:\n";
   for (const auto& r : ranges)
-    d.out << "  " << r.joint << ": [" << num(r.lower) << ", " << num(r.upper) << "] " << r.unit
-          << "  (q0 = " << num(r.q0) << "; ends: " << r.lower_end << ", " << r.upper_end << ")\n";
+    d.out << "  " << r.joint << ": [" << short_number(r.lower) << ", " << short_number(r.upper)
+          << "] " << r.unit << "  (q0 = " << short_number(r.q0) << "; ends: " << r.lower_end << ", "
+          << r.upper_end << ")\n";
 }
 
 // What was not judged, whether the report is full, and what the summary left out.

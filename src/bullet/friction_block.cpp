@@ -3,14 +3,13 @@
 // run sticks (slide_stop, used on Bullet's and lcsim's runs alike).
 #include <cmath>
 #include <lcsim/bullet/bullet.hpp>
+#include <lcsim/core/format.hpp>
 #include <stdexcept>
 #include <string>
 
 namespace lcsim::bullet {
 
 namespace {
-
-std::string fmt(double x) { return sim::short_number(x); }
 
 FrictionBlockOf refuse(const mech::Model& model, const std::string& why) {
   FrictionBlockOf out;
@@ -34,10 +33,11 @@ int single_column(const mech::SparseMatrix& E, int i) {
 std::string rigid_block_error(const mech::MechanicalModel& m) {
   const double m0 = m.M.coeff(0, 0);
   if (m.M.coeff(0, 1) != 0.0 || m.M.coeff(1, 0) != 0.0)
-    return "mechanical.M(0, 1) = " + fmt(m.M.coeff(0, 1)) +
+    return "mechanical.M(0, 1) = " + short_number(m.M.coeff(0, 1)) +
            ": one rigid block needs a diagonal M (its mass on both coordinates)";
   if (std::abs(m.M.coeff(1, 1) - m0) > 1e-12 * m0)
-    return "mechanical.M(1, 1) = " + fmt(m.M.coeff(1, 1)) + " differs from M(0, 0) = " + fmt(m0) +
+    return "mechanical.M(1, 1) = " + short_number(m.M.coeff(1, 1)) +
+           " differs from M(0, 0) = " + short_number(m0) +
            ": one rigid block has one mass on both coordinates";
   if (m.K.norm() != 0.0) return "mechanical.K is not zero: a block on a floor has no spring";
   if (m.D.norm() != 0.0) return "mechanical.D is not zero: a block on a floor has no damper";
@@ -47,7 +47,7 @@ std::string rigid_block_error(const mech::MechanicalModel& m) {
 // The first bad field of b and why ("mu must be in [0, 10] (got -1)"), or "".
 std::string block_rule_error(const FrictionBlock& b) {
   auto bad = [](const char* name, double value, const char* rule) {
-    return std::string(name) + " must be " + rule + " (got " + fmt(value) + ")";
+    return std::string(name) + " must be " + rule + " (got " + short_number(value) + ")";
   };
   if (!(std::isfinite(b.mass) && b.mass > 0.0)) return bad("mass", b.mass, "finite and > 0");
   // Bullet clamps the combined friction coefficient to [-10, 10]
@@ -96,14 +96,14 @@ FrictionBlockOf friction_block_of(const mech::Model& model, const Eigen::VectorX
   const mech::FrictionalContact& fc = m.friction[0];
   if (fc.tangent.coeff(n) != 0.0 || fc.tangent.coeff(t) == 0.0)
     return refuse(model, "mechanical.friction[0].tangent must be along coordinate " +
-                             std::to_string(t) + " only (got " + fmt(fc.tangent.coeff(0)) + ", " +
-                             fmt(fc.tangent.coeff(1)) + ")");
+                             std::to_string(t) + " only (got " + short_number(fc.tangent.coeff(0)) +
+                             ", " + short_number(fc.tangent.coeff(1)) + ")");
   if (std::string why = rigid_block_error(m); !why.empty()) return refuse(model, why);
   if (m.f(t) != 0.0)
-    return refuse(model, "mechanical.f[" + std::to_string(t) + "] = " + fmt(m.f(t)) +
+    return refuse(model, "mechanical.f[" + std::to_string(t) + "] = " + short_number(m.f(t)) +
                              ": the closed form has no force along the floor");
   if (!(m.f(n) < 0.0))
-    return refuse(model, "mechanical.f[" + std::to_string(n) + "] = " + fmt(m.f(n)) +
+    return refuse(model, "mechanical.f[" + std::to_string(n) + "] = " + short_number(m.f(n)) +
                              ": gravity must press the block onto the floor (f < 0)");
   const Eigen::VectorXd x0 = x0_in.size() > 0 ? x0_in : model.initial;
   if (x0.size() != 4)
@@ -112,9 +112,10 @@ FrictionBlockOf friction_block_of(const mech::Model& model, const Eigen::VectorX
   if (!x0.allFinite()) return refuse(model, "the initial state is not finite");
   const double c = m.E.coeff(0, n), gap = c * x0(n) + m.g(0);
   if (std::abs(gap) > 1e-12 * (std::abs(c * x0(n)) + std::abs(m.g(0)) + 1e-300))
-    return refuse(model, "the block starts at gap " + fmt(gap) + " (it must start on the floor)");
+    return refuse(model,
+                  "the block starts at gap " + short_number(gap) + " (it must start on the floor)");
   if (x0(2 + n) != 0.0)
-    return refuse(model, "initial[" + std::to_string(2 + n) + "] = " + fmt(x0(2 + n)) +
+    return refuse(model, "initial[" + std::to_string(2 + n) + "] = " + short_number(x0(2 + n)) +
                              ": the block must start with no normal velocity");
   FrictionBlockOf out;
   FrictionBlock& b = out.block;
@@ -137,8 +138,8 @@ SlideStop slide_stop(const std::vector<double>& t, const std::vector<double>& x,
                                 std::to_string(t.size()) + ", " + std::to_string(x.size()) + ", " +
                                 std::to_string(v.size()) + ")");
   if (!(std::isfinite(v_tol) && v_tol >= 0.0))
-    throw std::invalid_argument("slide_stop: v_tol must be finite and >= 0 (got " + fmt(v_tol) +
-                                ")");
+    throw std::invalid_argument("slide_stop: v_tol must be finite and >= 0 (got " +
+                                short_number(v_tol) + ")");
   std::size_t j = t.size();
   while (j > 0 && std::abs(v[j - 1]) <= v_tol) --j;
   SlideStop s;

@@ -66,14 +66,13 @@
 
 #include <cmath>
 #include <lcsim/bullet/bullet.hpp>
+#include <lcsim/core/format.hpp>
 #include <memory>
 #include <string>
 
 namespace lcsim::bullet {
 
 namespace {
-
-std::string fmt(double x) { return sim::short_number(x); }
 
 // btBoxShape's collision margin (Bullet's default, CONVEX_DISTANCE_MARGIN).
 constexpr double kBoxMargin = 0.04;
@@ -193,13 +192,13 @@ FrictionBoxRun refused(const FrictionBlock& b, std::string why) {
 std::string friction_box_settings_error(const FrictionBoxSettings& s, double t_end) {
   auto bad = [](const char* name, double value, const std::string& rule) {
     return std::string("bullet friction box: setting ") + name + " must be " + rule + " (got " +
-           fmt(value) + ")";
+           short_number(value) + ")";
   };
   if (!(std::isfinite(s.h) && s.h > 0.0)) return bad("h", s.h, "finite and > 0");
   if (std::isfinite(t_end) && t_end / s.h > 1e8)
-    return bad("h", s.h, "at least t_end / 1e8 = " + fmt(t_end / 1e8));
+    return bad("h", s.h, "at least t_end / 1e8 = " + short_number(t_end / 1e8));
   if (s.solver_iterations < 1) return bad("solver_iterations", s.solver_iterations, ">= 1");
-  const std::string above_margin = "finite and > btBoxShape's margin " + fmt(kBoxMargin);
+  const std::string above_margin = "finite and > btBoxShape's margin " + short_number(kBoxMargin);
   if (!(std::isfinite(s.half_width) && s.half_width > kBoxMargin))
     return bad("half_width", s.half_width, above_margin);
   if (!(std::isfinite(s.half_height) && s.half_height > kBoxMargin))
@@ -228,7 +227,7 @@ FrictionBoxRun simulate_friction_box(const FrictionBlock& b, const FrictionBoxSe
     const FrictionBoxSample smp = observe(*w, s, j == grid.n ? b.t_end : j * grid.h, h);
     if (!std::isfinite(smp.x) || !std::isfinite(smp.v) || !std::isfinite(smp.gap)) {
       r.status = Status::kNumericalFailure;
-      r.message = "bullet friction box: non-finite state at t = " + fmt(smp.t);
+      r.message = "bullet friction box: non-finite state at t = " + short_number(smp.t);
       return r;
     }
     r.samples.push_back(smp);

@@ -51,6 +51,7 @@
 #include <algorithm>
 #include <cmath>
 #include <lcsim/bullet/bullet.hpp>
+#include <lcsim/core/format.hpp>
 #include <lcsim/scene/scene.hpp>
 #include <memory>
 #include <stdexcept>
@@ -65,8 +66,6 @@ namespace {
 
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
-
-std::string fmt(double x) { return sim::short_number(x); }
 
 // A mimic joint m of a simulated joint J (coordinate `leader`), q_m = a q_J + b:
 // a link of its own in Bullet, tied to J's by a gear constraint.
@@ -250,8 +249,8 @@ void warn(sim::Trajectory& tr, const mech::MechanicalModel& m, const MatrixXd& K
     if (w * opt.h > 2.0)
       tr.warn("bullet-explicit-springs", 0.0,
               "bullet: springs are explicit joint torques, unstable for omega h > 2: omega = " +
-                  fmt(w) + " rad/s gives omega h = " + fmt(w * opt.h) + " at h = " + fmt(opt.h) +
-                  "; expect growth, or reduce h");
+                  short_number(w) + " rad/s gives omega h = " + short_number(w * opt.h) +
+                  " at h = " + short_number(opt.h) + "; expect growth, or reduce h");
   }
   for (int i = 0; i < m.num_constraints(); ++i)
     if (m.restitution(i) > 0.0) {
@@ -259,7 +258,7 @@ void warn(sim::Trajectory& tr, const mech::MechanicalModel& m, const MatrixXd& K
               "bullet: restitution is lost: Bullet's multibody joint limits are inelastic "
               "(btMultiBodyJointLimitConstraint has no bounce); constraint '" +
                   m.constraints[static_cast<std::size_t>(i)] +
-                  "' has e = " + fmt(m.restitution(i)));
+                  "' has e = " + short_number(m.restitution(i)));
       break;
     }
 }
@@ -345,8 +344,8 @@ std::string multibody_description(const WorldSettings& s) {
          (s.multibody_mlcp ? "btMultiBodyMLCPConstraintSolver (btDantzigSolver)"
                            : "btMultiBodyConstraintSolver (" + std::to_string(s.solver_iterations) +
                                  " iterations)") +
-         ", btMultiBodyJointLimitConstraint limits (ERP " + fmt(s.limit_erp) + ", max impulse " +
-         fmt(s.limit_max_impulse) + ")";
+         ", btMultiBodyJointLimitConstraint limits (ERP " + short_number(s.limit_erp) +
+         ", max impulse " + short_number(s.limit_max_impulse) + ")";
 }
 
 sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene& setup,

@@ -46,6 +46,7 @@
 #include <chrono>
 #include <cmath>
 #include <lcsim/bullet/bullet.hpp>
+#include <lcsim/core/format.hpp>
 #include <lcsim/io/io.hpp>
 #include <lcsim/scene/scene.hpp>
 #include <memory>
@@ -64,7 +65,6 @@ using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
 // Messages print numbers as every integrator does.
-std::string fmt(double x) { return sim::short_number(x); }
 
 // One row of E as Bullet sees it.
 struct Limit {
@@ -110,7 +110,7 @@ Limit classify(const mech::MechanicalModel& m, int i, double range) {
       return L;
     }
     throw std::invalid_argument(
-        "bullet: " + who + " has coefficients " + fmt(c0) + " and " + fmt(c1) +
+        "bullet: " + who + " has coefficients " + short_number(c0) + " and " + short_number(c1) +
         ": a Bullet limit needs opposite coefficients (a hook c (q_a - q_b) + g >= 0)");
   }
   throw std::invalid_argument("bullet: " + who + " involves " + std::to_string(nz.size()) +
@@ -131,7 +131,7 @@ std::vector<Limit> limits_of(const mech::Model& model, double range) {
       if (it.row() != c && std::abs(it.value()) > 1e-14 * mscale)
         throw std::invalid_argument(
             "bullet: M(" + std::to_string(it.row()) + ", " + std::to_string(c) +
-            ") = " + fmt(it.value()) +
+            ") = " + short_number(it.value()) +
             ": one rigid body per coordinate needs a diagonal M (a non-diagonal M runs in "
             "Bullet only as a URDF scene, whose multibody Bullet builds from the URDF)");
   std::vector<Limit> out;
@@ -288,7 +288,8 @@ Plan plan_of(const mech::Model& model, const WorldSettings& s) {
 
 std::string rb6_description(const WorldSettings& s) {
   return "btSequentialImpulseConstraintSolver (" + std::to_string(s.solver_iterations) +
-         " iterations), btGeneric6DofSpring2Constraint limits (stop ERP " + fmt(s.stop_erp) + ")";
+         " iterations), btGeneric6DofSpring2Constraint limits (stop ERP " +
+         short_number(s.stop_erp) + ")";
 }
 
 }  // namespace
@@ -314,8 +315,9 @@ void warn_explicit_springs(sim::Trajectory& tr, const mech::MechanicalModel& m, 
   if (std::sqrt(w2) * h > 2.0)
     tr.warn("bullet-explicit-springs", 0.0,
             "bullet: springs are explicit forces -K q, unstable for omega h > 2: omega <= " +
-                fmt(std::sqrt(w2)) + " rad/s gives omega h up to " + fmt(std::sqrt(w2) * h) +
-                " at h = " + fmt(h) + "; expect growth, or reduce h");
+                short_number(std::sqrt(w2)) + " rad/s gives omega h up to " +
+                short_number(std::sqrt(w2) * h) + " at h = " + short_number(h) +
+                "; expect growth, or reduce h");
 }
 
 // Measured (a ball dropped on a 6DOF2 lower limit, e = 0.5, h = 1e-3,
@@ -329,8 +331,8 @@ void warn_restitution_lost(sim::Trajectory& tr, const mech::MechanicalModel& m,
       tr.warn("bullet-restitution-lost", 0.0,
               "bullet: restitution is lost or reduced: Bullet 3.24 applies a limit's bounce "
               "only near stop ERP 1 (this scene uses " +
-                  fmt(s.stop_erp) + "; at 0.2 nothing rebounds); constraint '" + m.constraints[i] +
-                  "' has e = " + fmt(m.restitution(i)));
+                  short_number(s.stop_erp) + "; at 0.2 nothing rebounds); constraint '" +
+                  m.constraints[i] + "' has e = " + short_number(m.restitution(i)));
       break;
     }
 }
@@ -420,7 +422,8 @@ sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>&
 
 std::string settings_error(const WorldSettings& s) {
   auto bad = [](const char* name, double value, const char* rule) {
-    return std::string("bullet setting ") + name + " must be " + rule + " (got " + fmt(value) + ")";
+    return std::string("bullet setting ") + name + " must be " + rule + " (got " +
+           short_number(value) + ")";
   };
   if (s.solver_iterations < 1) return bad("solver_iterations", s.solver_iterations, ">= 1");
   if (!(s.stop_erp > 0.0 && s.stop_erp <= 1.0)) return bad("stop_erp", s.stop_erp, "in (0, 1]");

@@ -18,6 +18,7 @@
 #include <iostream>
 #include <lcsim/app/impact_map.hpp>
 #include <lcsim/app/impacts.hpp>
+#include <lcsim/core/format.hpp>
 #include <lcsim/impact/impact.hpp>
 #include <lcsim/io/io.hpp>
 #include <lcsim/scene/scene.hpp>
@@ -43,15 +44,7 @@ struct ImpactsArgs {
   std::string closed;
 };
 
-std::string fmt_vec(const Eigen::VectorXd& v) {
-  std::string s = "(";
-  char buf[64];
-  for (int i = 0; i < v.size(); ++i) {
-    std::snprintf(buf, sizeof buf, "%s%.6g", i ? ", " : "", v(i));
-    s += buf;
-  }
-  return s + ")";
-}
+std::string fmt_vec(const Eigen::VectorXd& v) { return "(" + number_list(v, 6) + ")"; }
 
 std::string mode_text(const mech::MechanicalModel& m, const impact::IndexSet& mode,
                       const char* sep) {

@@ -4,6 +4,7 @@
 // 2 on bad input.
 #include <cstdio>
 #include <iostream>
+#include <lcsim/core/format.hpp>
 #include <lcsim/io/io.hpp>
 #include <lcsim/lcp/lcp.hpp>
 #include <memory>
@@ -20,15 +21,7 @@ struct LcpArgs {
   bool json = false;
 };
 
-std::string vector_text(const Eigen::VectorXd& v) {
-  std::string s = "[";
-  char buf[32];
-  for (Eigen::Index i = 0; i < v.size(); ++i) {
-    std::snprintf(buf, sizeof buf, "%.17g", v(i));
-    s += (i ? ", " : "") + std::string(buf);
-  }
-  return s + "]";
-}
+std::string vector_text(const Eigen::VectorXd& v) { return "[" + number_list(v, 17) + "]"; }
 
 // Iterative solvers count sweeps, pivoting ones count pivots.
 bool counts_iterations(const std::string& solver, const lcp::Result& r) {
@@ -54,8 +47,7 @@ void run_lcp(const LcpArgs& args) {
     if (!r.message.empty()) j["message"] = r.message;
     std::cout << j.dump(2) << "\n";
   } else {
-    char res[32];
-    std::snprintf(res, sizeof res, "%.3g", r.residual);
+    const std::string res = format_number(r.residual, 3);
     std::cout << "solver:   " << solver->name() << "\n"
               << "status:   " << lcp::to_string(r.status, "solved") << "\n"
               << "z =       " << vector_text(r.z) << "\n"

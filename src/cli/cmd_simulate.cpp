@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <iostream>
 #include <lcsim/app/run.hpp>
+#include <lcsim/core/format.hpp>
 #include <lcsim/impact/impact.hpp>
 #include <lcsim/io/io.hpp>
 #include <lcsim/scene/linearisation.hpp>
@@ -45,15 +46,7 @@ struct SimulateArgs {
   double linearisation_threshold = scene::kLinearisationThreshold;  // scenes: warn above it
 };
 
-std::string fmt_vec(const Eigen::VectorXd& v) {
-  std::string s = "(";
-  char buf[64];
-  for (int i = 0; i < v.size(); ++i) {
-    std::snprintf(buf, sizeof buf, "%s%.10g", i ? ", " : "", v(i));
-    s += buf;
-  }
-  return s + ")";
-}
+std::string fmt_vec(const Eigen::VectorXd& v) { return "(" + number_list(v, 10) + ")"; }
 
 // "{0 hook, 1 wall}": index and name of each constraint of a mechanical
 // model; "{0,1}" for an LCS (its complementarity pairs have no names).

@@ -5,6 +5,7 @@
 #include <Eigen/SparseCholesky>
 #include <cmath>
 #include <cstdio>
+#include <lcsim/core/format.hpp>
 #include <lcsim/mech/mech.hpp>
 #include <limits>
 #include <string>
@@ -13,12 +14,6 @@
 namespace lcsim::mech {
 
 namespace {
-
-std::string num(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
 
 std::string dims(Eigen::Index r, Eigen::Index c) {
   return std::to_string(r) + " x " + std::to_string(c);
@@ -32,19 +27,20 @@ std::optional<std::string> non_finite(const Mat& A) {
       for (SparseMatrix::InnerIterator it(A, j); it; ++it)
         if (!std::isfinite(it.value()))
           return "[" + std::to_string(it.row()) + "][" + std::to_string(it.col()) +
-                 "] = " + num(it.value());
+                 "] = " + short_number(it.value());
   } else {
     for (Eigen::Index i = 0; i < A.rows(); ++i)
       for (Eigen::Index j = 0; j < A.cols(); ++j)
         if (!std::isfinite(A(i, j)))
-          return "[" + std::to_string(i) + "][" + std::to_string(j) + "] = " + num(A(i, j));
+          return "[" + std::to_string(i) + "][" + std::to_string(j) +
+                 "] = " + short_number(A(i, j));
   }
   return std::nullopt;
 }
 
 std::optional<std::string> non_finite_vector(const VectorXd& v) {
   for (Eigen::Index i = 0; i < v.size(); ++i)
-    if (!std::isfinite(v(i))) return "[" + std::to_string(i) + "] = " + num(v(i));
+    if (!std::isfinite(v(i))) return "[" + std::to_string(i) + "] = " + short_number(v(i));
   return std::nullopt;
 }
 
@@ -80,14 +76,17 @@ std::optional<ModelProblem> check_friction(const MechanicalModel& m) {
     for (Eigen::SparseVector<double>::InnerIterator it(c.tangent); it; ++it) {
       if (!std::isfinite(it.value()))
         return ModelProblem{
-            at + ".tangent[" + std::to_string(it.index()) + "] = " + num(it.value()), "not finite"};
+            at + ".tangent[" + std::to_string(it.index()) + "] = " + short_number(it.value()),
+            "not finite"};
       largest = std::max(largest, std::abs(it.value()));
     }
     if (!(largest > 0.0)) return ModelProblem{at + ".tangent", "all zero (it measures no sliding)"};
-    if (!std::isfinite(c.mu)) return ModelProblem{at + ".mu", "not finite (got " + num(c.mu) + ")"};
-    if (c.mu < 0.0) return ModelProblem{at + ".mu", "must be >= 0 (got " + num(c.mu) + ")"};
+    if (!std::isfinite(c.mu))
+      return ModelProblem{at + ".mu", "not finite (got " + short_number(c.mu) + ")"};
+    if (c.mu < 0.0)
+      return ModelProblem{at + ".mu", "must be >= 0 (got " + short_number(c.mu) + ")"};
     if (!std::isfinite(c.velocity))
-      return ModelProblem{at + ".velocity", "not finite (got " + num(c.velocity) + ")"};
+      return ModelProblem{at + ".velocity", "not finite (got " + short_number(c.velocity) + ")"};
   }
   return std::nullopt;
 }
@@ -104,10 +103,11 @@ std::optional<ModelProblem> check_mass_matrix(const SparseMatrix& M) {
       const Eigen::Index i = it.row();
       if (std::abs(it.value() - M.coeff(j, i)) > 1e-12 * scale) {
         const Eigen::Index a = std::min(i, j), b = std::max(i, j);
-        return ModelProblem{"mechanical.M",
-                            "not symmetric (M[" + std::to_string(a) + "][" + std::to_string(b) +
-                                "] = " + num(M.coeff(a, b)) + " but M[" + std::to_string(b) + "][" +
-                                std::to_string(a) + "] = " + num(M.coeff(b, a)) + ")"};
+        return ModelProblem{"mechanical.M", "not symmetric (M[" + std::to_string(a) + "][" +
+                                                std::to_string(b) +
+                                                "] = " + short_number(M.coeff(a, b)) + " but M[" +
+                                                std::to_string(b) + "][" + std::to_string(a) +
+                                                "] = " + short_number(M.coeff(b, a)) + ")"};
       }
     }
   const double rel = static_cast<double>(M.rows()) * std::numeric_limits<double>::epsilon();
@@ -118,18 +118,18 @@ std::optional<ModelProblem> check_mass_matrix(const SparseMatrix& M) {
     const VectorXd ev = Eigen::SelfAdjointEigenSolver<MatrixXd>(S).eigenvalues();
     if (llt.info() != Eigen::Success || ev.minCoeff() <= rel * std::abs(ev.maxCoeff()))
       return ModelProblem{"mechanical.M", "not positive definite (smallest eigenvalue " +
-                                              num(ev.minCoeff()) + ", largest " +
-                                              num(ev.maxCoeff()) + ")"};
+                                              short_number(ev.minCoeff()) + ", largest " +
+                                              short_number(ev.maxCoeff()) + ")"};
     return std::nullopt;
   }
   const Eigen::SimplicialLDLT<SparseMatrix> ldlt(M);
   const VectorXd d = ldlt.info() == Eigen::Success ? ldlt.vectorD() : VectorXd();
   if (d.size() == 0 || !d.allFinite() || d.minCoeff() <= rel * d.cwiseAbs().maxCoeff())
     return ModelProblem{"mechanical.M",
-                        d.size() == 0
-                            ? "not positive definite (its LDL' factorisation failed)"
-                            : "not positive definite (smallest LDL' pivot " + num(d.minCoeff()) +
-                                  ", largest " + num(d.maxCoeff()) + ")"};
+                        d.size() == 0 ? "not positive definite (its LDL' factorisation failed)"
+                                      : "not positive definite (smallest LDL' pivot " +
+                                            short_number(d.minCoeff()) + ", largest " +
+                                            short_number(d.maxCoeff()) + ")"};
   return std::nullopt;
 }
 
@@ -199,7 +199,7 @@ std::optional<ModelProblem> check_values(const MechanicalModel& m) {
   for (Eigen::Index i = 0; i < k; ++i)
     if (m.restitution(i) < 0.0 || m.restitution(i) > 1.0)
       return ModelProblem{"mechanical.restitution[" + std::to_string(i) + "]",
-                          "outside [0, 1] (got " + num(m.restitution(i)) + ")"};
+                          "outside [0, 1] (got " + short_number(m.restitution(i)) + ")"};
   // A zero row of E is the constraint 0 q + g >= 0: it never acts (g >= 0) or
   // is never satisfiable (g < 0), and its multiplier has no leading index.
   if (k > 0) {
@@ -258,7 +258,8 @@ std::optional<ModelProblem> check_model(const Model& model) {
       return ModelProblem{"initial" + *at, "not finite"};
   }
   if (!std::isnan(model.t_end) && !(model.t_end > 0.0 && std::isfinite(model.t_end)))
-    return ModelProblem{"t_end", "must be a finite number > 0 (got " + num(model.t_end) + ")"};
+    return ModelProblem{"t_end",
+                        "must be a finite number > 0 (got " + short_number(model.t_end) + ")"};
   return std::nullopt;
 }
 

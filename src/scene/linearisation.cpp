@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <lcsim/core/format.hpp>
 #include <lcsim/io/json.hpp>
 #include <lcsim/io/text.hpp>
 #include <lcsim/scene/linearisation.hpp>
@@ -94,14 +95,8 @@ LinearisationCheck check_linearisation(const Scene& scene, const std::vector<Vec
 std::string linearisation_warning(const LinearisationCheck& check, double threshold) {
   check_linearisation_threshold(threshold);
   if (!(check.error > threshold)) return "";
-  const auto g3 = [](double x) {
-    char b[32];
-    std::snprintf(b, sizeof b, "%.3g", x);
-    return std::string(b);
-  };
-  std::string q;
-  for (Eigen::Index i = 0; i < check.worst_q.size(); ++i)
-    q += (i ? ", " : "") + g3(check.worst_q(i));
+  const auto g3 = [](double x) { return format_number(x, 3); };
+  const std::string q = number_list(check.worst_q, 3);
   return "the linear model is off by " + g3(100.0 * check.error) + " % (mass " +
          g3(100.0 * check.mass_error) + " %, forces " + g3(100.0 * check.force_error) +
          " %) at q = (" + q + "), above the threshold " + g3(100.0 * threshold) +

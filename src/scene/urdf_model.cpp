@@ -25,6 +25,7 @@
 #include <cstdio>
 #include <fstream>
 #include <functional>
+#include <lcsim/core/format.hpp>
 #include <lcsim/io/text.hpp>
 #include <lcsim/scene/urdf.hpp>
 #include <set>
@@ -49,8 +50,6 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
                        const std::string& what) {
   throw InputError(source + ": " + element + ": " + what);
 }
-
-std::string num(double x) { return format_number(x); }
 
 Matrix3d skew(const Vector3d& c) {
   Matrix3d s;
@@ -143,14 +142,8 @@ std::string check_inertia(urdf::Inertial& in, bool balance, const std::string& s
   const double tol = kInertiaTolerance * std::max(std::abs(p(0)), std::abs(p(2)));
   // The moments are computed, not read: 6 significant digits (the file's
   // own values are in `got`, exactly).
-  const auto six = [](double x) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.6g", x);
-    return std::string(buf);
-  };
-  const auto three = [&](const Vector3d& v) {
-    return six(v(0)) + ", " + six(v(1)) + ", " + six(v(2));
-  };
+  const auto six = [](double x) { return short_number(x); };
+  const auto three = [&](const Vector3d& v) { return number_list(v, 6); };
   std::string problem, why;
   if (p(0) < -tol) {
     problem =
@@ -162,9 +155,9 @@ std::string check_inertia(urdf::Inertial& in, bool balance, const std::string& s
     why = "the triangle inequality broken";
   }
   if (problem.empty()) return "";
-  const std::string got = "(got ixx=" + num(in.ixx) + ", ixy=" + num(in.ixy) +
-                          ", ixz=" + num(in.ixz) + ", iyy=" + num(in.iyy) + ", iyz=" + num(in.iyz) +
-                          ", izz=" + num(in.izz) + ")";
+  const std::string got = "(got ixx=" + format_number(in.ixx) + ", ixy=" + format_number(in.ixy) +
+                          ", ixz=" + format_number(in.ixz) + ", iyy=" + format_number(in.iyy) +
+                          ", iyz=" + format_number(in.iyz) + ", izz=" + format_number(in.izz) + ")";
   if (!balance)
     fail(source, el,
          problem + " " + got +
@@ -216,9 +209,11 @@ void check_links(urdf::ModelInterface& m, const std::string& source, UrdfRepairs
     const std::string el = "link '" + name + "': <inertial>";
     if (!finite_pose(in.origin)) fail(source, el + " <origin>", "not finite");
     if (!std::isfinite(in.mass) || in.mass < 0.0)
-      fail(source, el + " <mass value>", "must be finite and >= 0 (got " + num(in.mass) + ")");
+      fail(source, el + " <mass value>",
+           "must be finite and >= 0 (got " + format_number(in.mass) + ")");
     for (double x : {in.ixx, in.ixy, in.ixz, in.iyy, in.iyz, in.izz})
-      if (!std::isfinite(x)) fail(source, el + " <inertia>", "not finite (got " + num(x) + ")");
+      if (!std::isfinite(x))
+        fail(source, el + " <inertia>", "not finite (got " + format_number(x) + ")");
     if (std::string note = check_inertia(in, repairs.balance_inertia, source, el + " <inertia>");
         !note.empty())
       repairs.notes.push_back(one_line(note));
@@ -234,26 +229,28 @@ void check_joint(const std::string& name, const urdf::Joint& j, const std::strin
   const Vector3d a = vec(j.axis);
   if (moves(j) && (!a.allFinite() || a.norm() == 0.0))
     fail(source, el + ": <axis xyz>",
-         "must be finite and non-zero (got " + num(a.x()) + " " + num(a.y()) + " " + num(a.z()) +
-             ")");
+         "must be finite and non-zero (got " + format_number(a.x()) + " " + format_number(a.y()) +
+             " " + format_number(a.z()) + ")");
   if (j.limits) {
     const urdf::JointLimits& l = *j.limits;
     if (!std::isfinite(l.lower) || !std::isfinite(l.upper))
       fail(source, el + ": <limit>",
-           "lower and upper must be finite (got lower=" + num(l.lower) + ", upper=" + num(l.upper) +
-               ")");
+           "lower and upper must be finite (got lower=" + format_number(l.lower) +
+               ", upper=" + format_number(l.upper) + ")");
     // lower > upper (Bullet's data files use it for "no limit") is refused
     // only where the limit becomes a stop (scene_stops.cpp): a frozen joint's
     // limits are never used.
   }
   if (j.mimic && (!std::isfinite(j.mimic->multiplier) || !std::isfinite(j.mimic->offset)))
     fail(source, el + ": <mimic>",
-         "multiplier and offset must be finite (got multiplier=" + num(j.mimic->multiplier) +
-             ", offset=" + num(j.mimic->offset) + ")");
+         "multiplier and offset must be finite (got multiplier=" +
+             format_number(j.mimic->multiplier) + ", offset=" + format_number(j.mimic->offset) +
+             ")");
   if (j.dynamics) {
     const double d = j.dynamics->damping;
     if (!std::isfinite(d) || d < 0.0)
-      fail(source, el + ": <dynamics damping>", "must be finite and >= 0 (got " + num(d) + ")");
+      fail(source, el + ": <dynamics damping>",
+           "must be finite and >= 0 (got " + format_number(d) + ")");
   }
 }
 
@@ -600,7 +597,7 @@ static std::shared_ptr<const UrdfDynamics::Impl> make_dynamics(
           "moved by joint '" + joints[i] +
               "' but it (with every link fixed, frozen or jointed below it) has no <inertial> mass "
               "(got total mass " +
-              num(mass) + ")");
+              format_number(mass) + ")");
   }
   return std::make_shared<const UrdfDynamics::Impl>(UrdfDynamics::Impl{std::move(t), q0, gravity});
 }

@@ -44,6 +44,18 @@ inline std::string format_number(double x, int digits) {
 // ostream prints it by default ("0.001", "3.16228e+04").
 inline std::string short_number(double x) { return format_number(x, 6); }
 
+// The entries of a vector (anything with size() and [i]: Eigen, std::vector)
+// with `digits` significant digits, joined by ", ": "1, 0.5, -2".
+template <class V>
+std::string number_list(const V& v, int digits) {
+  std::string s;
+  for (decltype(v.size()) i = 0; i < v.size(); ++i) {
+    if (i) s += ", ";
+    append_number(s, static_cast<double>(v[i]), digits);
+  }
+  return s;
+}
+
 // One part of a message: a string as it is, a character as itself, a bool
 // as "true" / "false", an integer in full, a floating-point number by
 // short_number (so numbers read as an ostream prints them by default).
