@@ -159,10 +159,8 @@ struct GeometricTail {
   double since = 0.0;    // the first impact of the evidence
 };
 
-struct EventResult {
-  Status status = Status::kNumericalFailure;  // kOk when computed; message says why not
-  bool ok() const { return status == Status::kOk; }
-  std::string message;
+// kOk when computed; the message says why not.
+struct EventResult : OutcomeStartingAs<Status::kNumericalFailure> {
   VectorXd x_plus;
   lcs::IndexSet mode;
   std::vector<FrictionMode> friction;  // models with friction: the selected stick / slip modes
