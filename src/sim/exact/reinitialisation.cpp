@@ -10,7 +10,6 @@
 // approaches, select_regular_mode.
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "sim/exact/event_driven_detail.hpp"
 
@@ -44,12 +43,9 @@ EventDriven::ContactScan EventDriven::scan_contacts(double t, const VectorXd& xa
       gap_tol +=
           kSqrtEps * (m.E.row(r).cwiseAbs().sum() * q.cwiseAbs().maxCoeff() + std::abs(m.g(r)));
     if (s.gap(r) < -gap_tol) {
-      std::ostringstream msg;
-      msg.precision(6);
-      msg << "constraint '" << m.constraints[r] << "' is violated at t = " << t
-          << " (gap = " << s.gap(r)
-          << "): the state is infeasible, E q + g >= 0 must hold (thesis §3.8)";
-      s.violation = msg.str();
+      s.violation =
+          text("constraint '", m.constraints[r], "' is violated at t = ", t, " (gap = ", s.gap(r),
+               "): the state is infeasible, E q + g >= 0 must hold (thesis §3.8)");
       return s;
     }
     if (s.gap(r) > gap_tol) continue;
