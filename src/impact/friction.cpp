@@ -190,7 +190,7 @@ void set_outcomes(const mech::MechanicalModel& m, const ImpactInput& in, const C
     const double scale = c.T.row(fi).cwiseAbs().dot(in.v.cwiseAbs() + out.v_after.cwiseAbs()) +
                          std::abs(c.velocity(fi));
     out.outcome[static_cast<size_t>(row)] =
-        std::abs(ut) <= 1e-9 * scale + kAbsTol
+        std::abs(ut) <= mech::zero_tolerance(scale)
             ? ContactOutcome::kStick
             : (ut > 0 ? ContactOutcome::kSlipPositive : ContactOutcome::kSlipNegative);
   }

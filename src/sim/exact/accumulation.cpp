@@ -172,6 +172,7 @@ std::string EventDriven::take_accumulation_limit(int r, double t, const Geometri
     // itself open by 1e-10 and out of its own limit: it bounced on).
     const double bounce =
         std::abs(rate(s)) * (2.0 * std::max(0.0, t_star - t) + time_resolution(t));
+    // Not mech::zero_tolerance (mech/tolerances.hpp): 1e-6 relative, wider (see above).
     if (!took_part || gap(s) > 1e-6 * gap_scale(s) + ldcp_.tol_abs + bounce) continue;
     names += (names.empty() ? "'" : ", '") + model_.mechanical->constraints[s] + "'";
     joined.push_back(s);

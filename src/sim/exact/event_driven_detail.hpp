@@ -254,7 +254,7 @@ class EventDriven {
     return 16.0 * kEps * std::max(1.0, std::abs(t)) + opt_.event_time_tol;
   }
   bool is_zero(double value, double scale) const {
-    return std::abs(value) <= ldcp_.tol_rel * scale + ldcp_.tol_abs;
+    return std::abs(value) <= mech::zero_tolerance(scale, ldcp_);
   }
 
   // `friction`: the mode of each entry of mechanical.friction (empty for

@@ -55,7 +55,7 @@ EventDriven::ContactScan EventDriven::scan_contacts(double t, const VectorXd& xa
     // times the fastest frequency (a stiff spring grazing its stop).
     const double rate_noise = 64.0 * kEps * m.E.row(r).cwiseAbs().sum() *
                               (v.cwiseAbs().maxCoeff() + rho_A_ * q.cwiseAbs().maxCoeff());
-    const double rate_tol = ldcp_.tol_rel * rate_scale(r) + ldcp_.tol_abs + rate_noise;
+    const double rate_tol = mech::zero_tolerance(rate_scale(r), ldcp_) + rate_noise;
     if (std::abs(s.rate(r)) <= rate_tol) s.resting.push_back(r);
     if (s.rate(r) < -rate_tol) {
       s.approaching = true;
