@@ -4,9 +4,9 @@
 // normals, Newton's restitution on the approaching normals.
 #include <algorithm>
 #include <cmath>
+#include <lcsim/core/format.hpp>
 #include <lcsim/impact/impact.hpp>
 #include <limits>
-#include <sstream>
 
 #include "impact/detail.hpp"
 
@@ -137,8 +137,6 @@ constexpr Eigen::Index kMaxPatternContacts = 8, kMaxPatternNormals = 12;
 
 std::string painleve(const mech::MechanicalModel& m, const IndexSet& closed,
                      const ClosedFriction& c, const MatrixXd& W, const MatrixXd& WNT) {
-  std::ostringstream msg;
-  msg.precision(6);
   const std::string tail =
       "; the friction impact LCP may have no solution or several (not resolved)";
   for (size_t f = 0; f < c.index.size(); ++f) {
@@ -149,11 +147,10 @@ std::string painleve(const mech::MechanicalModel& m, const IndexSet& closed,
     // Relative to the terms that form it: below that it is zero to rounding.
     if (coef > 1e-12 * (wnn + mu * std::abs(wnt))) continue;
     const int row = closed[static_cast<size_t>(j)];
-    msg << "Painlevé-type case at contact " << row << " ('" << m.constraints[row]
-        << "'): W_NN - mu |W_NT| = " << wnn << " - " << mu << " * " << std::abs(wnt) << " = "
-        << coef << " <= 0, so sliding " << (wnt > 0 ? "along +t" : "along -t")
-        << " presses the contact shut" << tail;
-    return msg.str();
+    return text("Painlevé-type case at contact ", row, " ('", m.constraints[row],
+                "'): W_NN - mu |W_NT| = ", wnn, " - ", mu, " * ", std::abs(wnt), " = ", coef,
+                " <= 0, so sliding ", (wnt > 0 ? "along +t" : "along -t"),
+                " presses the contact shut", tail);
   }
   const Eigen::Index nf = c.mu.size();
   if (nf < 1 || (nf == 1 && W.rows() == 1) || nf > kMaxPatternContacts ||
@@ -166,13 +163,13 @@ std::string painleve(const mech::MechanicalModel& m, const IndexSet& closed,
       Ns.col(c.normal_of[static_cast<size_t>(f)]) -= sigma * c.mu(f) * WNT.col(f);
     }
     if (lcp::is_p_matrix(Ns)) continue;
-    msg << "Painlevé-type case at contacts";
+    std::string msg = "Painlevé-type case at contacts";
     for (size_t f = 0; f < c.index.size(); ++f)
-      msg << " " << closed[static_cast<size_t>(c.normal_of[f])]
-          << (((pattern >> f) & 1) ? " (slip-)" : " (slip+)");
-    msg << ": with these slips the normal matrix W_NN - W_NT diag(sigma mu) is not a P-matrix"
-        << tail;
-    return msg.str();
+      msg += text(" ", closed[static_cast<size_t>(c.normal_of[f])],
+                  (((pattern >> f) & 1) ? " (slip-)" : " (slip+)"));
+    return msg +
+           ": with these slips the normal matrix W_NN - W_NT diag(sigma mu) is not a P-matrix" +
+           tail;
   }
   return "";
 }
@@ -193,7 +190,7 @@ void set_outcomes(const mech::MechanicalModel& m, const ImpactInput& in, const C
     const double scale = c.T.row(fi).cwiseAbs().dot(in.v.cwiseAbs() + out.v_after.cwiseAbs()) +
                          std::abs(c.velocity(fi));
     out.outcome[static_cast<size_t>(row)] =
-        std::abs(ut) <= 1e-9 * scale + kAbsTol
+        std::abs(ut) <= mech::zero_tolerance(scale)
             ? ContactOutcome::kStick
             : (ut > 0 ? ContactOutcome::kSlipPositive : ContactOutcome::kSlipNegative);
   }
@@ -231,12 +228,10 @@ void flag_energy_gain(const ClosedFriction& c, const VectorXd& lambda_T, ImpactR
   const double surface_work = c.velocity.dot(lambda_T);
   if (out.energy_after - surface_work > out.energy_before * (1.0 + 1e-12) + 1e-300) {
     out.energy_gain = true;
-    std::ostringstream msg;
-    msg.precision(6);
-    msg << "kinetic energy rose through the impact, " << out.energy_before << " -> "
-        << out.energy_after << " J: Newton restitution with coupled normal and tangential "
-        << "directions (W_NT != 0) can create energy (Kane's paradox)";
-    out.message = msg.str();
+    out.message = text("kinetic energy rose through the impact, ", out.energy_before, " -> ",
+                       out.energy_after,
+                       " J: Newton restitution with coupled normal and tangential "
+                       "directions (W_NT != 0) can create energy (Kane's paradox)");
   }
 }
 

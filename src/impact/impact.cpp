@@ -100,6 +100,7 @@ std::optional<Refined> refine_on_active_set(const Setup& s, const VectorXd& v,
   // by at most that, one left out makes the check below reject the result.
   const VectorXd scale = s.EJ.cwiseAbs() * (v.cwiseAbs() + v_lcp.cwiseAbs()) + c.cwiseAbs();
   std::vector<Eigen::Index> act;
+  // Not mech::zero_tolerance (mech/tolerances.hpp): 1e-10 relative, the LCP's acceptance.
   for (Eigen::Index i = 0; i < nj; ++i)
     if (z(i) > 0.0 || rate(i) <= 1e-10 * scale(i) + kAbsTol) act.push_back(i);
   if (act.empty()) return std::nullopt;
@@ -150,6 +151,7 @@ std::optional<Refined> refine_on_active_set(const Setup& s, const VectorXd& v,
   // Impulses within rounding of zero are zero (the mode is the support).
   const double lambda_scale =
       std::max(out.impulse_J.cwiseAbs().maxCoeff(), z.cwiseAbs().maxCoeff());
+  // Not mech::zero_tolerance (mech/tolerances.hpp): relative to the largest impulse, no floor.
   for (Eigen::Index i = 0; i < nj; ++i)
     if (std::abs(out.impulse_J(i)) <= kRelTol * lambda_scale) out.impulse_J(i) = 0.0;
   // Still a solution? Impulse >= 0 and every closed rate >= 0, to the
@@ -157,7 +159,7 @@ std::optional<Refined> refine_on_active_set(const Setup& s, const VectorXd& v,
   if (out.impulse_J.minCoeff() < -1e-9 * lambda_scale) return std::nullopt;
   const VectorXd rate_new = s.EJ * out.v_after + c;
   for (Eigen::Index i = 0; i < nj; ++i)
-    if (rate_new(i) < -(1e-9 * scale(i) + kAbsTol)) return std::nullopt;
+    if (rate_new(i) < -mech::zero_tolerance(scale(i))) return std::nullopt;
   return out;
 }
 
@@ -172,6 +174,7 @@ void finish(const ImpactInput& in, const Setup& s, const VectorXd& impulse_J,
   for (size_t i = 0; i < in.closed.size(); ++i) {
     out.impulse(in.closed[i]) = impulse_J(i);
     if (impulse_J(i) > mode_threshold) out.mode.push_back(in.closed[i]);
+    // Not mech::zero_tolerance (mech/tolerances.hpp): relative to the largest impulse, no floor.
     if (impulse_J(i) < -1e-9 * lambda_scale) admissible = false;
   }
   out.energy_after = mech::kinetic_energy(m, v_after);
@@ -179,7 +182,7 @@ void finish(const ImpactInput& in, const Setup& s, const VectorXd& impulse_J,
   const VectorXd scale = s.EJ.cwiseAbs() * (in.v.cwiseAbs() + v_after.cwiseAbs());
   out.worst_rate = std::min(0.0, rates.size() ? rates.minCoeff() : 0.0);
   for (Eigen::Index i = 0; i < rates.size(); ++i)
-    if (rates(i) < -(1e-9 * scale(i) + kAbsTol)) admissible = false;
+    if (rates(i) < -mech::zero_tolerance(scale(i))) admissible = false;
   out.admissible = admissible;
 }
 

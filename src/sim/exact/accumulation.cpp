@@ -3,7 +3,6 @@
 // and the limit state (the contacts taking part closed and at rest).
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "sim/exact/event_driven_detail.hpp"
 
@@ -173,6 +172,7 @@ std::string EventDriven::take_accumulation_limit(int r, double t, const Geometri
     // itself open by 1e-10 and out of its own limit: it bounced on).
     const double bounce =
         std::abs(rate(s)) * (2.0 * std::max(0.0, t_star - t) + time_resolution(t));
+    // Not mech::zero_tolerance (mech/tolerances.hpp): 1e-6 relative, wider (see above).
     if (!took_part || gap(s) > 1e-6 * gap_scale(s) + ldcp_.tol_abs + bounce) continue;
     names += (names.empty() ? "'" : ", '") + model_.mechanical->constraints[s] + "'";
     joined.push_back(s);
@@ -184,20 +184,19 @@ std::string EventDriven::take_accumulation_limit(int r, double t, const Geometri
   const VectorXd dv = xa.segment(N_, N_) - x_before.segment(N_, N_);
   const double moved = std::sqrt(dq.dot(model_.mechanical->M * dq));
   const double slowed = std::sqrt(dv.dot(model_.mechanical->M * dv));
-  std::ostringstream note;
-  note.precision(6);
-  note << "impacts at " << names << " accumulate: ";
+  std::string note = "impacts at " + names + " accumulate: ";
   if (ratio > 0.0)
-    note << "their intervals shrink by the ratio " << ratio
-         << (tail.period > 1 ? " every " + std::to_string(tail.period) + " impacts" : "")
-         << ", so the remaining impacts take " << (t_star - t) << " s (geometric tail d r/(1 - r))";
+    note +=
+        text("their intervals shrink by the ratio ", ratio,
+             (tail.period > 1 ? " every " + std::to_string(tail.period) + " impacts" : ""),
+             ", so the remaining impacts take ", (t_star - t), " s (geometric tail d r/(1 - r))");
   else
-    note << "two impacts of '" << model_.mechanical->constraints[r] << "' " << (t - since)
-         << " s apart, below accumulation_dt or the resolution of their times";
-  note << "; limit taken at t = " << t << ": their gaps and rates set to zero (positions moved by "
-       << moved << ", velocities by " << slowed
-       << " in the kinetic metric), then the limit mode up to t* = " << t_star;
-  return note.str();
+    note += text("two impacts of '", model_.mechanical->constraints[r], "' ", (t - since),
+                 " s apart, below accumulation_dt or the resolution of their times");
+  return note + text("; limit taken at t = ", t,
+                     ": their gaps and rates set to zero (positions moved by ", moved,
+                     ", velocities by ", slowed,
+                     " in the kinetic metric), then the limit mode up to t* = ", t_star);
 }
 
 }  // namespace lcsim::sim::detail

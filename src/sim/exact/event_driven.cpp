@@ -87,13 +87,11 @@ void EventDriven::check_feasible(double t, const VectorXd& xa, const VectorXd& y
   const double terms = sys_.C.row(r).cwiseAbs().sum() * xa.cwiseAbs().maxCoeff();
   // An event state lies within the event time's resolution of the crossing.
   const double rate = model_.mechanical->E.row(r).dot(xa.segment(N_, N_));
+  // Not mech::event_gap_tolerance (mech/tolerances.hpp): sqrt(eps) of the state's scale.
   if (y(r) >= -(kSqrtEps * terms + ldcp_.tol_abs + time_resolution(t) * std::abs(rate))) return;
-  std::ostringstream msg;
-  msg.precision(6);
-  msg << "constraint '" << model_.mechanical->constraints[static_cast<size_t>(r)]
-      << "' is violated at t = " << t << " (gap = " << y(r)
-      << "): the exact method missed a contact event; please report the model";
-  infeasible_ = msg.str();
+  infeasible_ = text("constraint '", model_.mechanical->constraints[static_cast<size_t>(r)],
+                     "' is violated at t = ", t, " (gap = ", y(r),
+                     "): the exact method missed a contact event; please report the model");
 }
 
 void EventDriven::record(Trajectory& tr, double t, const VectorXd& xa, const Phase& ph) const {

@@ -159,10 +159,8 @@ struct GeometricTail {
   double since = 0.0;    // the first impact of the evidence
 };
 
-struct EventResult {
-  Status status = Status::kNumericalFailure;  // kOk when computed; message says why not
-  bool ok() const { return status == Status::kOk; }
-  std::string message;
+// kOk when computed; the message says why not.
+struct EventResult : OutcomeStartingAs<Status::kNumericalFailure> {
   VectorXd x_plus;
   lcs::IndexSet mode;
   std::vector<FrictionMode> friction;  // models with friction: the selected stick / slip modes
@@ -256,7 +254,7 @@ class EventDriven {
     return 16.0 * kEps * std::max(1.0, std::abs(t)) + opt_.event_time_tol;
   }
   bool is_zero(double value, double scale) const {
-    return std::abs(value) <= ldcp_.tol_rel * scale + ldcp_.tol_abs;
+    return std::abs(value) <= mech::zero_tolerance(scale, ldcp_);
   }
 
   // `friction`: the mode of each entry of mechanical.friction (empty for

@@ -48,9 +48,9 @@ std::vector<int> EventDriven::zero_sliding(const lcs::IndexSet& mode, const Vect
     // terms, and of the state through the fastest frequency.
     const double noise = 64.0 * kEps * fc.tangent.cwiseAbs().sum() *
                          (v.cwiseAbs().maxCoeff() + rho_A_ * q.cwiseAbs().maxCoeff());
-    const double tol =
-        ldcp_.tol_rel * (fc.tangent.cwiseAbs().dot(v.cwiseAbs()) + std::abs(fc.velocity)) +
-        ldcp_.tol_abs + noise;
+    const double tol = mech::zero_tolerance(
+                           fc.tangent.cwiseAbs().dot(v.cwiseAbs()) + std::abs(fc.velocity), ldcp_) +
+                       noise;
     if (std::abs(s) <= tol ||
         outcome_[static_cast<size_t>(fc.contact)] == impact::ContactOutcome::kStick) {
       zero.push_back(static_cast<int>(f));
@@ -128,8 +128,7 @@ std::vector<FrictionMode> EventDriven::friction_lcp_modes(const lcs::IndexSet& m
   for (Eigen::Index z = 0; z < nz; ++z) {
     // Sliding acceleration t'v' = w_T - xi; zero to the rounding of its terms.
     const double a = w(nn + z) - res.z(nn + nz + z);
-    const double tol =
-        ldcp_.tol_rel * (w_scale(nn + z) + std::abs(res.z(nn + nz + z))) + ldcp_.tol_abs;
+    const double tol = mech::zero_tolerance(w_scale(nn + z) + std::abs(res.z(nn + nz + z)), ldcp_);
     FrictionMode& mode_z = fm[static_cast<size_t>(zero[z])];
     mode_z = a > tol ? FrictionMode::kSlipPositive
                      : (a < -tol ? FrictionMode::kSlipNegative : FrictionMode::kStick);

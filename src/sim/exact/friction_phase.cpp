@@ -13,7 +13,6 @@
 #include <cmath>
 #include <lcsim/lcp/lcp.hpp>
 #include <limits>
-#include <sstream>
 
 #include "sim/exact/event_driven_detail.hpp"
 
@@ -52,20 +51,18 @@ std::string EventDriven::painleve_phase(const Phase& ph, const MatrixXd& S, int 
   }
   if (lcp::is_p_matrix(Ns)) return "";
   const mech::MechanicalModel& m = *model_.mechanical;
-  std::ostringstream msg;
-  msg.precision(6);
-  msg << "Painlevé-type phase: with contact";
+  std::string msg = "Painlevé-type phase: with contact";
   for (size_t f = 0; f < ph.friction.size(); ++f) {
     if (!slipping(ph.friction[f])) continue;
     const int r = m.friction[f].contact;
-    msg << " " << r << " ('" << m.constraints[static_cast<size_t>(r)] << "', "
-        << to_string(ph.friction[f]) << ")";
+    msg += text(" ", r, " ('", m.constraints[static_cast<size_t>(r)], "', ",
+                to_string(ph.friction[f]), ")");
   }
-  msg << " slipping, the normal matrix E_I M^-1 (E_I - sigma mu T)' is not a P-matrix";
-  if (nI == 1) msg << " (W_NN - sigma mu W_NT = " << Ns(0, 0) << " <= 0)";
-  msg << ": the contact force is not determined, the relay LCP may have no solution or several "
+  msg += " slipping, the normal matrix E_I M^-1 (E_I - sigma mu T)' is not a P-matrix";
+  if (nI == 1) msg += text(" (W_NN - sigma mu W_NT = ", Ns(0, 0), " <= 0)");
+  return msg +
+         ": the contact force is not determined, the relay LCP may have no solution or several "
          "(not resolved)";
-  return msg.str();
 }
 
 // F (normals), Ft and Acl of a mode with closed frictional contacts; false

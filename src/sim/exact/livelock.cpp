@@ -3,7 +3,6 @@
 // rounding end the run with a message naming the contacts involved.
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "sim/exact/event_driven_detail.hpp"
 
@@ -36,20 +35,18 @@ std::string LivelockGuard::after_event(double t, const VectorXd& x_minus, const 
   for (int r = 0; r < static_cast<int>(ev.impulse.size()); ++r)
     if (ev.impulse(r) != 0.0) involved_.insert(r);
   if (streak_ < limit_) return "";
-  std::ostringstream msg;
-  msg.precision(6);
-  msg << "no progress at t = " << t << ": " << streak_ << " events in " << (t - since_)
-      << " s each changed the state by less than rounding, at contacts ";
+  std::string msg = text("no progress at t = ", t, ": ", streak_, " events in ", (t - since_),
+                         " s each changed the state by less than rounding, at contacts ");
   bool first = true;
   for (int r : involved_) {
-    msg << (first ? "" : ", ")
-        << (r < static_cast<int>(names_.size()) ? "'" + names_[r] + "'" : std::to_string(r));
+    msg += first ? "" : ", ";
+    msg += r < static_cast<int>(names_.size()) ? "'" + names_[r] + "'" : std::to_string(r);
     first = false;
   }
-  if (involved_.empty()) msg << "(none)";
-  msg << " (their modes alternate with impulses below rounding): the event-driven method "
+  if (involved_.empty()) msg += "(none)";
+  return msg +
+         " (their modes alternate with impulses below rounding): the event-driven method "
          "cannot resolve this contact configuration; a time-stepping method (Moreau–Jean) can";
-  return msg.str();
 }
 
 }  // namespace lcsim::sim::detail

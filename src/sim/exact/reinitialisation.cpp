@@ -10,7 +10,6 @@
 // approaches, select_regular_mode.
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "sim/exact/event_driven_detail.hpp"
 
@@ -44,12 +43,9 @@ EventDriven::ContactScan EventDriven::scan_contacts(double t, const VectorXd& xa
       gap_tol +=
           kSqrtEps * (m.E.row(r).cwiseAbs().sum() * q.cwiseAbs().maxCoeff() + std::abs(m.g(r)));
     if (s.gap(r) < -gap_tol) {
-      std::ostringstream msg;
-      msg.precision(6);
-      msg << "constraint '" << m.constraints[r] << "' is violated at t = " << t
-          << " (gap = " << s.gap(r)
-          << "): the state is infeasible, E q + g >= 0 must hold (thesis §3.8)";
-      s.violation = msg.str();
+      s.violation =
+          text("constraint '", m.constraints[r], "' is violated at t = ", t, " (gap = ", s.gap(r),
+               "): the state is infeasible, E q + g >= 0 must hold (thesis §3.8)");
       return s;
     }
     if (s.gap(r) > gap_tol) continue;
@@ -59,7 +55,7 @@ EventDriven::ContactScan EventDriven::scan_contacts(double t, const VectorXd& xa
     // times the fastest frequency (a stiff spring grazing its stop).
     const double rate_noise = 64.0 * kEps * m.E.row(r).cwiseAbs().sum() *
                               (v.cwiseAbs().maxCoeff() + rho_A_ * q.cwiseAbs().maxCoeff());
-    const double rate_tol = ldcp_.tol_rel * rate_scale(r) + ldcp_.tol_abs + rate_noise;
+    const double rate_tol = mech::zero_tolerance(rate_scale(r), ldcp_) + rate_noise;
     if (std::abs(s.rate(r)) <= rate_tol) s.resting.push_back(r);
     if (s.rate(r) < -rate_tol) {
       s.approaching = true;

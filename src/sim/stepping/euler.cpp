@@ -22,13 +22,11 @@ namespace {
 
 using Eigen::MatrixXd;
 
-struct EulerFactors {
-  MatrixXd Phi;                               // (I - hA)^{-1}
-  MatrixXd PhiB;                              // h (I - hA)^{-1} B
-  MatrixXd G;                                 // D + h C (I - hA)^{-1} B, the LCP matrix of step 4
-  Status status = Status::kNumericalFailure;  // kOk when computed; message says why not
-  bool ok() const { return status == Status::kOk; }
-  std::string message;
+// kOk when computed; the message says why not.
+struct EulerFactors : OutcomeStartingAs<Status::kNumericalFailure> {
+  MatrixXd Phi;   // (I - hA)^{-1}
+  MatrixXd PhiB;  // h (I - hA)^{-1} B
+  MatrixXd G;     // D + h C (I - hA)^{-1} B, the LCP matrix of step 4
 };
 
 EulerFactors euler_factors(const lcs::Lcs& sys, double h) {

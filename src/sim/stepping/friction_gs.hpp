@@ -43,11 +43,10 @@ struct FrictionGsProblem {
   int n_normal = 0;
 };
 
-struct FrictionGsResult {
-  lcp::Status status = lcp::Status::kNumericalFailure;
+// kSolved or kIterationLimit when the sweeps ran; the message says why not.
+struct FrictionGsResult : OutcomeStartingAs<lcp::Status::kNumericalFailure> {
   int sweeps = 0;
   double residual = 0.0;  // natural residual of the friction LCP
-  std::string message;
 };
 
 // lambda: the warm start on entry (n_N + n_F, projected onto the cone by the
