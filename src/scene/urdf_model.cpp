@@ -142,7 +142,6 @@ std::string check_inertia(urdf::Inertial& in, bool balance, const std::string& s
   const double tol = kInertiaTolerance * std::max(std::abs(p(0)), std::abs(p(2)));
   // The moments are computed, not read: 6 significant digits (the file's
   // own values are in `got`, exactly).
-  const auto six = [](double x) { return short_number(x); };
   const auto three = [&](const Vector3d& v) { return number_list(v, 6); };
   std::string problem, why;
   if (p(0) < -tol) {
@@ -150,8 +149,9 @@ std::string check_inertia(urdf::Inertial& in, bool balance, const std::string& s
         "not positive semi-definite: principal moments " + three(p) + " (kg m^2), a negative one";
     why = "a negative moment";
   } else if (p(0) + p(1) < p(2) - tol) {
-    problem = "principal moments " + three(p) + " break the triangle inequality (" + six(p(0)) +
-              " + " + six(p(1)) + " < " + six(p(2)) + "): no rigid body has them";
+    problem = "principal moments " + three(p) + " break the triangle inequality (" +
+              short_number(p(0)) + " + " + short_number(p(1)) + " < " + short_number(p(2)) +
+              "): no rigid body has them";
     why = "the triangle inequality broken";
   }
   if (problem.empty()) return "";
