@@ -4,11 +4,13 @@
 // summary line ends it. Failed runs are rows of the table, not an exit code.
 #include <cstdio>
 #include <iostream>
+#include <lcsim/io/input_error.hpp>
 #include <lcsim/study/execute.hpp>
 #include <lcsim/study/study.hpp>
 #include <memory>
 
 #include "cli/command.hpp"
+#include "cli/flag_names.hpp"
 
 namespace lcsim::cli {
 namespace {
@@ -27,7 +29,12 @@ void run(const StudyArgs& a) {
   o.resume = a.resume;
   o.jobs = a.jobs;
   o.progress = [](const std::string& line) { std::cerr << "study: " << line << "\n"; };
-  const study::Summary sum = study::run_study(s, o);
+  study::Summary sum;
+  try {
+    sum = study::run_study(s, o);
+  } catch (const io::InputError& e) {  // the library names fields, the user typed flags
+    throw io::InputError(with_flag_names(e.what(), study_flags()));
+  }
   if (!sum.writer) return;
   std::fprintf(stderr,
                "study: %zu runs (%zu from the journal, %zu computed), %zu not completed, "

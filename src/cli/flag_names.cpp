@@ -35,6 +35,13 @@ constexpr FieldFlag kImpactsFlags[] = {
     {"x0", "--x0"},
 };
 
+// study::ExecOptions's fields, as its messages name them.
+constexpr FieldFlag kStudyFlags[] = {
+    {"resume = true continues", "--resume continues"},
+    {"jobs", "--jobs"},
+    {"out", "--out"},
+};
+
 bool word_char(char c) {
   return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == ':';
 }
@@ -51,6 +58,7 @@ bool ends_word(const std::string& message, size_t end) {
 FieldFlags simulate_flags() { return kSimulateFlags; }
 FieldFlags analyze_flags() { return kAnalyzeFlags; }
 FieldFlags impacts_flags() { return kImpactsFlags; }
+FieldFlags study_flags() { return kStudyFlags; }
 
 std::string with_flag_names(const std::string& message, FieldFlags flags) {
   std::string out;

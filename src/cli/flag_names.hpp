@@ -22,6 +22,8 @@ FieldFlags simulate_flags();
 FieldFlags analyze_flags();
 // `lcsim impacts`: the fields of app::ImpactsRequest.
 FieldFlags impacts_flags();
+// `lcsim study`: the fields of study::ExecOptions.
+FieldFlags study_flags();
 
 // `message` with each whole field name of `flags` replaced by its flag
 // ("dt_out must be ..." -> "--dt-out must be ...", "x0: ..." -> "--x0: ...").

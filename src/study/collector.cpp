@@ -67,10 +67,10 @@ int jobs_of(const ExecOptions& opt) {
 
 Collector::Collector(const Study& s, const ExecOptions& opt)
     : study_(s), opt_(opt), start_(std::chrono::steady_clock::now()), last_progress_(start_) {
-  if (opt.out.empty()) throw io::InputError("--out: no output file given");
+  if (opt.out.empty()) throw io::InputError("out: no output file given");
   if (opt.jobs < 0)
-    throw io::InputError("--jobs: must be >= 0, 0 for one per core (got " +
-                         std::to_string(opt.jobs) + ")");
+    throw io::InputError("jobs: must be >= 0, 0 for one per core (got " + std::to_string(opt.jobs) +
+                         ")");
   const std::size_t n = run_count(s);
   journal_ = std::make_unique<Journal>(journal_path(opt), s.fingerprint, n, opt.resume);
   rows_ = journal_->rows();

@@ -62,8 +62,8 @@ Journal::Journal(const std::filesystem::path& path, const std::string& fp, std::
     : path_(path.string()), last_sync_(std::chrono::steady_clock::now()) {
   const bool exists = std::filesystem::exists(path);
   if (exists && !resume)
-    throw io::InputError(path_ + ": a journal of an earlier run is here: pass --resume to " +
-                         "continue it, or remove it to start again");
+    throw io::InputError(path_ + ": a journal of an earlier run is here: resume = true continues " +
+                         "it, or remove it to start again");
   const std::string header = header_json(fp, runs);
   std::size_t keep = 0;  // bytes of whole, checked lines
   if (exists) {
