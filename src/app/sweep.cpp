@@ -306,8 +306,6 @@ std::vector<PlannedRow> plan_rows(const mech::Model& model, const Eigen::VectorX
   return rows;
 }
 
-nlohmann::json num(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); }
-
 nlohmann::json text_or_null(const std::string& s) {
   return s.empty() ? nlohmann::json() : nlohmann::json(s);
 }
@@ -374,12 +372,12 @@ nlohmann::json sweep_json(const SweepResult& r) {
     o["reference_law"] = row.reference.label();
     o["reference_inelastic"] = row.reference.inelastic;
     o["reference_reason"] = row.reference.reason;
-    o["error_final"] = num(row.error_final);
-    o["error_max"] = num(row.error_max);
-    o["error_events"] = num(row.error_events);
+    o["error_final"] = io::finite_or_null(row.error_final);
+    o["error_max"] = io::finite_or_null(row.error_max);
+    o["error_events"] = io::finite_or_null(row.error_events);
     o["error_floor"] = text_or_null(row.error_floor);
-    o["max_violation"] = num(row.max_violation);
-    o["energy_drift"] = num(row.energy_drift);
+    o["max_violation"] = io::finite_or_null(row.max_violation);
+    o["energy_drift"] = io::finite_or_null(row.energy_drift);
     o["steps"] = row.steps;
     o["lcp_solves"] = row.lcp_solves;
     o["wall_time_s"] = row.wall_time_s;

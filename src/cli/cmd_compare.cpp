@@ -47,10 +47,6 @@ struct CompareArgs {
   int iterations = bullet::WorldSettings{}.solver_iterations;
 };
 
-nlohmann::json num(double x) {
-  return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
-}
-
 // A block on a floor with friction: Bullet's box beside the exact run
 // (bullet::compare_friction_box), along the floor.
 void print_friction(const mech::Model& model, const CompareArgs& a,
@@ -64,7 +60,8 @@ void print_friction(const mech::Model& model, const CompareArgs& a,
     j["t_end"] = c.block.t_end;
     j["bullet_scene"] = "friction box";
     for (int i = 0; i < 3; ++i)
-      j["stop"][names[i]] = {{"time", num(stops[i]->time)}, {"distance", num(stops[i]->distance)}};
+      j["stop"][names[i]] = {{"time", io::finite_or_null(stops[i]->time)},
+                             {"distance", io::finite_or_null(stops[i]->distance)}};
     j["deviation_max"] = c.deviation_max;
     j["deviation_t"] = c.deviation_t;
     j["error_final"] = c.error_final;
@@ -105,16 +102,16 @@ void print_comparison_json(const mech::Model& model, const CompareArgs& a, const
   j["model"] = model.name;
   j["h"] = a.h;
   j["t_end"] = bt.t_end;
-  j["deviation_max"] = num(c.deviation_max);
+  j["deviation_max"] = io::finite_or_null(c.deviation_max);
   j["deviation_t"] = c.deviation_t;
-  j["error_final"] = num(c.error_final);
+  j["error_final"] = io::finite_or_null(c.error_final);
   nlohmann::json shifts = nlohmann::json::array();
   for (const auto& s : c.event_shifts)
     shifts.push_back({{"constraint", model.mechanical->constraints[s.constraint]},
                       {"kind", s.activation ? "activation" : "release"},
                       {"t_exact", s.t_exact},
-                      {"t_bullet", num(s.t_other)},
-                      {"shift", num(s.shift)}});
+                      {"t_bullet", io::finite_or_null(s.t_other)},
+                      {"shift", io::finite_or_null(s.shift)}});
   j["event_shifts"] = std::move(shifts);
   j["unmatched_bullet_switches"] = c.unmatched_other;
   j["energy_drift"] = c.energy_drift;
