@@ -63,7 +63,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     const lcsim::mech::Model m =
         lcsim::scene::parse_model(scene_text, (folder() / "scene.yaml").string());
-    (void)lcsim::scene::model_notes(m);
+    (void)lcsim::io::model_notes(m);
   } catch (const lcsim::io::InputError& e) {
     one_line(e);
   }
