@@ -232,6 +232,45 @@ TEST_F(Contacts, BoxAtRestHasTheGapsAndForcesOfItsGeometry) {
   EXPECT_EQ(ranges[3].unit, "rad");
 }
 
+// analyze's contact section (scene::contact_ranges) on the box at rest:
+// the bottom corners are closed, the top ones 0.1 m open; for corner0 at
+// p = (-0.15, -0.1, -0.05) the tightest coordinate is the roll rx, where
+// the exact gap changes by py sin(th) + pz (cos(th) - 1) and the linear one
+// by py th. The 1 % crossing of their difference relative to the larger
+// change, found here by bisection on that closed form on each side (the
+// nearer one counts), agrees with the scan's 50 bisections to 1e-12 rad.
+TEST(ContactRanges, BoxCornersAtRest) {
+  const scene::Scene s = *scene::load_scene_details(kRobots + "box_drop_scene.yaml");
+  const auto ranges = scene::contact_ranges(s, 0.01);
+  ASSERT_EQ(ranges.size(), 8u);
+  for (const auto& r : ranges) {
+    const bool top = r.contact >= "box.corner4";
+    EXPECT_EQ(r.closed, !top) << r.contact;
+    EXPECT_NEAR(r.gap, top ? 0.1 : 0.0, 1e-15) << r.contact;
+  }
+  const double py = -0.1, pz = -0.05;
+  const auto off = [&](double th) {
+    const double exact = py * std::sin(th) + pz * (std::cos(th) - 1), linear = py * th;
+    return std::abs(exact - linear) - 0.01 * std::max(std::abs(exact), std::abs(linear));
+  };
+  double nearest = 10.0;
+  for (const double dir : {-1.0, 1.0}) {
+    double lo = 1e-6, hi = 1.0;  // off(lo) < 0 < off(hi) on both sides
+    ASSERT_LT(off(dir * lo), 0.0);
+    ASSERT_GT(off(dir * hi), 0.0);
+    for (int k = 0; k < 200; ++k) {
+      const double mid = 0.5 * (lo + hi);
+      (off(dir * mid) > 0 ? hi : lo) = mid;
+    }
+    nearest = std::min(nearest, lo);
+  }
+  EXPECT_EQ(ranges[0].contact, "box.corner0");
+  EXPECT_EQ(ranges[0].coordinate, "box.rx");
+  EXPECT_EQ(ranges[0].unit, "rad");
+  EXPECT_EQ(ranges[0].end, "threshold");
+  EXPECT_NEAR(ranges[0].range, nearest, 1e-12);
+}
+
 // A floating body without contacts or torque: z(t) = z0 + vz t - g t^2/2
 // and x(t) = x0 + vx t exactly (the linear model of a free body is exact),
 // the rotation unchanged. The exact method's matrix exponentials reproduce
@@ -258,6 +297,55 @@ t_end: 1
     EXPECT_LE(s.x.segment<3>(3).cwiseAbs().maxCoeff(), 1e-12) << t;
     EXPECT_LE(s.x.tail<3>().cwiseAbs().maxCoeff(), 1e-12) << t;
   }
+}
+
+// Springs hold a floating base like a joint: a spring k on box.z with rest
+// r and no gravity makes z(t) = r + (z0 - r) cos(w t), w = sqrt(k / m), and
+// an initial spin about x turns it at a constant rate (no torque; the
+// linear model's rotation is the angular velocity at q0). Closed forms to
+// the exact method's rounding: 1e-12.
+TEST_F(Contacts, SpringHoldsAFloatingBase) {
+  write("box.urdf", io::read_file(kRobots + "box.urdf"));
+  const std::string path = write("spring.yaml", R"(urdf: box.urdf
+base: floating
+gravity: [0, 0, 0]
+springs: [{name: hold, joint: box.z, stiffness: 30, rest: 0.5}]
+initial: {q: {box.z: 0.7}, v: {box.rx: 0.25}}
+t_end: 1
+)");
+  const mech::Model model = scene::load_model(path);
+  sim::Options opt;
+  opt.t_end = 1.0;
+  opt.dt_out = 0.1;
+  const sim::Trajectory tr = sim::simulate_event_driven(model, model.initial, opt);
+  ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
+  const double w = std::sqrt(30.0 / 1.2);
+  for (const sim::Sample& x : tr.samples) {
+    EXPECT_NEAR(x.x(2), 0.5 + 0.2 * std::cos(w * x.t), 1e-12) << x.t;
+    EXPECT_NEAR(x.x(3), 0.25 * x.t, 1e-12) << x.t;
+  }
+}
+
+// Gravity's stiffness on a floating base whose centre of mass sits d = 0.1 m
+// below the root's origin: the potential m g z_c with z_c = z - d cos(rx)
+// (and the same in ry) gives K(rx, rx) = K(ry, ry) = m g d, no stiffness in
+// rz nor in the position, and no force at q0 on the rotations. K_g is a
+// central difference (h = 6e-6, urdf_model.cpp): 1e-8 as for the joints.
+TEST_F(Contacts, GravityStiffensAFloatingBaseAboutItsCentreOfMass) {
+  write("low.urdf", R"(<robot name="low"><link name="b">
+    <inertial><origin xyz="0 0 -0.1"/><mass value="1.2"/>
+      <inertia ixx="0.005" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.013"/></inertial>
+  </link></robot>)");
+  const mech::Model model = scene::load_model(write("low.yaml", R"(urdf: low.urdf
+base: {type: floating, pose: {xyz: [0, 0, 1]}}
+)"));
+  const MatrixXd K(model.mechanical->K);
+  MatrixXd expected = MatrixXd::Zero(6, 6);
+  expected(3, 3) = expected(4, 4) = 1.2 * kG * 0.1;
+  EXPECT_LE((K - expected).cwiseAbs().maxCoeff(), 1e-8) << K;
+  EXPECT_NEAR(model.mechanical->f(2), -1.2 * kG, 1e-12);
+  EXPECT_LE(model.mechanical->f.tail<3>().cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_EQ(model.mechanical->coordinates[3], "low.rx");
 }
 
 std::vector<int> bottom_corners(const mech::MechanicalModel& m) {
@@ -399,6 +487,40 @@ TEST_F(Contacts, BadInputIsOneClearLine) {
   EXPECT_NE(e.find("s.yaml: base: expected fixed or floating (got 'flying')"), std::string::npos)
       << e;
   for (const std::string& line : {e}) EXPECT_EQ(line.find('\n'), std::string::npos);
+}
+
+// The <collision> scan: an element in a comment is not one, a second
+// element of a link counts on, and a bad size names the link, the element
+// and the text.
+TEST_F(Contacts, CollisionScanReadsOnlyRealElements) {
+  const std::string urdf = R"(<robot name="b"><link name="b">
+    <inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+    <!-- <collision><geometry><box size="1 1 1"/></geometry></collision> -->
+    <collision name="ball"><origin xyz="0 0 0.5"/><geometry><sphere radius="0.25"/></geometry></collision>
+    <collision><geometry><sphere radius="0.5"/></geometry></collision>
+  </link></robot>)";
+  const scene::Scene s = load(R"(urdf: r.urdf
+base: floating
+planes: [{name: floor, point: [0, 0, -1], normal: [0, 0, 1]}]
+contacts: [{link: b, plane: floor}]
+)",
+                              urdf);
+  ASSERT_EQ(s.contacts.size(), 2u);
+  EXPECT_EQ(s.contacts[0].point.name, "b.sphere0");
+  EXPECT_EQ(s.contacts[0].gap, 1.25);  // centre 0.5 above the origin, 1 m above the floor
+  EXPECT_EQ(s.contacts[1].point.name, "b.sphere1");
+  EXPECT_EQ(s.contacts[1].gap, 0.5);
+  std::string bad = urdf;
+  bad.replace(bad.find("radius=\"0.5\""), 12, "radius=\"-1\"");
+  write("r.urdf", bad);
+  const std::string e = error("", R"(urdf: r.urdf
+base: floating
+planes: [{name: floor, point: [0, 0, -1], normal: [0, 0, 1]}]
+contacts: [{link: b, plane: floor}]
+)");
+  EXPECT_NE(e.find("r.urdf: link 'b': <collision> 1: <sphere radius>: must be > 0 (got -1)"),
+            std::string::npos)
+      << e;
 }
 
 // contact_options.max_distance drops the points farther than it at q0, and
