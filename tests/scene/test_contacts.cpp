@@ -422,6 +422,60 @@ TEST(ContactRuns, BoxTippedOnAnEdgeFallsOntoItsFaceAtTheClosedFormTime) {
   EXPECT_LE(tr.final_state.tail(6).cwiseAbs().maxCoeff(), 1e-12);
 }
 
+// Restitution per contact, as for stops: 0.5 on the four bottom corners
+// sends the dropped box back up at half its impact speed, and it lands
+// again 2 (v/2) / g later (closed forms; the event times are roots found to
+// rounding, 1e-12 s).
+TEST_F(Contacts, RestitutionPerContactBouncesTheBox) {
+  write("box.urdf", io::read_file(kRobots + "box.urdf"));
+  const std::string path =
+      write("bounce.yaml", io::read_file(kRobots + "box_drop_scene.yaml") +
+                               "restitution: {box.corner0: 0.5, box.corner1: 0.5, box.corner2: "
+                               "0.5, box.corner3: 0.5}\n");
+  const mech::Model model = scene::load_model(path);
+  sim::Options opt;
+  opt.t_end = model.t_end;
+  const sim::Trajectory tr = sim::simulate_event_driven(model, model.initial, opt);
+  ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
+  ASSERT_GE(tr.events.size(), 2u);
+  const double t1 = std::sqrt(2 * 0.2 / kG), v = kG * t1;
+  EXPECT_NEAR(tr.events[0].t, t1, 1e-12);
+  EXPECT_NEAR(tr.events[0].state_after(8), 0.5 * v, 1e-12);
+  EXPECT_NEAR(tr.events[1].t, t1 + v / kG, 1e-12);
+}
+
+// The quadruped (robots/quadruped_drop_scene.yaml: floating base, 8 joints
+// held by PD springs, 4 sphere feet) dropped h = 3 cm onto its straight
+// legs: gravity exerts no torque on a vertical leg, so it falls rigidly and
+// lands on its four feet at once at sqrt(2 h / g); the impact takes its
+// kinetic energy M_total g h (6 kg) and it then stays at rest on its feet.
+// Closed forms to rounding (1e-12 s, 1e-12 J; 1e-10 m/s for the final
+// velocities, which carry K_g's central-difference noise of ~1e-19 N/m on
+// the positions through the whole run).
+TEST(ContactRuns, QuadrupedLandsOnItsFourFeetAndStands) {
+  const mech::Model model = scene::load_model(kRobots + "quadruped_drop_scene.yaml");
+  const mech::MechanicalModel& m = *model.mechanical;
+  ASSERT_EQ(m.coordinates.size(), 14u);
+  ASSERT_EQ(m.constraints.size(), 4u);
+  EXPECT_EQ(m.constraints[0], "fl_foot.sphere0");
+  sim::Options opt;
+  opt.t_end = model.t_end;
+  const sim::Trajectory tr = sim::simulate_event_driven(model, model.initial, opt);
+  ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
+  ASSERT_GE(tr.events.size(), 1u);
+  const double h = 0.03, t_hit = std::sqrt(2 * h / kG);
+  EXPECT_NEAR(tr.events[0].t, t_hit, 1e-12);
+  const VectorXd gaps = m.E * tr.events[0].state_before.head(14) + m.g;
+  EXPECT_LE(gaps.cwiseAbs().maxCoeff(), 1e-12);  // all four feet at once
+  // The energies are ~22 J, sums over 14 coordinates of terms up to ~20 J
+  // carried through 31 LCP solves and matrix exponentials of the 29-state
+  // LCS: rounding of order 1e-15 relative per step leaves ~1e-12 J in their
+  // difference (measured 1.2e-12); 1e-11 J is 6e-12 of the 1.77 J lost.
+  EXPECT_NEAR(tr.energy_initial - tr.energy_final, 6.0 * kG * h, 1e-11);
+  EXPECT_NEAR(tr.final_state(2), 0.35, 1e-12);
+  EXPECT_LE(tr.final_state.tail(14).cwiseAbs().maxCoeff(), 1e-10);
+}
+
 // Backward Euler and Moreau-Jean on the dropped box: first order. Before
 // the impact the box falls freely and each method's error in z at the
 // same time is proportional to h: halving h halves it (ratio 2 within
