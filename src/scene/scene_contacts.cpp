@@ -146,10 +146,8 @@ SceneContacts add_contacts(const Keys& keys, const std::string& source, const Sc
       ++total;
       if (f.normal_row.isZero())
         fail(source, k + ".link",
-             "link '" + link +
-                 "' is not moved by any coordinate (joints: or a floating base), "
-                 "so its contact with plane '" +
-                 plane.name + "' could never change");
+             "contact '" + p.name + "' does not move toward or away from plane '" + plane.name +
+                 "' at q0 (no coordinate moves it along the normal: its row of E would be zero)");
       if (f.gap < -opt.penetration_tolerance)
         fail(source, k,
              "contact '" + p.name + "' penetrates plane '" + plane.name + "' by " +

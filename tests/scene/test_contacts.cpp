@@ -537,6 +537,14 @@ TEST_F(Contacts, BadInputIsOneClearLine) {
       << e;
   e = error("", "urdf: r.urdf\nbase: {type: floating, pose: {rpy: [0, 1]}}\n");
   EXPECT_NE(e.find("s.yaml: base.pose.rpy: expected 3 entries"), std::string::npos) << e;
+  e = error("",
+            "urdf: r.urdf\njoints: [j1]\n"
+            "planes: [{name: floor, point: [0, 0, -1], normal: [0, 0, 1]}]\n"
+            "contacts: [{link: base, plane: floor}]\n");
+  EXPECT_NE(e.find("s.yaml: contacts[0].link: contact 'base.corner0' does not move toward or "
+                   "away from plane 'floor' at q0"),
+            std::string::npos)
+      << e;
   e = error("", "urdf: r.urdf\nbase: flying\n");
   EXPECT_NE(e.find("s.yaml: base: expected fixed or floating (got 'flying')"), std::string::npos)
       << e;
