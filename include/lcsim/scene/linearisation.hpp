@@ -67,7 +67,9 @@ void check_linearisation_threshold(double threshold);
 // which e(q) <= threshold: from q0 outwards in 64 steps to the joint's limit
 // (or pi rad / 1 m when it has none), then 50 bisections where e first
 // exceeds the threshold (each coordinate alone; e need not be monotone, the
-// scan stops at the first crossing it sees).
+// scan stops at the first crossing it sees). A floating base's coordinates
+// come first, each named as a joint here ("box.z": m, "box.rx": rad), with
+// no limits.
 struct LinearRange {
   std::string joint;
   std::string unit;  // "rad" (revolute) or "m" (prismatic)

@@ -41,8 +41,9 @@ struct Scene {
   mech::Model model;
   std::shared_ptr<urdf::ModelInterface> urdf;
   std::string urdf_source;           // the URDF's path, for messages
-  std::map<std::string, double> q0;  // as the scene gives it (joints not named: 0)
-  Eigen::Vector3d gravity;           // m/s^2, URDF root frame
+  std::map<std::string, double> q0;  // as the scene gives it (joints not named: 0), and
+                                     // a floating base's reference coordinates by name
+  Eigen::Vector3d gravity;           // m/s^2, world frame (the root frame at the identity base)
   UrdfLinearisation lin;             // M, tau_g, K_g, damping at q0 (coordinates: lin.joints)
   std::vector<std::string> notes;    // what loading repaired (UrdfRepairs::notes), dropped contacts
   BasePose base;                     // where the URDF's root sits (fixed or floating)
