@@ -382,6 +382,22 @@ void linear_ranges_section(Draft& d, const std::optional<scene::Scene>& scene) {
           << r.upper_end << ")\n";
 }
 
+// Scenes with contacts (docs/contacts.md): each contact's gap at q0, whether
+// it is closed, and how far its linear gap holds (scene::contact_ranges).
+// Absent for every other model, whose reports stay as they were.
+void contacts_section(Draft& d, const std::optional<scene::Scene>& scene) {
+  if (!scene || scene->contacts.empty()) return;
+  const double threshold = d.options.linearisation_threshold;
+  const std::vector<scene::ContactRange> ranges = scene::contact_ranges(*scene, threshold);
+  d.j["contacts"] = scene::to_json(ranges);
+  d.out << "contacts at q0 (gap m; the linear gap is off by <= " << short_number(100.0 * threshold)
+        << " % of its change for the tightest coordinate moved alone):\n";
+  for (const auto& r : ranges)
+    d.out << "  " << r.contact << " on " << r.plane << ": gap " << short_number(r.gap)
+          << (r.closed ? " (closed)" : "") << ", |" << r.coordinate
+          << " - q0| <= " << short_number(r.range) << " " << r.unit << " (" << r.end << ")\n";
+}
+
 // What was not judged, whether the report is full, and what the summary left out.
 void closing_section(Draft& d) {
   d.j["not_judged"] = d.not_judged;
@@ -419,6 +435,7 @@ AnalysisReport analysis_report(const scene::LoadedModel& loaded, const AnalysisO
   well_posedness_json(d, wp, wp_left);
   well_posedness_text(d, wp, wp_left);
   linear_ranges_section(d, loaded.scene);
+  contacts_section(d, loaded.scene);
   for (const auto& n : wp_left) d.left.push_back("well_posedness." + n);
   closing_section(d);
   return {std::move(d.j), d.out.str()};

@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 #include <functional>
 #include <lcsim/io/yaml.hpp>
+#include <lcsim/scene/contacts.hpp>
 #include <lcsim/scene/urdf.hpp>
 #include <map>
 #include <memory>
@@ -30,6 +31,27 @@ std::string without_geometry(const std::string& xml);
 // stops they would lock the joint at 0 (bullet3's Minitaur knees, whose
 // <limit> gives only effort and velocity), so a scene refuses them there.
 std::map<std::string, std::string> limits_without_bounds(const std::string& xml);
+
+// A link's <collision> element as the URDF text has it (the same scanner):
+// the shape inside <geometry> and its size attributes, and its <origin>.
+// Nothing is checked here: contact_geometry.cpp checks the elements a
+// scene's contacts use, so an error in another link's geometry (which
+// urdfdom never sees) stops nothing.
+struct CollisionElement {
+  std::string link;
+  std::size_t index = 0;  // the link's n-th <collision> (0-based)
+  std::string shape;      // box, sphere, cylinder, capsule, mesh, ... ("" if none)
+  std::map<std::string, std::string> attributes;  // size, radius, length (those present)
+  std::string xyz, rpy;                           // of its <origin> ("" when absent)
+};
+std::vector<CollisionElement> collision_elements(const std::string& xml);
+// The contact points of `link`'s collision primitives, named
+// <prefix>.corner<k> (box), .sphere<k>, .cap<k> (capsule), .rim<k>
+// (cylinder), k counted per kind over the link; InputError naming the link
+// and the element for a mesh or any other shape, or a bad size.
+std::vector<ContactPoint> collision_points(const std::vector<CollisionElement>& elements,
+                                           const std::string& link, const std::string& prefix,
+                                           const std::string& urdf);
 
 // ---------------------------------------------------------------------------
 // Reading a scene file. read_scene (scene.cpp) is a driver that calls one
@@ -64,16 +86,27 @@ struct SceneUrdf {
   std::shared_ptr<urdf::ModelInterface> model;
   std::string path;                              // for messages
   std::map<std::string, std::string> unbounded;  // limits_without_bounds
+  std::vector<CollisionElement> collisions;      // collision_elements
   UrdfRepairs repairs;
 };
 SceneUrdf read_urdf(const Keys& keys, const std::string& source);
 
-// `joints:` (scene_joints.cpp): the simulated joints (the coordinates, in
-// file order), each with the stops it asked for ("lower", "upper") on its own
+// Three numbers (x, y, z) in `unit`, at `key` (scene_values.cpp).
+Eigen::Vector3d vector3(const YAML::Node& n, const std::string& source, const std::string& key,
+                        const std::string& unit);
+
+// `base:` (scene_base.cpp): `fixed` (the default, at the identity pose),
+// `floating`, or {type: fixed | floating, pose: {xyz, rpy}, name}.
+BasePose read_base(const Keys& keys, const std::string& source, const SceneUrdf& urdf);
+
+// `joints:` (scene_joints.cpp): the coordinates: a floating base's six
+// (base_coordinates) and then the simulated joints, in file order (a
+// floating base may have none), each with the stops it asked for ("lower", "upper") on its own
 // limits and on those of the joints that mimic it; and the URDF's mimic
 // joints that follow them.
 struct SceneJoints {
-  std::vector<std::string> names;
+  std::vector<std::string> names;  // every coordinate: the base's, then the joints
+  std::size_t base = 0;            // how many of names are the base's (0 or 6)
   std::vector<std::vector<std::string>> stops, mimic_stops;  // per joint, as names
   std::map<std::string, Mimic> mimics;
   Eigen::Index size() const { return static_cast<Eigen::Index>(names.size()); }
@@ -82,10 +115,13 @@ struct SceneJoints {
   // The joints' values in `values` as a vector over the coordinates (0 for
   // a joint not named).
   VectorXd vector_of(const std::map<std::string, double>& values) const;
+  // The simulated URDF joints (names after the base's).
+  std::vector<std::string> urdf_joints() const;
 };
 // Revolute, continuous or prismatic: a joint with a position.
 bool has_position(const urdf::Joint& j);
-SceneJoints read_joints(const Keys& keys, const std::string& source, const SceneUrdf& urdf);
+SceneJoints read_joints(const Keys& keys, const std::string& source, const SceneUrdf& urdf,
+                        const BasePose& base);
 // The check of a joint named where only simulated joints may be (springs,
 // constraints, initial): "" for a simulated joint, else why not.
 NameCheck simulated(const SceneJoints& joints, const SceneUrdf& urdf);
@@ -138,6 +174,18 @@ SceneConstraints joint_stops(const std::string& source, const SceneUrdf& urdf,
 void add_constraints(const Keys& keys, const std::string& source, const SceneUrdf& urdf,
                      const SceneJoints& joints, SceneConstraints& out);
 void check_unique_names(const SceneConstraints& c, const std::string& source);
+// `planes:` (scene_contacts.cpp): the world planes contacts may touch.
+std::vector<Plane> read_planes(const Keys& keys, const std::string& source);
+// `contacts:` and `contact_options:` (scene_contacts.cpp): each contact
+// point's row added to `out` (after the joint stops and constraints), its
+// frame returned with its row; a note when points were dropped.
+struct SceneContacts {
+  std::vector<ContactFrame> frames;
+  std::vector<std::string> notes;
+};
+SceneContacts add_contacts(const Keys& keys, const std::string& source, const SceneUrdf& urdf,
+                           const std::vector<Plane>& planes, const UrdfDynamics& dyn,
+                           const VectorXd& q0, SceneConstraints& out);
 // `restitution:` by constraint name (0 for those not named).
 VectorXd read_restitution(const Keys& keys, const std::string& source,
                           const std::vector<std::string>& constraints);

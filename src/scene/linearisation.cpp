@@ -23,6 +23,12 @@ using io::to_json;
 
 namespace {
 
+// The scene's simulated URDF joints: its coordinates after a floating base's.
+std::vector<std::string> urdf_joints(const Scene& s) {
+  const std::size_t nb = base_coordinates(s.base).size();
+  return {s.lin.joints.begin() + static_cast<std::ptrdiff_t>(nb), s.lin.joints.end()};
+}
+
 // e_M and e_F at q for the linear model (M0, f, K) and the exact dynamics.
 struct Errors {
   double mass = 0.0, force = 0.0;
@@ -37,7 +43,7 @@ struct Evaluator {
 
   explicit Evaluator(const Scene& s)
       : scene(s),
-        dyn(*s.urdf, s.lin.joints, s.q0, s.gravity, s.urdf_source),
+        dyn(*s.urdf, urdf_joints(s), s.q0, s.gravity, s.urdf_source, s.base),
         M0(s.model.mechanical->M.toDense()),
         K(s.model.mechanical->K.toDense()),
         f(s.model.mechanical->f),
@@ -109,18 +115,23 @@ std::vector<LinearRange> linear_ranges(const Scene& scene, double threshold) {
   std::vector<LinearRange> out;
   for (std::size_t i = 0; i < scene.lin.joints.size(); ++i) {
     const auto ii = static_cast<Eigen::Index>(i);
-    const auto j = scene.urdf->getJoint(scene.lin.joints[i]);
+    // A floating base's coordinates (the first six) are no URDF joint: its
+    // position (m) and rotation vector (rad) have no limits.
+    const bool is_base = i < base_coordinates(scene.base).size();
+    const auto j = is_base ? nullptr : scene.urdf->getJoint(scene.lin.joints[i]);
     const double q0 = ev.q0(ii);
     LinearRange r;
     r.joint = scene.lin.joints[i];
-    r.unit = j->type == urdf::Joint::PRISMATIC ? "m" : "rad";
+    const bool metres = is_base ? i < 3 : j->type == urdf::Joint::PRISMATIC;
+    r.unit = metres ? "m" : "rad";
     r.q0 = q0;
     for (const double dir : {-1.0, 1.0}) {
-      double end = j->type == urdf::Joint::PRISMATIC ? 1.0 : M_PI;
+      double end = metres ? 1.0 : M_PI;
       std::string why = "search";
       // No limit on a continuous joint (URDF ignores it there) nor where
       // lower > upper (Bullet's "no limit"; scene.cpp refuses it as a stop).
-      if (j->limits && j->type != urdf::Joint::CONTINUOUS && j->limits->lower <= j->limits->upper) {
+      if (j && j->limits && j->type != urdf::Joint::CONTINUOUS &&
+          j->limits->lower <= j->limits->upper) {
         const double lim = dir < 0 ? q0 - j->limits->lower : j->limits->upper - q0;
         if (lim >= 0.0) {
           end = lim;

@@ -138,21 +138,29 @@ mech::MechanicalModel assemble(const UrdfLinearisation& lin, const SceneDynamics
 // a new key's stage goes after those whose results it needs.
 Scene read_scene(const std::string& yaml_text, const std::string& source) {
   const YAML::Node root = load(yaml_text, source);
-  const Keys keys = mapping(root, source, "",
-                            {"name", "urdf", "joints", "q0", "gravity", "springs", "constraints",
-                             "restitution", "initial", "t_end", "balance_inertia"});
+  const Keys keys = mapping(
+      root, source, "",
+      {"name", "urdf", "joints", "q0", "gravity", "springs", "constraints", "restitution",
+       "initial", "t_end", "balance_inertia", "base", "planes", "contacts", "contact_options"});
   mech::Model model = named_model(keys, source);
   SceneUrdf urdf = read_urdf(keys, source);
-  const SceneJoints joints = read_joints(keys, source, urdf);
-  const std::map<std::string, double> q0 = read_q0(keys, source, urdf, joints);
+  const BasePose base = read_base(keys, source, urdf);
+  const SceneJoints joints = read_joints(keys, source, urdf, base);
+  std::map<std::string, double> q0 = read_q0(keys, source, urdf, joints);
   const Eigen::Vector3d gravity = read_gravity(keys, source);
-  const UrdfLinearisation lin = linearise_urdf(*urdf.model, joints.names, q0, gravity, urdf.path);
-  const VectorXd q0v = joints.vector_of(q0);
+  const UrdfDynamics exact(*urdf.model, joints.urdf_joints(), q0, gravity, urdf.path, base);
+  const VectorXd q0v = exact.reference();
+  for (std::size_t i = 0; i < joints.base; ++i)
+    q0[joints.names[i]] = q0v(static_cast<Eigen::Index>(i));
+  const UrdfLinearisation lin =
+      linearise_urdf(*urdf.model, joints.urdf_joints(), q0, gravity, urdf.path, base);
 
   SceneDynamics dyn = linear_dynamics(lin, q0v);
   add_springs(keys, source, urdf, joints, dyn);
   SceneConstraints constraints = joint_stops(source, urdf, joints);
   add_constraints(keys, source, urdf, joints, constraints);
+  const std::vector<Plane> planes = read_planes(keys, source);
+  SceneContacts contacts = add_contacts(keys, source, urdf, planes, exact, q0v, constraints);
   check_unique_names(constraints, source);
   mech::MechanicalModel m = assemble(lin, dyn, constraints, joints);
   m.restitution = read_restitution(keys, source, m.constraints);
@@ -162,8 +170,13 @@ Scene read_scene(const std::string& yaml_text, const std::string& source) {
 
   mech::fill_defaults(m);
   model.mechanical = m;
-  return Scene{
-      std::move(model), urdf.model, urdf.path, q0, gravity, lin, std::move(urdf.repairs.notes)};
+  std::vector<std::string> notes = std::move(urdf.repairs.notes);
+  for (std::string& n : contacts.notes) notes.push_back(std::move(n));
+  return Scene{std::move(model), urdf.model,
+               urdf.path,        q0,
+               gravity,          lin,
+               std::move(notes), base,
+               planes,           std::move(contacts.frames)};
 }
 
 mech::Model parse_scene(const std::string& yaml_text, const std::string& source) {
@@ -236,6 +249,12 @@ std::optional<Scene> scene_setup(const mech::Model& model) {
   try {
     std::optional<Scene> scene = load_scene_details(model.source);
     if (!scene || !same_model(*scene->model.mechanical, *model.mechanical)) return std::nullopt;
+    // Bullet's multibody (src/bullet) is built with its root fixed at the
+    // identity and no contacts: a scene with a floating or placed base, or
+    // with contacts, is not one it can build (it runs the matrices).
+    if (scene->base.floating || scene->base.pose.matrix() != Eigen::Matrix4d::Identity() ||
+        !scene->contacts.empty())
+      return std::nullopt;
     scene->model.mechanical->restitution = model.mechanical->restitution;  // the model's own
     return scene;
   } catch (const std::exception&) {

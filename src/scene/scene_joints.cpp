@@ -47,12 +47,22 @@ void read_joint(const YAML::Node& n, const std::string& source, const std::strin
 
 }  // namespace
 
-SceneJoints read_joints(const Keys& keys, const std::string& source, const SceneUrdf& urdf) {
+SceneJoints read_joints(const Keys& keys, const std::string& source, const SceneUrdf& urdf,
+                        const BasePose& base) {
+  SceneJoints out;
+  out.names = base_coordinates(base);
+  out.base = out.names.size();
+  out.stops.assign(out.base, {});
+  out.mimic_stops.assign(out.base, {});
+  // A floating body may have no joints at all (a box); a fixed one must.
+  if (!keys.count("joints") && out.base > 0) {
+    out.mimics = mimic_joints(*urdf.model, urdf.path, out.names);
+    return out;
+  }
   if (!keys.count("joints")) fail(source, "joints", "missing (name the joints to simulate)");
   const YAML::Node& jn = keys.at("joints");
-  if (!jn.IsSequence() || jn.size() == 0)
+  if (!jn.IsSequence() || (jn.size() == 0 && out.base == 0))
     fail(source, "joints", "expected a non-empty list of joint names (got " + describe(jn) + ")");
-  SceneJoints out;
   for (std::size_t i = 0; i < jn.size(); ++i)
     read_joint(jn[i], source, "joints[" + std::to_string(i) + "]", urdf, out);
   out.mimics = mimic_joints(*urdf.model, urdf.path, out.names);
@@ -68,6 +78,10 @@ Eigen::Index SceneJoints::coord(const std::string& name) const {
   return std::find(names.begin(), names.end(), name) - names.begin();
 }
 
+std::vector<std::string> SceneJoints::urdf_joints() const {
+  return {names.begin() + static_cast<std::ptrdiff_t>(base), names.end()};
+}
+
 VectorXd SceneJoints::vector_of(const std::map<std::string, double>& values) const {
   VectorXd v = VectorXd::Zero(size());
   for (Eigen::Index i = 0; i < size(); ++i)
@@ -78,6 +92,7 @@ VectorXd SceneJoints::vector_of(const std::map<std::string, double>& values) con
 
 NameCheck simulated(const SceneJoints& joints, const SceneUrdf& urdf) {
   return [&](const std::string& n) -> std::string {
+    if (static_cast<std::size_t>(joints.coord(n)) < joints.base) return "";  // a floating base's
     if (!urdf.model->getJoint(n)) return "no joint '" + n + "' in " + urdf.path;
     if (joints.mimics.count(n))
       return "joint '" + n + "' mimics '" + joints.mimics.at(n).leader +

@@ -24,6 +24,7 @@ SceneUrdf read_urdf(const Keys& keys, const std::string& source) {
   const std::string xml = io::read_file(urdf_path);
   out.model = parse_urdf(xml, urdf_path.string(), out.repairs);
   out.unbounded = limits_without_bounds(xml);
+  out.collisions = collision_elements(xml);
   out.path = urdf_path.string();
   return out;
 }

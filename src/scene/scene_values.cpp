@@ -31,4 +31,11 @@ std::map<std::string, double> by_name(const YAML::Node& n, const std::string& so
   return out;
 }
 
+Eigen::Vector3d vector3(const YAML::Node& n, const std::string& source, const std::string& key,
+                        const std::string& unit) {
+  const VectorXd v = io::yaml::vector(n, source, key);
+  io::yaml::expect_size(v, 3, source, key, "(x, y, z in " + unit + ")");
+  return v;
+}
+
 }  // namespace lcsim::scene

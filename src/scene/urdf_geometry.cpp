@@ -1,8 +1,10 @@
-// URDF text without the elements lcsim never reads: <visual>, <collision>
-// and <material>. lcsim models no geometry (docs/model-format.md), but
-// urdfdom refuses a whole robot for an error in one of them: Bullet's own
-// geometry types (capsule, plane, cdf), a mesh scale of four numbers, two
-// materials of one name. Public robot files have all of these.
+// URDF text without the elements urdfdom must not see: <visual>,
+// <collision> and <material>; and the <collision> elements as the text has
+// them, for a scene's contacts (collision_elements: only those a scene
+// names are checked, in contact_geometry.cpp). urdfdom refuses a whole
+// robot for an error in one of them: Bullet's own geometry types (capsule,
+// plane, cdf), a mesh scale of four numbers, two materials of one name. Public robot files have all
+// of these.
 //
 // A small scanner, not an XML parser: it copies the text, drops every such
 // element (from its start tag to its end tag, or a self-closing tag) and
@@ -10,6 +12,7 @@
 // that a tag inside them is not taken for an element. Anything it does not
 // recognise is copied unchanged and left to urdfdom.
 #include <array>
+#include <cctype>
 #include <cstring>
 #include <lcsim/io/text.hpp>
 #include <map>
@@ -115,6 +118,77 @@ std::map<std::string, std::string> limits_without_bounds(const std::string& xml)
     pos = e;
   }
   return out;
+}
+
+namespace {
+
+// The scan's place in the URDF text: the link and the collision element it
+// is in (for collision_elements).
+struct CollisionScan {
+  std::string link;                  // "" outside a <link>
+  std::map<std::string, int> count;  // <collision> elements seen per link
+  bool in_collision = false, in_geometry = false;
+  std::vector<CollisionElement> out;
+
+  // One tag of the text (start, end or self-closing), `tag` its text.
+  void see(const std::string& xml, std::size_t pos, const std::string& tag) {
+    const bool closes = tag.size() >= 2 && tag[tag.size() - 2] == '/';
+    if (starts_tag(xml, pos, "link")) {
+      link.clear();
+      if (!closes) has_attribute(tag, "name", &link);
+    } else if (tag.compare(0, 6, "</link") == 0) {
+      link.clear();
+    } else if (!link.empty() && starts_tag(xml, pos, "collision")) {
+      CollisionElement c;
+      c.link = link;
+      c.index = static_cast<std::size_t>(count[link]++);
+      out.push_back(c);
+      in_collision = !closes;
+    } else if (tag.compare(0, 11, "</collision") == 0) {
+      in_collision = in_geometry = false;
+    } else if (in_collision) {
+      see_inside(xml, pos, tag, closes);
+    }
+  }
+
+  void see_inside(const std::string& xml, std::size_t pos, const std::string& tag, bool closes) {
+    CollisionElement& c = out.back();
+    if (!in_geometry && starts_tag(xml, pos, "origin")) {
+      has_attribute(tag, "xyz", &c.xyz);
+      has_attribute(tag, "rpy", &c.rpy);
+    } else if (starts_tag(xml, pos, "geometry")) {
+      in_geometry = !closes;
+    } else if (tag.compare(0, 10, "</geometry") == 0) {
+      in_geometry = false;
+    } else if (in_geometry && c.shape.empty() && tag.size() > 1 && tag[1] != '/') {
+      std::size_t e = 1;
+      while (e < tag.size() && (std::isalnum(static_cast<unsigned char>(tag[e])) || tag[e] == '_'))
+        ++e;
+      c.shape = tag.substr(1, e - 1);
+      for (const char* a : {"size", "radius", "length"}) {
+        std::string v;
+        if (has_attribute(tag, a, &v)) c.attributes[a] = v;
+      }
+    }
+  }
+};
+
+}  // namespace
+
+std::vector<CollisionElement> collision_elements(const std::string& xml) {
+  CollisionScan scan;
+  std::size_t pos = 0;
+  while ((pos = xml.find('<', pos)) != std::string::npos) {
+    if (const std::size_t v = verbatim_end(xml, pos); v != std::string::npos) {
+      pos = v;
+      continue;
+    }
+    const std::size_t e = tag_end(xml, pos);
+    if (e == std::string::npos) break;  // unclosed: urdfdom reports it
+    scan.see(xml, pos, xml.substr(pos, e - pos));
+    pos = e;
+  }
+  return std::move(scan.out);
 }
 
 std::string without_geometry(const std::string& xml) {

@@ -280,12 +280,24 @@ struct Tree {
   std::map<std::string, int> owner;     // link -> moving joint moving it rigidly
   std::vector<std::string> link_order;  // root first (depth first)
   std::map<std::string, Mimic> mimics;  // every mimic joint of the URDF, resolved
+  BasePose base;                        // where the root sits
+  std::size_t nb = 0;                   // a floating base's coordinates (0 or 6), first in joints
 };
 
 Tree make_tree(const urdf::ModelInterface& model, const std::vector<std::string>& joints,
-               const std::string& source) {
-  Tree t{model, joints, joints.size(), {}, {}, {}, {}, {}, {}, mimic_joints(model, source, joints)};
+               const std::string& source, const BasePose& base) {
+  Tree t{model, base_coordinates(base),
+         0,     {},
+         {},    {},
+         {},    {},
+         {},    mimic_joints(model, source, joints),
+         base,  0};
   if (!model.getRoot()) fail(source, "<robot>", "no root link");
+  t.nb = t.joints.size();
+  for (std::size_t i = 0; i < t.nb; ++i) {
+    t.index[t.joints[i]] = static_cast<int>(i);
+    t.coord.push_back(static_cast<int>(i));
+  }
   for (std::size_t i = 0; i < joints.size(); ++i) {
     const auto j = model.getJoint(joints[i]);
     if (!j) fail(source, "joint '" + joints[i] + "'", "no such joint in the URDF");
@@ -293,9 +305,11 @@ Tree make_tree(const urdf::ModelInterface& model, const std::vector<std::string>
       fail(source, "joint '" + joints[i] + "'",
            "unsupported type for a simulated joint (only revolute, continuous and prismatic "
            "joints can be simulated; freeze it by leaving it out of the scene)");
-    t.index[joints[i]] = static_cast<int>(i);
-    t.coord.push_back(static_cast<int>(i));
+    t.index[joints[i]] = static_cast<int>(t.joints.size());
+    t.coord.push_back(static_cast<int>(t.joints.size()));
+    t.joints.push_back(joints[i]);
   }
+  t.n = t.joints.size();
   std::vector<std::pair<int, double>> follow;  // (coordinate, multiplier) of each mimic
   for (const auto& [name, mm] : t.mimics) {
     const auto it = t.index.find(mm.leader);
@@ -311,6 +325,7 @@ Tree make_tree(const urdf::ModelInterface& model, const std::vector<std::string>
   for (std::size_t k = 0; k < follow.size(); ++k)
     t.T(n + static_cast<Eigen::Index>(k), follow[k].first) = follow[k].second;
   t.parent.assign(t.joints.size(), -1);
+  for (std::size_t k = 1; k < t.nb; ++k) t.parent[k] = static_cast<int>(k - 1);  // x, y, ... rz
   std::function<void(const urdf::Link&, int)> walk = [&](const urdf::Link& link, int owner) {
     t.owner[link.name] = owner;
     t.link_order.push_back(link.name);
@@ -324,28 +339,59 @@ Tree make_tree(const urdf::ModelInterface& model, const std::vector<std::string>
       walk(*model.getLink(cj->child_link_name), child_owner);
     }
   };
-  walk(*model.getRoot(), -1);
+  walk(*model.getRoot(), static_cast<int>(t.nb) - 1);  // the root: the base's last (or the world)
   return t;
 }
 
-// Every joint position at coordinates q: the simulated joints from q, the
-// frozen ones from q0 (0 if absent), each mimic from its leader.
-std::map<std::string, double> positions(const Tree& t, const std::map<std::string, double>& q0,
-                                        const VectorXd& q) {
-  std::map<std::string, double> p = q0;
-  for (std::size_t i = 0; i < t.n; ++i) p[t.joints[i]] = q(static_cast<Eigen::Index>(i));
+// The configuration at coordinates q: every joint position (the simulated
+// joints from q, the frozen ones from q0 (0 if absent), each mimic from its
+// leader) and the root's world pose.
+struct Config {
+  std::map<std::string, double> q;  // joint positions by name
+  Isometry3d root;                  // world pose of the root link
+  Vector3d rot = Vector3d::Zero();  // a floating base's rotation vector (rad)
+};
+
+Config positions(const Tree& t, const std::map<std::string, double>& q0, const VectorXd& q) {
+  Config c{q0, t.base.pose};
+  for (std::size_t i = t.nb; i < t.n; ++i) c.q[t.joints[i]] = q(static_cast<Eigen::Index>(i));
   for (const auto& [name, mm] : t.mimics) {
-    const auto it = p.find(mm.leader);
-    p[name] = mm.multiplier * (it == p.end() ? 0.0 : it->second) + mm.offset;
+    const auto it = c.q.find(mm.leader);
+    c.q[name] = mm.multiplier * (it == c.q.end() ? 0.0 : it->second) + mm.offset;
   }
-  return p;
+  if (t.nb > 0) {
+    c.rot = q.segment<3>(3);
+    const double th = c.rot.norm();
+    const Matrix3d R =
+        th > 0.0 ? Eigen::AngleAxisd(th, c.rot / th).toRotationMatrix() : Matrix3d::Identity();
+    c.root.linear() = R * t.base.pose.linear();
+    c.root.translation() = q.head<3>();
+  }
+  return c;
+}
+
+// The left Jacobian of SO(3) at the rotation vector r: d/dt exp([r]x) =
+// [J_l(r) r']x exp([r]x), J_l = 1 + a [r]x + b [r]x^2 with
+// a = (1 - cos th)/th^2, b = (th - sin th)/th^3 (th = |r|). Below th = 1e-2
+// their series to th^4 (the next terms, th^6/40320 and th^6/362880, are
+// under 3e-17), where the closed forms lose digits to cancellation.
+Matrix3d left_jacobian(const Vector3d& r) {
+  const double th = r.norm(), t2 = th * th;
+  double a = 0.5 - t2 / 24.0 + t2 * t2 / 720.0, b = 1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0;
+  if (th >= 1e-2) {
+    const double s = std::sin(0.5 * th);
+    a = 2.0 * s * s / t2;  // 1 - cos th = 2 sin^2(th/2), without cancellation
+    b = (th - std::sin(th)) / (t2 * th);
+  }
+  const Matrix3d K = skew(r);
+  return Matrix3d::Identity() + a * K + b * K * K;
 }
 
 // World pose of every link with simulated and frozen joints at q (by name).
-std::map<std::string, Isometry3d> link_poses(const Tree& t,
-                                             const std::map<std::string, double>& q) {
+std::map<std::string, Isometry3d> link_poses(const Tree& t, const Config& c) {
+  const std::map<std::string, double>& q = c.q;
   std::map<std::string, Isometry3d> X;
-  X[t.model.getRoot()->name] = Isometry3d::Identity();
+  X[t.model.getRoot()->name] = c.root;
   for (const auto& name : t.link_order) {
     const auto link = t.model.getLink(name);
     for (const auto& cj : link->child_joints) {
@@ -357,13 +403,25 @@ std::map<std::string, Isometry3d> link_poses(const Tree& t,
   return X;
 }
 
-// Motion subspace of simulated joint `name` in world coordinates.
-Vector6d subspace(const Tree& t, const std::string& name,
-                  const std::map<std::string, Isometry3d>& X) {
-  const auto j = t.model.getJoint(name);
+// Motion subspace of moving joint i in world coordinates. A floating
+// base's translations move the root along the world axes; its rotation
+// coordinate k turns the tree about the root's origin p with angular
+// velocity J_l(r) e_k (so v0 = p x omega, as for a revolute joint at p).
+Vector6d subspace(const Tree& t, std::size_t i, const std::map<std::string, Isometry3d>& X,
+                  const Config& c) {
+  Vector6d S;
+  if (i < t.nb) {
+    if (i < 3) {
+      S << Vector3d::Zero(), Vector3d::Unit(static_cast<Eigen::Index>(i));
+    } else {
+      const Vector3d w = left_jacobian(c.rot).col(static_cast<Eigen::Index>(i - 3));
+      S << w, c.root.translation().cross(w);
+    }
+    return S;
+  }
+  const auto j = t.model.getJoint(t.joints[i]);
   const Isometry3d& Xc = X.at(j->child_link_name);  // joint frame after its motion
   const Vector3d a = Xc.linear() * vec(j->axis).normalized();
-  Vector6d S;
   if (j->type == urdf::Joint::PRISMATIC)
     S << Vector3d::Zero(), a;
   else
@@ -398,7 +456,7 @@ void up(const Tree& t, int o, F f) {
   for (int b = o; b >= 0; b = t.parent[static_cast<std::size_t>(b)]) f(b);
 }
 
-MatrixXd crba(const Tree& t, const std::map<std::string, double>& q) {
+MatrixXd crba(const Tree& t, const Config& q) {
   const auto X = link_poses(t, q);
   const auto n = static_cast<Eigen::Index>(t.joints.size());
   std::vector<Matrix6d> Ic(t.joints.size(), Matrix6d::Zero());
@@ -410,7 +468,7 @@ MatrixXd crba(const Tree& t, const std::map<std::string, double>& q) {
     up(t, o, [&](int b) { Ic[static_cast<std::size_t>(b)] += I; });
   }
   std::vector<Vector6d> S;
-  for (const auto& j : t.joints) S.push_back(subspace(t, j, X));
+  for (std::size_t i = 0; i < t.joints.size(); ++i) S.push_back(subspace(t, i, X, q));
   MatrixXd M = MatrixXd::Zero(n, n);
   for (Eigen::Index i = 0; i < n; ++i) {
     const auto ui = static_cast<std::size_t>(i);
@@ -423,8 +481,7 @@ MatrixXd crba(const Tree& t, const std::map<std::string, double>& q) {
 
 // tau_g,i = S_i . (sum of the gravity wrenches (c x m g, m g) of the bodies
 // joint i moves).
-VectorXd gravity_force(const Tree& t, const std::map<std::string, double>& q,
-                       const Vector3d& gravity) {
+VectorXd gravity_force(const Tree& t, const Config& q, const Vector3d& gravity) {
   const auto X = link_poses(t, q);
   std::vector<Vector6d> F(t.joints.size(), Vector6d::Zero());
   for (const auto& name : t.link_order) {
@@ -438,7 +495,7 @@ VectorXd gravity_force(const Tree& t, const std::map<std::string, double>& q,
   }
   VectorXd tau(static_cast<Eigen::Index>(t.joints.size()));
   for (std::size_t i = 0; i < t.joints.size(); ++i)
-    tau(static_cast<Eigen::Index>(i)) = subspace(t, t.joints[i], X).dot(F[i]);
+    tau(static_cast<Eigen::Index>(i)) = subspace(t, i, X, q).dot(F[i]);
   return t.T.transpose() * tau;
 }
 
@@ -573,15 +630,15 @@ struct UrdfDynamics::Impl {
 static std::shared_ptr<const UrdfDynamics::Impl> make_dynamics(
     const urdf::ModelInterface& model, const std::vector<std::string>& joints,
     const std::map<std::string, double>& q0, const Eigen::Vector3d& gravity,
-    const std::string& source) {
-  Tree t = make_tree(model, joints, source);
+    const std::string& source, const BasePose& base) {
+  Tree t = make_tree(model, joints, source, base);
   // A simulated joint must move some mass: the links it carries (its child
   // link, the links fixed or frozen to it, those its mimics move, and
   // everything below them, simulated or not) need an <inertial> with mass
   // > 0. A massless link between two simulated joints (a hip or shoulder
   // written as chained revolute joints) is fine: the joint above still
   // moves the limb below it.
-  std::vector<double> moved(joints.size(), 0.0);
+  std::vector<double> moved(t.n, 0.0);
   for (const auto& [name, o] : t.owner) {
     const auto link = model.getLink(name);
     if (o < 0 || !link->inertial) continue;
@@ -590,7 +647,7 @@ static std::shared_ptr<const UrdfDynamics::Impl> make_dynamics(
     for (int c : coords) moved[static_cast<std::size_t>(c)] += link->inertial->mass;
   }
   for (std::size_t i = 0; i < joints.size(); ++i) {
-    const double mass = moved[i];
+    const double mass = moved[t.nb + i];
     if (!(mass > 0.0))
       fail(
           source, "link '" + model.getJoint(joints[i])->child_link_name + "'",
@@ -605,13 +662,27 @@ static std::shared_ptr<const UrdfDynamics::Impl> make_dynamics(
 UrdfDynamics::UrdfDynamics(const urdf::ModelInterface& model,
                            const std::vector<std::string>& joints,
                            const std::map<std::string, double>& q0, const Eigen::Vector3d& gravity,
-                           const std::string& source)
-    : joints_(joints),
-      impl_(one_line_errors([&] { return make_dynamics(model, joints, q0, gravity, source); })) {}
+                           const std::string& source, const BasePose& base)
+    : impl_(one_line_errors(
+          [&] { return make_dynamics(model, joints, q0, gravity, source, base); })) {
+  joints_.assign(impl_->tree.joints.begin(),
+                 impl_->tree.joints.begin() + static_cast<std::ptrdiff_t>(impl_->tree.n));
+}
+
+std::vector<std::string> base_coordinates(const BasePose& base) {
+  if (!base.floating) return {};
+  std::vector<std::string> out;
+  for (const char* c : {"x", "y", "z", "rx", "ry", "rz"}) out.push_back(base.name + "." + c);
+  return out;
+}
 
 VectorXd UrdfDynamics::reference() const {
   VectorXd q(static_cast<Eigen::Index>(joints_.size()));
-  for (std::size_t i = 0; i < joints_.size(); ++i) {
+  const std::size_t nb = impl_->tree.nb;
+  for (std::size_t i = 0; i < nb; ++i)  // the base at its reference pose: (p0, 0)
+    q(static_cast<Eigen::Index>(i)) =
+        i < 3 ? impl_->tree.base.pose.translation()(static_cast<Eigen::Index>(i)) : 0.0;
+  for (std::size_t i = nb; i < joints_.size(); ++i) {
     const auto it = impl_->q0.find(joints_[i]);
     q(static_cast<Eigen::Index>(i)) = it == impl_->q0.end() ? 0.0 : it->second;
   }
@@ -630,21 +701,45 @@ VectorXd UrdfDynamics::damping() const {
   // A mimic's damper acts through its leader: d_J + sum a_m^2 d_m (T' D T).
   const Tree& t = impl_->tree;
   VectorXd d = VectorXd::Zero(static_cast<Eigen::Index>(t.joints.size()));
-  for (std::size_t i = 0; i < t.joints.size(); ++i) {
+  for (std::size_t i = t.nb; i < t.joints.size(); ++i) {  // the base has no damper
     const auto j = t.model.getJoint(t.joints[i]);
     if (j->dynamics) d(static_cast<Eigen::Index>(i)) = j->dynamics->damping;
   }
   return (t.T.transpose() * d.asDiagonal() * t.T).diagonal();
 }
 
+Eigen::Isometry3d UrdfDynamics::link_pose(const std::string& link, const VectorXd& q) const {
+  const Tree& t = impl_->tree;
+  if (!t.owner.count(link)) throw InputError("no link '" + link + "' in the URDF");
+  return link_poses(t, positions(t, impl_->q0, q)).at(link);
+}
+
+Eigen::Matrix3Xd UrdfDynamics::point_jacobian(const std::string& link, const Eigen::Vector3d& local,
+                                              const VectorXd& q) const {
+  const Tree& t = impl_->tree;
+  if (!t.owner.count(link)) throw InputError("no link '" + link + "' in the URDF");
+  const Config c = positions(t, impl_->q0, q);
+  const auto X = link_poses(t, c);
+  const Vector3d w = X.at(link) * local;
+  // Moving joint b turns with omega and moves the world origin's point
+  // with v0: the point w moves with v0 + omega x w.
+  Eigen::Matrix3Xd J = Eigen::Matrix3Xd::Zero(3, static_cast<Eigen::Index>(t.joints.size()));
+  up(t, t.owner.at(link), [&](int b) {
+    const Vector6d S = subspace(t, static_cast<std::size_t>(b), X, c);
+    J.col(b) = S.tail<3>() + S.head<3>().cross(w);
+  });
+  return J * t.T;
+}
+
 UrdfLinearisation linearise_urdf(const urdf::ModelInterface& model,
                                  const std::vector<std::string>& joints,
                                  const std::map<std::string, double>& q0,
-                                 const Eigen::Vector3d& gravity, const std::string& source) {
-  const UrdfDynamics dyn(model, joints, q0, gravity, source);
+                                 const Eigen::Vector3d& gravity, const std::string& source,
+                                 const BasePose& base) {
+  const UrdfDynamics dyn(model, joints, q0, gravity, source, base);
   const VectorXd q = dyn.reference();
   UrdfLinearisation lin;
-  lin.joints = joints;
+  lin.joints = dyn.joints();
   lin.M = dyn.mass_matrix(q);
   lin.tau_g = dyn.gravity_force(q);
   // Gravity stiffness by central differences: tau_g is a sum of products of

@@ -67,7 +67,9 @@ void check_linearisation_threshold(double threshold);
 // which e(q) <= threshold: from q0 outwards in 64 steps to the joint's limit
 // (or pi rad / 1 m when it has none), then 50 bisections where e first
 // exceeds the threshold (each coordinate alone; e need not be monotone, the
-// scan stops at the first crossing it sees).
+// scan stops at the first crossing it sees). A floating base's coordinates
+// come first, each named as a joint here ("box.z": m, "box.rx": rad), with
+// no limits.
 struct LinearRange {
   std::string joint;
   std::string unit;  // "rad" (revolute) or "m" (prismatic)
@@ -79,6 +81,31 @@ struct LinearRange {
   std::string lower_end, upper_end;
 };
 std::vector<LinearRange> linear_ranges(const Scene& scene, double threshold);
+
+// Per contact of the scene (Scene::contacts, in row order): its gap at q0
+// (the model's E q0 + g, m), whether it is closed there
+// (mech::gap_is_zero), and how far the configuration can move before the
+// linear gap is off by more than `threshold`. Along each coordinate alone
+// (others at q0) the error of the linear gap is
+//   e = |phi(q) - gap_lin(q)| / max(|phi(q) - phi(q0)|, |gap_lin(q) - phi(q0)|)
+// (0 where both changes vanish: a rotation about the plane's normal), the
+// error relative to the gap's change since q0; it is scanned as
+// linear_ranges scans (64 steps to pi rad, 1 m or the joint's limit, then
+// 50 bisections), both ways, and `range` is the smaller distance reached,
+// `coordinate` the coordinate whose range is the smallest among those in
+// rad (rotations bend the gap; a translation or prismatic joint along
+// which the point moves straight never does), or among all if none is a
+// rotation. `end`: "threshold" or "search"/"limit" (no crossing).
+struct ContactRange {
+  std::string contact, plane;
+  double gap = 0.0;  // m, at q0
+  bool closed = false;
+  std::string coordinate, unit;
+  double range = 0.0;  // rad or m
+  std::string end;
+};
+std::vector<ContactRange> contact_ranges(const Scene& scene, double threshold);
+nlohmann::json to_json(const std::vector<ContactRange>& ranges);
 
 // JSON of the two: {error, mass_error, force_error, worst_q, states} and
 // [{joint, unit, q0, lower, upper, lower_end, upper_end}, ...].

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <lcsim/io/input_error.hpp>
 #include <lcsim/mech/mech.hpp>
+#include <lcsim/scene/contacts.hpp>
 #include <lcsim/scene/urdf.hpp>
 #include <map>
 #include <memory>
@@ -40,10 +41,14 @@ struct Scene {
   mech::Model model;
   std::shared_ptr<urdf::ModelInterface> urdf;
   std::string urdf_source;           // the URDF's path, for messages
-  std::map<std::string, double> q0;  // as the scene gives it (joints not named: 0)
-  Eigen::Vector3d gravity;           // m/s^2, URDF root frame
+  std::map<std::string, double> q0;  // as the scene gives it (joints not named: 0), and
+                                     // a floating base's reference coordinates by name
+  Eigen::Vector3d gravity;           // m/s^2, world frame (the root frame at the identity base)
   UrdfLinearisation lin;             // M, tau_g, K_g, damping at q0 (coordinates: lin.joints)
-  std::vector<std::string> notes;    // what loading repaired (UrdfRepairs::notes)
+  std::vector<std::string> notes;    // what loading repaired (UrdfRepairs::notes), dropped contacts
+  BasePose base;                     // where the URDF's root sits (fixed or floating)
+  std::vector<Plane> planes;         // the world planes of `planes:`
+  std::vector<ContactFrame> contacts;  // one per contact row of E (ContactFrame::row)
 };
 Scene read_scene(const std::string& yaml_text, const std::string& source);
 // The scene in `path`, or nullopt when the file is a model, not a scene (no

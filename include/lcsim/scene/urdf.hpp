@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <Eigen/Geometry>
 #include <filesystem>
 #include <lcsim/io/input_error.hpp>
 #include <map>
@@ -25,8 +26,9 @@ using io::InputError;
 // masses >= 0; inertia tensors positive semi-definite with I1 + I2 >= I3
 // (refused, or repaired: UrdfRepairs); non-zero axes on revolute,
 // continuous and prismatic joints.
-// <visual>, <collision> and <material> are dropped unread (no geometry is
-// used). A <limit> with lower > upper is no limit; a scene refuses it only
+// <visual>, <collision> and <material> are dropped before urdfdom parses
+// (a scene reads the <collision> primitives its contacts use from the text
+// itself: docs/contacts.md). A <limit> with lower > upper is no limit; a scene refuses it only
 // where it would become a stop. InputError names the file, the element and
 // the value.
 std::shared_ptr<urdf::ModelInterface> load_urdf(const std::filesystem::path& path);
@@ -50,11 +52,28 @@ struct UrdfRepairs {
 std::shared_ptr<urdf::ModelInterface> parse_urdf(const std::string& xml, const std::string& source,
                                                  UrdfRepairs& repairs);
 
+// Where the URDF's root link sits in the world. Fixed: at `pose` (the
+// identity by default: the root frame is the world). Floating: the root
+// moves with six coordinates, named <name>.x, .y, .z (the root origin's
+// world position, m) and <name>.rx, .ry, .rz (a rotation vector r, rad, in
+// world axes, about the reference orientation: the root's orientation is
+// exp([r]x) R0), with the reference pose `pose` = (R0, p0) at q = (p0, 0).
+// Its angular velocity is J_l(r) r' (J_l the left Jacobian of SO(3), the
+// identity at r = 0), so the model is exact at every r and the linear model
+// about q0 uses r' as the angular velocity.
+struct BasePose {
+  bool floating = false;
+  std::string name;  // floating: prefix of the coordinate names
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+};
+// The six coordinate names of a floating base, none for a fixed one.
+std::vector<std::string> base_coordinates(const BasePose& base);
+
 // The rigid-body part of a scene linearised about a reference configuration.
 // Coordinates are the joint positions themselves (rad for revolute, m for
-// prismatic joints), in the order of `joints`.
+// prismatic joints), in the order of `joints`, after a floating base's six.
 struct UrdfLinearisation {
-  std::vector<std::string> joints;  // the simulated joints
+  std::vector<std::string> joints;  // the coordinates: a floating base's, then the joints
   MatrixXd M;        // joint-space mass matrix at q0 (composite-rigid-body algorithm)
   VectorXd tau_g;    // gravity generalised force at q0 (N or N m)
   MatrixXd K_g;      // gravity stiffness -d tau_g / dq at q0 (symmetric)
@@ -89,17 +108,26 @@ std::map<std::string, Mimic> mimic_joints(const urdf::ModelInterface& model,
 // its motion enters the Jacobian of every body below it, so its mass,
 // gravity and damping act through J. A simulated joint that is itself a
 // mimic is refused (InputError naming both joints). `model` must outlive
-// this object. Errors as linearise_urdf.
+// this object. Errors as linearise_urdf. With a floating `base`, q starts
+// with its six coordinates (BasePose) and joints() with their names; a
+// fixed base at a pose places the whole tree there (gravity stays in world
+// axes).
 class UrdfDynamics {
  public:
   UrdfDynamics(const urdf::ModelInterface& model, const std::vector<std::string>& joints,
                const std::map<std::string, double>& q0, const Eigen::Vector3d& gravity,
-               const std::string& source);
-  const std::vector<std::string>& joints() const { return joints_; }
-  VectorXd reference() const;                       // q0 of the simulated joints
+               const std::string& source, const BasePose& base = {});
+  const std::vector<std::string>& joints() const { return joints_; }  // every coordinate
+  VectorXd reference() const;  // q0 of the coordinates (a floating base at its pose: (p0, 0))
   MatrixXd mass_matrix(const VectorXd& q) const;    // M(q), composite-rigid-body algorithm
   VectorXd gravity_force(const VectorXd& q) const;  // tau_g(q) (N or N m)
   VectorXd damping() const;                         // diagonal of T' diag(<dynamics damping>) T
+  // World pose of link `link` at q; InputError for a link not in the URDF.
+  Eigen::Isometry3d link_pose(const std::string& link, const VectorXd& q) const;
+  // d(X_link(q) local)/dq (3 x N, world axes, m per coordinate unit): the
+  // world velocity of the link point `local` (link frame, m) is J q'.
+  Eigen::Matrix3Xd point_jacobian(const std::string& link, const Eigen::Vector3d& local,
+                                  const VectorXd& q) const;
   struct Impl;
 
  private:
@@ -115,6 +143,7 @@ class UrdfDynamics {
 UrdfLinearisation linearise_urdf(const urdf::ModelInterface& model,
                                  const std::vector<std::string>& joints,
                                  const std::map<std::string, double>& q0,
-                                 const Eigen::Vector3d& gravity, const std::string& source);
+                                 const Eigen::Vector3d& gravity, const std::string& source,
+                                 const BasePose& base = {});
 
 }  // namespace lcsim::scene

@@ -1,0 +1,143 @@
+// How far a scene's linear contact gaps hold: each contact's exact signed
+// distance against its row of E and g, along each coordinate alone
+// (declarations and definitions in lcsim/scene/linearisation.hpp).
+#include <urdf_model/model.h>
+
+#include <algorithm>
+#include <cmath>
+#include <lcsim/mech/tolerances.hpp>
+#include <lcsim/scene/linearisation.hpp>
+#include <limits>
+
+namespace lcsim::scene {
+
+namespace {
+
+// The farthest s in (0, end] with !exceeds(s) before the first crossing:
+// 64 steps, then 50 bisections (as linear_ranges). `crossed` says whether
+// the threshold was crossed.
+template <class F>
+double scan(const F& exceeds, double end, bool& crossed) {
+  constexpr int kSteps = 64, kBisections = 50;
+  double ok = 0.0, bad = -1.0;
+  for (int k = 1; k <= kSteps && bad < 0.0; ++k) {
+    const double s = k == kSteps ? end : end * k / kSteps;
+    (exceeds(s) ? bad : ok) = s;
+  }
+  for (int k = 0; k < kBisections && bad > 0.0; ++k) {
+    const double mid = 0.5 * (ok + bad);
+    (exceeds(mid) ? bad : ok) = mid;
+  }
+  crossed = bad > 0.0;
+  return ok;
+}
+
+struct Axis {
+  std::string unit;
+  double lower = 0.0, upper = 0.0;  // how far it may go each way (m or rad)
+  bool limit_lower = false, limit_upper = false;
+};
+
+// Coordinate i's unit and search extent: a floating base's position (m) or
+// rotation (rad); a joint's own, bounded by its limits where it has them.
+Axis axis_of(const Scene& s, std::size_t i, double q0) {
+  const std::size_t nb = base_coordinates(s.base).size();
+  Axis a;
+  const auto j = i < nb ? nullptr : s.urdf->getJoint(s.lin.joints[i]);
+  const bool metres = i < nb ? i < 3 : j->type == urdf::Joint::PRISMATIC;
+  a.unit = metres ? "m" : "rad";
+  a.lower = a.upper = metres ? 1.0 : M_PI;
+  if (j && j->limits && j->type != urdf::Joint::CONTINUOUS &&
+      j->limits->lower <= j->limits->upper) {
+    if (q0 - j->limits->lower >= 0.0) a.lower = q0 - j->limits->lower, a.limit_lower = true;
+    if (j->limits->upper - q0 >= 0.0) a.upper = j->limits->upper - q0, a.limit_upper = true;
+  }
+  return a;
+}
+
+// How far coordinate i can move either way (the smaller) before contact
+// c's linear gap is off by `threshold` of its change, and what ends it.
+struct Reach {
+  double distance = std::numeric_limits<double>::infinity();
+  std::string end = "search";
+};
+Reach reach_along(const UrdfDynamics& dyn, const ContactFrame& c, const Plane& plane,
+                  const VectorXd& q0, Eigen::Index i, const Axis& a, double threshold) {
+  Reach r;
+  for (const double dir : {-1.0, 1.0}) {
+    const auto exceeds = [&](double step) {
+      VectorXd q = q0;
+      q(i) += dir * step;
+      const double exact = signed_distance(dyn, c.point, plane, q) - c.gap;
+      const double linear = c.normal_row(i) * dir * step;
+      const double change = std::max(std::abs(exact), std::abs(linear));
+      return change > 0.0 && std::abs(exact - linear) > threshold * change;
+    };
+    bool crossed = false;
+    const double got = scan(exceeds, dir < 0 ? a.lower : a.upper, crossed);
+    if (got < r.distance) {
+      r.distance = got;
+      const bool limit = dir < 0 ? a.limit_lower : a.limit_upper;
+      r.end = crossed ? "threshold" : limit ? "limit" : "search";
+    }
+  }
+  return r;
+}
+
+}  // namespace
+
+std::vector<ContactRange> contact_ranges(const Scene& s, double threshold) {
+  check_linearisation_threshold(threshold);
+  const std::size_t nb = base_coordinates(s.base).size();
+  const std::vector<std::string> joints(s.lin.joints.begin() + static_cast<std::ptrdiff_t>(nb),
+                                        s.lin.joints.end());
+  const UrdfDynamics dyn(*s.urdf, joints, s.q0, s.gravity, s.urdf_source, s.base);
+  const VectorXd q0 = dyn.reference();
+  const mech::MechanicalModel& m = *s.model.mechanical;
+  const VectorXd gaps = m.E * q0 + m.g;
+  const VectorXd scale = mech::gap_scale(m.E, q0, m.g);
+  bool any_rad = false;
+  for (std::size_t i = 0; i < s.lin.joints.size(); ++i)
+    any_rad |= axis_of(s, i, q0(static_cast<Eigen::Index>(i))).unit == "rad";
+  std::vector<ContactRange> out;
+  for (const ContactFrame& c : s.contacts) {
+    const Plane& plane = *std::find_if(s.planes.begin(), s.planes.end(),
+                                       [&](const Plane& p) { return p.name == c.plane; });
+    ContactRange r;
+    r.contact = c.point.name;
+    r.plane = c.plane;
+    r.gap = gaps(c.row);
+    r.closed = mech::gap_is_zero(r.gap, scale(c.row));
+    r.range = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < s.lin.joints.size(); ++i) {
+      const auto ii = static_cast<Eigen::Index>(i);
+      const Axis a = axis_of(s, i, q0(ii));
+      if (any_rad && a.unit != "rad") continue;  // rotations bend the gap; report theirs
+      const Reach got = reach_along(dyn, c, plane, q0, ii, a, threshold);
+      if (got.distance < r.range || r.coordinate.empty()) {
+        r.coordinate = s.lin.joints[i];
+        r.unit = a.unit;
+        r.range = got.distance;
+        r.end = got.end;
+      }
+    }
+    out.push_back(r);
+  }
+  return out;
+}
+
+nlohmann::json to_json(const std::vector<ContactRange>& ranges) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const ContactRange& r : ranges)
+    a.push_back({{"contact", r.contact},
+                 {"plane", r.plane},
+                 {"gap", r.gap},
+                 {"closed", r.closed},
+                 {"coordinate", r.coordinate},
+                 {"unit", r.unit},
+                 {"range", r.range},
+                 {"end", r.end}});
+  return a;
+}
+
+}  // namespace lcsim::scene
