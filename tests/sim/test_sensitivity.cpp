@@ -116,11 +116,12 @@ struct Perturbation {
 };
 
 void expect_matches_fd(const mech::Model& m, const VectorXd& x0, double T,
-                       const std::vector<Perturbation>& ps, bool x0_columns) {
+                       const std::vector<Perturbation>& ps, bool x0_columns,
+                       const std::string& law = "moreau-restitution") {
   std::vector<std::string> names;
   if (x0_columns) names.push_back("x0");
   for (const auto& p : ps) names.push_back(p.column);
-  const sim::Trajectory tr = run(m, x0, T, names);
+  const sim::Trajectory tr = run(m, x0, T, names, law);
   ASSERT_TRUE(tr.ok()) << tr.message;
   if (!tr.sensitivity_losses.empty()) {
     const auto& l = tr.sensitivity_losses.front();
@@ -143,7 +144,7 @@ void expect_matches_fd(const mech::Model& m, const VectorXd& x0, double T,
         mech::Model mm = m;
         VectorXd xx = x0;
         all[c].apply(mm, xx, s == 0 ? h : -h);
-        const sim::Trajectory t2 = run(mm, xx, T);
+        const sim::Trajectory t2 = run(mm, xx, T, {}, law);
         EXPECT_TRUE(t2.ok()) << t2.message;
         EXPECT_EQ(t2.events.size(), tr.events.size()) << all[c].column << ": events differ";
         out[s] = t2.final_state;
@@ -222,6 +223,8 @@ TEST(Sensitivity, HookAgainstFiniteDifferences) {
       sparse_entry("M[0][1]", 'M', 0, 1, 1e-4),
   };
   expect_matches_fd(m, x0, 2.0, ps, true);
+  // Newton's law (its restitution outside the LCP: dv+/de = G E' lambda).
+  expect_matches_fd(m, x0, 2.0, ps, false, "newton");
 }
 
 // A URDF scene: the double pendulum swinging against its shoulder stop.
