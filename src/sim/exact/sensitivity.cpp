@@ -108,11 +108,20 @@ void Sensitivity::start(const VectorXd& xa) {
 // Acl's velocity rows are Q H and F_I = -W^{-1} E_I G H (eq. (3.65) with
 // the leading rows of order 2), so dQ = -Q dM Q and
 // dF_I = W^{-1} E_I G (dM Q H - dH).
+// Each parameter moves one or two entries of H or M, so its terms are
+// columns of Q and rows of Q H (O(N n) each, not products of N x N
+// matrices). Kept per mode: Acl, its balancing and these depend on the mode
+// only (frictionless models).
 void Sensitivity::mode_derivatives(const lcs::IndexSet& mode) {
   const int P = static_cast<int>(cols_.params.size());
   dAb_.assign(static_cast<size_t>(P), MatrixXd());
   dF_.assign(static_cast<size_t>(P), MatrixXd());
   if (!mech_ || P == 0) return;
+  if (const auto it = mode_cache_.find(mode); it != mode_cache_.end()) {
+    dAb_ = it->second.first;
+    dF_ = it->second.second;
+    return;
+  }
   const mech::MechanicalModel& m = *model_.mechanical;
   const int kI = static_cast<int>(mode.size());
   MatrixXd EI(kI, N_);
@@ -126,32 +135,52 @@ void Sensitivity::mode_derivatives(const lcs::IndexSet& mode) {
   }
   MatrixXd H(N_, n_);
   H << -dense(m.K), -dense(m.D), m.f;
+  const MatrixXd QH = Q * H;
   for (int p = 0; p < P; ++p) {
     const SensParam& sp = cols_.params[static_cast<size_t>(p)];
-    MatrixXd dH = MatrixXd::Zero(N_, n_), dM = MatrixXd::Zero(N_, N_);
-    if (sp.kind == 'f') dH(sp.i, n_ - 1) = 1.0;
-    if (sp.kind == 'K') dH(sp.i, sp.j) = -1.0;
-    if (sp.kind == 'D') dH(sp.i, N_ + sp.j) = -1.0;
-    if (sp.kind == 'M') dM(sp.i, sp.j) = dM(sp.j, sp.i) = 1.0;
-    const MatrixXd QH = Q * H;
+    // dH has one entry -1 (K, D) or +1 (f) at (i, col); dM is the unit
+    // entry (i, j) and its mirror.
+    MatrixXd dAv = MatrixXd::Zero(N_, n_), dF = MatrixXd::Zero(kI, n_);
+    if (sp.kind == 'M') {
+      dAv -= Q.col(sp.i) * QH.row(sp.j);
+      dF += WinvEG.col(sp.i) * QH.row(sp.j);
+      if (sp.i != sp.j) {
+        dAv -= Q.col(sp.j) * QH.row(sp.i);
+        dF += WinvEG.col(sp.j) * QH.row(sp.i);
+      }
+    } else {
+      const int col = sp.kind == 'f' ? n_ - 1 : sp.kind == 'K' ? sp.j : N_ + sp.j;
+      const double sign = sp.kind == 'f' ? 1.0 : -1.0;
+      if (sp.kind == 'f' || sp.kind == 'K' || sp.kind == 'D') {
+        dAv.col(col) = sign * Q.col(sp.i);
+        dF.col(col) = -sign * WinvEG.col(sp.i);
+      }
+    }
     MatrixXd dA = MatrixXd::Zero(n_, n_);
-    dA.middleRows(N_, N_) = Q * dH - Q * dM * QH;
+    dA.middleRows(N_, N_) = dAv;
     dAb_[static_cast<size_t>(p)] = D_.cwiseInverse().asDiagonal() * dA * D_.asDiagonal();
-    dF_[static_cast<size_t>(p)] = WinvEG * (dM * QH - dH);
+    dF_[static_cast<size_t>(p)] = dF;
   }
+  mode_cache_.emplace(mode, std::make_pair(dAb_, dF_));
 }
 
 void Sensitivity::begin_phase(const Phase& ph, double t0, const VectorXd& xa, const MatrixXd& S) {
   Acl_ = ph.Acl;
   Ab_ = ph.Ab;
+  use_sparse_ = ph.use_sparse;
+  if (use_sparse_) Ab_sparse_ = ph.Ab_sparse;
   D_ = ph.D;
   mode_ = ph.mode;
   monitors_ = ph.monitors;
   for (Monitor& mon : monitors_) mon.w = mon.w.cwiseQuotient(ph.D.transpose());
-  mode_derivatives(ph.mode);
+  if (std::any_of(exists_.begin(), exists_.end(), [](char e) { return e != 0; }))
+    mode_derivatives(ph.mode);
+  else
+    dAb_.clear(), dF_.assign(cols_.params.size(), MatrixXd());  // at() carries nothing
   norm1_ = Ab_.cwiseAbs().colwise().sum().maxCoeff();
   double dnorm = 0.0;
-  for (const MatrixXd& d : dAb_) dnorm = std::max(dnorm, d.cwiseAbs().colwise().sum().maxCoeff());
+  for (const MatrixXd& d : dAb_)
+    if (d.size() > 0) dnorm = std::max(dnorm, d.cwiseAbs().colwise().sum().maxCoeff());
   norm1_ += dnorm;
   t0_ = tc_ = t0;
   x0_ = xa;
@@ -173,6 +202,10 @@ const MatrixXd& Sensitivity::at(double t) {
   }
   const double tau = t - tc_;
   if (tau == 0.0 || Acl_.size() == 0) return Sc_;
+  if (std::none_of(exists_.begin(), exists_.end(), [](char e) { return e != 0; })) {
+    tc_ = t;  // every column absent: nothing to carry (Sc_ is zero)
+    return Sc_;
+  }
   const int P = static_cast<int>(cols_.params.size());
   const long steps = std::max(1L, static_cast<long>(std::ceil(norm1_ * tau)));
   const double dt = tau / static_cast<double>(steps);
@@ -184,10 +217,10 @@ const MatrixXd& Sensitivity::at(double t) {
     double prev = std::max(tS.cwiseAbs().maxCoeff(), tz.cwiseAbs().maxCoeff());
     for (int k = 1; k <= 80; ++k) {
       const double c = dt / static_cast<double>(k);
-      MatrixXd nS = Ab_ * tS;
+      MatrixXd nS = use_sparse_ ? MatrixXd(Ab_sparse_ * tS) : MatrixXd(Ab_ * tS);
       for (int p = 0; p < P; ++p) nS.col(nx0_ + p) += dAb_[static_cast<size_t>(p)] * tz;
       tS = nS * c;
-      tz = (Ab_ * tz) * c;
+      tz = (use_sparse_ ? VectorXd(Ab_sparse_ * tz) : VectorXd(Ab_ * tz)) * c;
       sumS += tS;
       sumz += tz;
       const double cur = std::max(tS.cwiseAbs().maxCoeff(), tz.cwiseAbs().maxCoeff());

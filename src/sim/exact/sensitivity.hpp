@@ -9,7 +9,9 @@
 
 #include <Eigen/Dense>
 #include <lcsim/sim/sim.hpp>
+#include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sim/exact/event_driven_detail.hpp"
@@ -92,6 +94,9 @@ class Sensitivity {
   MatrixXd S0_;
   VectorXd x0_;
   MatrixXd Acl_, Ab_;
+  Eigen::SparseMatrix<double, Eigen::RowMajor> Ab_sparse_;  // when the phase uses it
+  bool use_sparse_ = false;
+  std::map<lcs::IndexSet, std::pair<std::vector<MatrixXd>, std::vector<MatrixXd>>> mode_cache_;
   VectorXd D_;
   double norm1_ = 0.0;
   std::vector<MatrixXd> dAb_;  // balanced dAcl/dtheta per parameter
