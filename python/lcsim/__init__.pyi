@@ -76,6 +76,7 @@ class Event:
     note: str
     friction_impulse: np.ndarray  # per frictional contact (empty without friction)
     friction_modes: list[str]  # 'open', 'stick', 'slip+' or 'slip-' after the event
+    dt: list[Optional[float]]  # d t_event / d sensitivity column, None where absent
 
 class Trajectory:
     """The result of simulate: samples as numpy arrays, events, status, diagnostics."""
@@ -108,6 +109,11 @@ class Trajectory:
     events_not_recorded: int
     wall_time_s: float
     model: Model
+    # Forward sensitivities (simulate(..., sensitivity=[...]), docs/sensitivities.md):
+    sensitivity_columns: list[str]
+    dx_dx0: Optional[np.ma.MaskedArray]  # (n, state, state), None unless 'x0' was asked
+    dx_dp: dict[str, np.ma.MaskedArray]  # name as asked -> (n, state)
+    sensitivity_losses: list[dict[str, Any]]  # {t, contact, reason, columns}
     def to_csv(self, path: Optional[Path] = None) -> Optional[str]: ...
     def to_json(self, path: Optional[Path] = None) -> Optional[str]: ...
 
@@ -141,7 +147,8 @@ def simulate(model: Model, x0: Optional[ArrayLike] = None, t_end: Optional[float
              impact: Optional[str] = None, dt_out: float = 0.0,
              lcp_solver: Optional[str] = None, force: bool = False,
              max_output: Optional[float] = None,
-             progress: Optional[Callable[[float], Any]] = None) -> Trajectory: ...
+             progress: Optional[Callable[[float], Any]] = None,
+             sensitivity: Iterable[str] = ()) -> Trajectory: ...
 def impacts(model: Model, x0: Optional[ArrayLike] = None,
             rules: Optional[Iterable[str]] = None,
             restitution: Optional[ArrayLike] = None) -> dict[str, ImpactResult]: ...

@@ -28,7 +28,11 @@ struct SampleBuffers {
   // n x frictional contacts: sim::FrictionMode's value, kNoFrictionMode where
   // the sample records none.
   std::vector<std::int8_t> friction_mode;
-  py::ssize_t nx = 0, k = 0, nf = 0;
+  // Forward sensitivities (Options::sensitivity): n x state x columns, and
+  // n x columns with 1 where the column's derivative exists.
+  std::vector<double> dx;
+  std::vector<std::uint8_t> dx_ok;
+  py::ssize_t nx = 0, k = 0, nf = 0, nc = 0;
   explicit SampleBuffers(const mech::Model& m)
       : nx(m.state_size()),
         k(m.num_constraints()),
@@ -59,6 +63,12 @@ struct SampleBuffers {
                                     ? static_cast<std::int8_t>(s.friction_mode[j])
                                     : kNoFrictionMode);
     }
+    if (s.dx.size() > 0) {
+      nc = s.dx.cols();
+      for (Eigen::Index r = 0; r < s.dx.rows(); ++r)
+        for (Eigen::Index c = 0; c < s.dx.cols(); ++c) dx.push_back(s.dx(r, c));
+      for (char ok : s.dx_exists) dx_ok.push_back(ok ? 1 : 0);
+    }
     active.resize(t.size() * static_cast<std::size_t>(k), 0);
     for (int i : s.mode)
       if (i >= 0 && i < k) active[(t.size() - 1) * static_cast<std::size_t>(k) + i] = 1;
@@ -76,6 +86,8 @@ struct Run {
   py::array_t<double> u_t;                  // tangential multipliers, n x frictional contacts
   py::array_t<std::int8_t> friction_modes;  // n x frictional contacts (SampleBuffers)
   py::array modes;                          // bool, n x k
+  py::array_t<double> dx;                   // n x state x columns (SampleBuffers)
+  py::array_t<std::uint8_t> dx_ok;          // n x columns
 
   // The run as the library gives it, samples included (for the writers).
   sim::Sample sample(py::ssize_t i) const {
@@ -115,7 +127,8 @@ std::shared_ptr<Run> simulate(const ModelHandle& model, const std::optional<Vect
                               std::optional<double> h, std::optional<double> theta,
                               std::optional<std::string> impact, double dt_out,
                               std::optional<std::string> lcp_solver, bool force,
-                              std::optional<double> max_output, const py::object& progress) {
+                              std::optional<double> max_output, const py::object& progress,
+                              const std::vector<std::string>& sensitivity) {
   app::RunRequest req;
   req.method = method;
   req.x0 = x0;  // unset: the model's
@@ -128,6 +141,7 @@ std::shared_ptr<Run> simulate(const ModelHandle& model, const std::optional<Vect
   if (lcp_solver) opt.lcp_solver = *lcp_solver;
   if (max_output) opt.max_output_bytes = *max_output;
   opt.force = force;
+  opt.sensitivity = sensitivity;
   SampleBuffers buf(model->model);
   // Room for the output grid's samples (plus a few for events), so that a
   // run's buffers are allocated once rather than grown: up to 64 MB, beyond
@@ -168,6 +182,14 @@ std::shared_ptr<Run> simulate(const ModelHandle& model, const std::optional<Vect
   run->friction_modes = numpy_owning(std::move(buf.friction_mode), {n, buf.nf});
   run->modes =
       numpy_owning(std::move(buf.active), {n, buf.k}).attr("view")("bool").cast<py::array>();
+  const py::ssize_t nc = static_cast<py::ssize_t>(run->traj.sensitivity_columns.size());
+  // Every sample carries dx when sensitivities were computed (else none).
+  const bool have = nc > 0 && buf.dx.size() == static_cast<std::size_t>(n * buf.nx * nc) &&
+                    buf.dx_ok.size() == static_cast<std::size_t>(n * nc);
+  if (!have) buf.dx.clear(), buf.dx_ok.clear();
+  const py::ssize_t rows = have ? n : 0;
+  run->dx = numpy_owning(std::move(buf.dx), {rows, buf.nx, nc});
+  run->dx_ok = numpy_owning(std::move(buf.dx_ok), {rows, nc});
   return run;
 }
 
@@ -194,6 +216,16 @@ void bind_event(py::module_& m) {
         return out;
       },
       "Mode per frictional contact after the event: 'open', 'stick', 'slip+' or 'slip-'.");
+  e.def_property_readonly(
+      "dt",
+      [](const sim::Event& ev) {
+        py::list out;
+        for (Eigen::Index c = 0; c < ev.dt.size(); ++c)
+          out.append(ev.dt_exists[static_cast<std::size_t>(c)] ? py::cast(ev.dt(c)) : py::none());
+        return out;
+      },
+      "d t_event / d column of Trajectory.sensitivity_columns (s per unit), None where it "
+      "does not exist; empty without sensitivities.");
   e.def("__repr__", [](const sim::Event& ev) {
     return "<lcsim.Event " + std::string(sim::to_string(ev.type)) +
            " at t = " + std::to_string(ev.t) + ">";
@@ -218,6 +250,62 @@ void bind_samples(RunClass& r) {
   r.def_readonly("y", &Run::y, "Gaps / outputs, shape (n, constraints); NaN where not recorded.");
   r.def_readonly("modes", &Run::modes,
                  "Modes, shape (n, constraints), bool: True where a constraint is active.");
+}
+
+// Column c of the sensitivities as a masked array (masked where it does not
+// exist): shape (n, state) for one column, (n, state, count) for `count`.
+py::object masked_columns(const Run& run, py::ssize_t c, py::ssize_t count, bool squeeze) {
+  py::object np = py::module_::import("numpy");
+  py::slice cols(c, c + count, 1);
+  py::object data = run.dx[py::make_tuple(py::ellipsis(), cols)];
+  py::object ok = run.dx_ok[py::make_tuple(py::slice(0, run.dx_ok.shape(0), 1), py::none(), cols)];
+  py::object mask = np.attr("broadcast_to")(np.attr("logical_not")(ok), data.attr("shape"));
+  py::object out = py::module_::import("numpy.ma")
+                       .attr("masked_array")(data, py::arg("mask") = mask.attr("copy")());
+  return squeeze ? out[py::make_tuple(py::ellipsis(), 0)] : out;
+}
+
+// Forward sensitivities (simulate(..., sensitivity=[...])).
+void bind_sensitivities(RunClass& r) {
+  r.def_property_readonly(
+      "sensitivity_columns", [](const Run& run) { return run.traj.sensitivity_columns; },
+      "The sensitivity columns: x0[i] per initial-state entry, then the parameters asked.");
+  r.def_property_readonly(
+      "dx_dx0",
+      [](const Run& run) -> py::object {
+        const auto& cols = run.traj.sensitivity_columns;
+        if (cols.empty() || cols.front() != "x0[0]") return py::none();
+        return masked_columns(run, 0, run.x.shape(1), false);
+      },
+      "dx(t)/dx0 at each sample, numpy.ma masked array of shape (n, state, state) "
+      "(sample, entry of x, entry of x0), masked where the derivative does not exist; "
+      "None unless 'x0' was asked.");
+  r.def_property_readonly(
+      "dx_dp",
+      [](const Run& run) {
+        py::dict out;
+        const auto& cols = run.traj.sensitivity_columns;
+        for (std::size_t c = 0; c < cols.size(); ++c)
+          if (cols[c].rfind("x0[", 0) != 0)
+            out[py::str(cols[c])] = masked_columns(run, static_cast<py::ssize_t>(c), 1, true);
+        return out;
+      },
+      "dx(t)/dp per parameter asked (its name as asked, 'e[stop]'): numpy.ma masked arrays "
+      "of shape (n, state), masked where the derivative does not exist.");
+  r.def_property_readonly(
+      "sensitivity_losses",
+      [](const Run& run) {
+        py::list out;
+        for (const auto& l : run.traj.sensitivity_losses) {
+          py::list cols;
+          for (int c : l.columns)
+            cols.append(run.traj.sensitivity_columns[static_cast<std::size_t>(c)]);
+          out.append(py::dict(py::arg("t") = l.t, py::arg("contact") = l.contact,
+                              py::arg("reason") = l.reason, py::arg("columns") = cols));
+        }
+        return out;
+      },
+      "Where derivatives stop existing: dicts with t, contact, reason and the columns ended.");
 }
 
 // Trajectory's events, status and diagnostics: the library's sim::Trajectory.
@@ -314,17 +402,20 @@ is a status ('numerical failure', 'event limit', ...) with a message, not an exc
   bind_samples(r);
   bind_summary(r);
   bind_writers(r);
+  bind_sensitivities(r);
   m.def("simulate", &simulate, py::arg("model"), py::arg("x0") = py::none(),
         py::arg("t_end") = py::none(), py::arg("method") = "event", py::arg("h") = py::none(),
         py::arg("theta") = py::none(), py::arg("impact") = py::none(), py::arg("dt_out") = 0.0,
         py::arg("lcp_solver") = py::none(), py::arg("force") = false,
         py::arg("max_output") = py::none(), py::arg("progress") = py::none(),
+        py::arg("sensitivity") = std::vector<std::string>{},
         R"(Simulates `model` from x0 (default: the model's initial state) to t_end (default:
 the model's) with `method` (lcsim.integrator_names()). Unset options keep the library's
 defaults; an option the method does not read is refused. dt_out is the output grid (0:
 events, start and end only). `progress(t)` is called as the run goes. The GIL is
 released during the run. Raises InputError for invalid input; numerical trouble is
-the returned trajectory's status.)");
+the returned trajectory's status. `sensitivity` (method 'event'): 'x0' and parameter
+names ('f[1]', 'e[stop]', docs/sensitivities.md) give run.dx_dx0 and run.dx_dp.)");
 }
 
 }  // namespace lcsim::python

@@ -6,6 +6,7 @@
 #include <lcsim/impact/impact.hpp>
 #include <lcsim/io/csv.hpp>
 #include <lcsim/io/json.hpp>
+#include <lcsim/io/sensitivity.hpp>
 #include <utility>
 #include <vector>
 
@@ -22,7 +23,8 @@ bool checks_linearisation(const scene::LoadedModel& loaded, const RunRequest& r)
 // points unless an output grid was asked for.
 sim::Options run_options(const scene::LoadedModel& loaded, const RunRequest& r) {
   sim::Options opt = r.options;
-  const bool asked = !r.csv_path.empty() || r.sample_sink || r.keep_samples;
+  const bool asked =
+      !r.csv_path.empty() || r.sample_sink || r.keep_samples || !r.sensitivity_csv_path.empty();
   const bool check = checks_linearisation(loaded, r);
   opt.record_samples = asked || check;
   const double horizon = opt.t_end.value_or(loaded.model.t_end);
@@ -35,6 +37,7 @@ sim::Options run_options(const scene::LoadedModel& loaded, const RunRequest& r) 
 // the CSV, the caller's sink, the kept samples and the visited states.
 struct SampleRoute {
   std::optional<io::TrajectoryCsvWriter> csv;
+  std::optional<io::SensitivityCsvWriter> sensitivity_csv;
   std::function<void(const sim::Sample&)> caller;
   std::vector<sim::Sample> kept;
   bool keep = false, visit = false;
@@ -43,9 +46,12 @@ struct SampleRoute {
   SampleRoute(const scene::LoadedModel& loaded, const RunRequest& r)
       : caller(r.sample_sink), keep(r.keep_samples), visit(checks_linearisation(loaded, r)) {
     if (!r.csv_path.empty()) csv.emplace(r.csv_path, loaded.model);  // fails now, not after
+    if (!r.sensitivity_csv_path.empty())
+      sensitivity_csv.emplace(r.sensitivity_csv_path, loaded.model);
   }
   void add(const sim::Sample& s) {
     if (csv) csv->write(s);
+    if (sensitivity_csv) sensitivity_csv->write(s);
     if (caller) caller(s);
     if (visit) visited.add(s.x);
     if (keep) kept.push_back(s);
@@ -69,6 +75,8 @@ void finish(const scene::LoadedModel& loaded, const RunRequest& r, const sim::Op
     route.csv->commit();
     out.csv_written = true;
   }
+  if (tr.status == sim::RunStatus::kCompleted && route.sensitivity_csv)
+    route.sensitivity_csv->commit(tr.sensitivity_columns);
   if (route.visit) {
     out.linearisation = scene::check_linearisation(*loaded.scene, route.visited.states());
     out.linearisation_warning =
@@ -102,6 +110,8 @@ nlohmann::json run_json(const mech::Model& model, const sim::Trajectory& traject
   const auto& lin = linearisation;
   j["linearisation_error"] = lin ? nlohmann::json(lin->error) : nlohmann::json(nullptr);
   j["linearisation_check"] = lin ? scene::to_json(*lin) : nlohmann::json(nullptr);
+  if (!trajectory.sensitivity_columns.empty())
+    j["sensitivity"] = io::sensitivity_json(model, trajectory);
   return j;
 }
 

@@ -1,6 +1,7 @@
 // `lcsim simulate MODEL`: run an integrator on a model and report the run.
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <lcsim/app/run.hpp>
 #include <lcsim/core/format.hpp>
@@ -41,6 +42,7 @@ struct SimulateArgs {
   std::optional<double> max_output;  // bytes
   bool force = false;                // backward Euler despite the consistency guard
   bool project = false;              // move an infeasible q0 onto E q + g >= 0 first
+  std::string sensitivity;           // --sensitivity x0,f[1],e[stop] (Options::sensitivity)
   bool progress = false;     // --progress: progress lines on stderr even when not a terminal
   bool no_progress = false;  // --no-progress
   double linearisation_threshold = scene::kLinearisationThreshold;  // scenes: warn above it
@@ -59,6 +61,12 @@ std::string fmt_set(const mech::Model& model, const std::vector<int>& s) {
   return r + "}";
 }
 
+// Beside the trajectory's CSV: "run.csv" -> "run.sensitivity.csv".
+std::string sensitivity_csv_path(const std::string& out) {
+  const std::filesystem::path p(out);
+  return (p.parent_path() / (p.stem().string() + ".sensitivity.csv")).string();
+}
+
 sim::Options run_options(const SimulateArgs& a, const mech::Model& model) {
   sim::Options opt;
   opt.t_end = resolve_horizon(model, a.model, a.t_end_given, a.t_end);
@@ -70,6 +78,12 @@ sim::Options run_options(const SimulateArgs& a, const mech::Model& model) {
   if (a.lcp) opt.lcp_solver = *a.lcp;
   if (a.max_output) opt.max_output_bytes = *a.max_output;
   opt.force = a.force;
+  for (size_t p = 0; !a.sensitivity.empty() && p != std::string::npos;) {
+    const size_t comma = a.sensitivity.find(',', p);
+    opt.sensitivity.push_back(
+        a.sensitivity.substr(p, comma == std::string::npos ? comma : comma - p));
+    p = comma == std::string::npos ? comma : comma + 1;
+  }
   return opt;
 }
 
@@ -110,6 +124,14 @@ void project_start(const mech::Model& model, Eigen::VectorXd& x0) {
             << "(kinetic-metric distance " << moved << ")\n";
 }
 
+// Where the run's sensitivities stopped existing, and their CSV.
+void print_sensitivity(const sim::Trajectory& tr, const std::string& csv) {
+  for (const auto& l : tr.sensitivity_losses)
+    std::printf("sensitivity: no derivative from t = %.15g (%s%s%s)\n", l.t, l.contact.c_str(),
+                l.contact.empty() ? "" : ": ", l.reason.c_str());
+  if (!csv.empty()) std::printf("sensitivities written to %s\n", csv.c_str());
+}
+
 void run_simulate(const SimulateArgs& a) {
   try {  // checked first, before the model is read
     scene::check_linearisation_threshold(a.linearisation_threshold);
@@ -127,6 +149,8 @@ void run_simulate(const SimulateArgs& a) {
   if (a.project) project_start(model, *req.x0);
   req.options = run_options(a, model);
   req.csv_path = a.out;
+  if (!a.out.empty() && !a.sensitivity.empty())
+    req.sensitivity_csv_path = sensitivity_csv_path(a.out);
   req.linearisation_threshold = a.linearisation_threshold;
   std::optional<ProgressLine> progress;  // started with the run, once --out is open
   req.on_start = [&progress, &a, t_end = *req.options.t_end] {
@@ -149,6 +173,7 @@ void run_simulate(const SimulateArgs& a) {
     std::cout << app::run_json(model, tr, run.linearisation).dump(2) << "\n";
   else
     print_summary(a, model, tr, run.linearisation, run.csv_written);
+  if (!a.json) print_sensitivity(tr, run.csv_written ? req.sensitivity_csv_path : "");
   if (!run.linearisation_warning.empty())
     std::cerr << "lcsim: warning: " << run.linearisation_warning << "\n";
   print_warnings(tr);
@@ -185,6 +210,10 @@ void setup(CLI::App& app) {
                   "default " +
                       sim::short_number(defaults.max_output_bytes));
   cmd->add_flag("--json", a->json, "Print the run summary as JSON");
+  cmd->add_option("--sensitivity", a->sensitivity,
+                  "Forward sensitivities of the exact method, comma-separated: x0, f[i], g[c], "
+                  "e[c], K[i][j], D[i][j], M[i][j] (docs/sensitivities.md); in --json, and with "
+                  "--out in <out>.sensitivity.csv");
   cmd->add_option("--linearisation-threshold", a->linearisation_threshold,
                   "Scenes: warn when the linear model is off by more than this (relative; "
                   "default " +

@@ -11,6 +11,8 @@ namespace {
 // --t-end or from the model file's t_end, and the message cannot tell which.
 constexpr FieldFlag kSimulateFlags[] = {
     {"Options::max_output_bytes", "--max-output"},
+    {"Options::sensitivity", "--sensitivity"},
+    {"sensitivity", "--sensitivity"},
     {"Options::lcp_solver", "--lcp"},
     {"Options::dt_out", "--dt-out"},
     {"Options::impact", "--impact"},

@@ -153,6 +153,7 @@ Options keep_used(const Options& opt, const OptionsUsed& used) {
   visit_method_options(used, [&](bool u, auto member, const char*) {
     if (!u) out.*member = defaults.*member;
   });
+  if (!used.sensitivity) out.sensitivity.clear();
   return out;
 }
 
@@ -182,6 +183,7 @@ std::string check_run(const mech::Model& model, const VectorXd& x0, const Option
   if (std::string m = check_values(opt, used); !m.empty()) return m;
   if (std::string m = refuse_friction_law(model, opt, used); !m.empty()) return m;
   if (std::string m = ignored_options(opt, method, used); !m.empty()) return m;
+  if (std::string m = check_sensitivity(model, opt, method, used); !m.empty()) return m;
   if (std::string m = infeasible_start(model, x0); !m.empty()) return m;
   return check_output_size(model, opt, used);
 }

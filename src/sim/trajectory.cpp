@@ -108,7 +108,8 @@ class EventDrivenIntegrator : public Integrator {
   OptionsUsed options_used() const override {
     OptionsUsed u;
     u.impact = u.lcp_solver = u.event_search = u.dense_lcs = true;
-    u.friction = true;  // stick / slip modes (friction_phase.cpp, friction_modes.cpp)
+    u.friction = true;     // stick / slip modes (friction_phase.cpp, friction_modes.cpp)
+    u.sensitivity = true;  // forward sensitivities (sensitivity.cpp)
     return u;
   }
   Trajectory integrate(const mech::Model& model, const VectorXd& x0,

@@ -34,7 +34,8 @@ struct RunRequest {
   // and sample_sink, which run_model sets, and dt_out (see run_model).
   sim::Options options;
   // Where the samples go, any of:
-  std::string csv_path;                                 // "" = none (io::TrajectoryCsvWriter)
+  std::string csv_path;              // "" = none (io::TrajectoryCsvWriter)
+  std::string sensitivity_csv_path;  // "" = none; the samples' dx (io::SensitivityCsvWriter)
   std::function<void(const sim::Sample&)> sample_sink;  // the caller's own (must not throw)
   bool keep_samples = false;                            // in the returned trajectory
   // A scene's run checks its linear model at the visited states
@@ -68,7 +69,8 @@ ModelRun run_model(const scene::LoadedModel& loaded, const RunRequest& request);
 
 // What `lcsim simulate --json` prints (less its final newline):
 // io::trajectory_json with linearisation_error and linearisation_check (null
-// when the run was not checked).
+// when the run was not checked), and "sensitivity" (io::sensitivity_json)
+// when the run computed sensitivities.
 nlohmann::json run_json(const mech::Model& model, const sim::Trajectory& trajectory,
                         const std::optional<scene::LinearisationCheck>& linearisation);
 

@@ -10,5 +10,6 @@
 #include <lcsim/io/json.hpp>
 #include <lcsim/io/lcp_file.hpp>
 #include <lcsim/io/model_file.hpp>
+#include <lcsim/io/sensitivity.hpp>
 #include <lcsim/io/text.hpp>
 #include <lcsim/io/yaml.hpp>

@@ -48,6 +48,14 @@ struct Sample {
   // The mode of each entry of mechanical.friction, in its order; empty for
   // frictionless models and for methods that do not determine it.
   std::vector<FrictionMode> friction_mode;
+  // Forward sensitivities (Options::sensitivity; both empty otherwise,
+  // docs/sensitivities.md): dx(:, c) = dx/dtheta_c, the derivative of x with
+  // respect to column c of Trajectory::sensitivity_columns (rows as x; units
+  // of x per unit of the column's quantity), and dx_exists[c] = 1 when that
+  // derivative exists here, 0 when it does not (its entries are then 0 and
+  // are not a value: Trajectory::sensitivity_losses says why).
+  Eigen::MatrixXd dx;
+  std::vector<char> dx_exists;
 };
 
 struct Event {
@@ -65,6 +73,22 @@ struct Event {
   // extrapolated; for a kStick / kSlip event, each contact whose mode
   // changed ("'floor': slip+ -> stick"). Empty otherwise.
   std::string note;
+  // Forward sensitivities (Options::sensitivity; empty otherwise): dt(c) =
+  // dt_event/dtheta_c (s per unit of column c), dt_exists[c] as
+  // Sample::dx_exists. An event at t = 0 has dt = 0 (its time is fixed).
+  Eigen::RowVectorXd dt;
+  std::vector<char> dt_exists;
+};
+
+// Where a forward sensitivity stops existing (docs/sensitivities.md): the
+// time t (s), the constraint involved (its name, "" if none), why ("grazing
+// contact", ...), and the columns of Trajectory::sensitivity_columns that it
+// ends (from t on, dx_exists is 0 for them).
+struct SensitivityLoss {
+  double t = 0.0;
+  std::string contact;
+  std::string reason;
+  std::vector<int> columns;
 };
 
 struct Options;
@@ -98,6 +122,14 @@ struct Trajectory : Outcome {
   // ("the URDF's nonlinear multibody (Bullet)"): its error against an exact
   // run of the model has that difference as a floor.
   std::string dynamics;
+  // Forward sensitivities (Options::sensitivity; all empty otherwise): the
+  // columns, "x0[i]" for each entry i of the initial state then each named
+  // parameter as asked ("f[1]", "e[stop]"); dx/dtheta at t_end (state size x
+  // columns) with its dx_exists; and where derivatives stopped existing.
+  std::vector<std::string> sensitivity_columns;
+  Eigen::MatrixXd dx_final;
+  std::vector<char> dx_final_exists;
+  std::vector<SensitivityLoss> sensitivity_losses;
   // Hands a recorded sample to opt.sample_sink when set (it is then not
   // kept), else appends it to samples.
   void record_sample(Sample s, const Options& opt);
@@ -175,6 +207,15 @@ struct Options {
   // Gauss–Seidel on the sparse Delassus matrix, warm-started from the
   // previous step's impulses.
   int pivot_max_active = 32;
+  // Forward sensitivities of the exact method (docs/sensitivities.md): "x0"
+  // (every entry of the initial state) and named parameters of a
+  // frictionless mechanical model: "f[i]", "g[c]", "e[c]", "K[i][j]",
+  // "D[i][j]", "M[i][j]" (i, j a coordinate's index or name, c a
+  // constraint's; M[i][j] moves M(i,j) and M(j,i) together). Empty: none
+  // (the run is unchanged). Refused (kInvalidInput) by methods other than
+  // "event", for models with friction and impact laws whose map is not
+  // differentiable at a fixed active set (check_sensitivity).
+  std::vector<std::string> sensitivity;
 };
 
 // What a method reads from Options besides what every method reads (t_end,
@@ -197,7 +238,15 @@ struct OptionsUsed {
   // The method handles mechanical.friction (planar Coulomb, issue 17); a
   // method without it refuses a model with friction (check_run).
   bool friction = false;
+  // The method computes Options::sensitivity (the exact method).
+  bool sensitivity = false;
 };
+
+// "" when `opt.sensitivity` is empty or asks what the model and the method
+// (`used`, its impact law opt.impact) can give; else one line naming the
+// entry and why (src/sim/exact/sensitivity_names.cpp).
+std::string check_sensitivity(const mech::Model& model, const Options& opt, std::string_view method,
+                              const OptionsUsed& used);
 
 class Integrator {
  public:

@@ -33,6 +33,7 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "sim/exact/event_driven_detail.hpp"
+#include "sim/exact/sensitivity.hpp"
 
 namespace lcsim::sim {
 
@@ -108,6 +109,7 @@ void EventDriven::record(Trajectory& tr, double t, const VectorXd& xa, const Pha
   s.y = sys_.C * xa + sys_.D * s.u;
   s.mode = ph.mode;
   fill_friction(s, ph, xa);
+  if (sens_) sens_->fill(t, s.dx, s.dx_exists);
   tr.record_sample(std::move(s), opt_);
 }
 
@@ -156,7 +158,9 @@ bool EventDriven::start_run(RunState& r, const VectorXd& x0_user) {
     tr.energy_final = tr.energy_initial;
     return false;
   }
+  if (sens_) sens_->start(r.xa);
   if (ev.jumped) record_initial_jump(r, ev);
+  if (sens_) sens_->after_event(ev, r.phase, r.t, ev.x_plus, {}, -1);
   r.xa = ev.x_plus;
   record(tr, r.t, r.xa, r.phase);
   return true;
@@ -178,6 +182,7 @@ void EventDriven::record_initial_jump(RunState& r, const EventResult& ev) const 
   e.mode_after = ev.mode;
   e.impulse = ev.impulse;
   set_friction(e, ev);
+  if (sens_) sens_->fill_event(e);
   r.tr.events.push_back(std::move(e));
 }
 
@@ -196,6 +201,7 @@ bool EventDriven::next_phase(RunState& r, LivelockGuard& livelock) {
   PhaseMarch pm(phase, r.t, r.xa, opt_.dt_out,
                 [this, &phase]() -> StepExp& { return step_exp(phase, opt_.dt_out); });
   pm.start = monitor_start(phase, pm.xstart, r.t, h_max);
+  if (sens_) sens_->check_phase_start(phase, r.t, pm.start.m0, ldcp_undetermined_);
   const double h_first = std::max(pm.start.h_first, 1e-15 * std::max(1.0, std::abs(r.t)));
   arm_monitors(pm);
   march_phase(pm, h_first, h_max, r.tr);
@@ -260,6 +266,7 @@ bool EventDriven::take_event(RunState& r, PhaseMarch& pm, LivelockGuard& liveloc
   // pm refers to r.phase, which reinitialise replaces: not used below.
   const lcs::IndexSet old_mode = r.phase.mode;
   const std::vector<FrictionMode> old_friction = r.phase.friction;
+  if (sens_) sens_->before_event(r.t, x_minus, pm.trigger_monitor);
   EventResult ev;
   if (zeno_guard(r, events_seen) || !reinitialise(r, x_minus, ev)) {
     r.xa = x_minus;
@@ -272,6 +279,7 @@ bool EventDriven::take_event(RunState& r, PhaseMarch& pm, LivelockGuard& liveloc
     tr.status = RunStatus::kEventLimit;
     return false;
   }
+  if (sens_) sens_->after_event(ev, r.phase, r.t, r.xa, old_mode, trigger);
   Event e;
   e.t = r.t;
   e.state_before = user(x_minus);
@@ -280,7 +288,9 @@ bool EventDriven::take_event(RunState& r, PhaseMarch& pm, LivelockGuard& liveloc
   e.impulse = ev.impulse;
   set_friction(e, ev);
   e.note = ev.note;
+  if (sens_) sens_->fill_event(e);
   if (!classify_event(e, ev, old_mode, old_friction)) {
+    if (sens_) sens_->graze(r.t, trigger);
     // A graze or a re-selection of the same mode: not a mode change.
     if (keep) record(tr, r.t, r.xa, r.phase);
     return true;
@@ -375,6 +385,16 @@ void EventDriven::end_run(RunState& r) const {
   if (r.tr.status == RunStatus::kCompleted && !infeasible_.empty()) fail(r.tr, infeasible_);
   r.tr.final_state = user(r.xa);
   r.tr.energy_final = energy(r.xa);
+  if (sens_) {
+    r.tr.sensitivity_columns = sens_->column_names();
+    sens_->fill(r.t, r.tr.dx_final, r.tr.dx_final_exists);
+    r.tr.sensitivity_losses = sens_->losses();
+  }
+}
+
+void EventDriven::init_sensitivity() {
+  sens_ = std::make_shared<Sensitivity>(model_, sys_, parse_sensitivity(model_, opt_.sensitivity),
+                                        impact_->name());
 }
 
 }  // namespace detail

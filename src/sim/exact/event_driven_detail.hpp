@@ -174,6 +174,13 @@ struct EventResult : OutcomeStartingAs<Status::kNumericalFailure> {
   std::string note;     // how an accumulation's limit was taken (Event::note)
   long lcp_solves = 0;
   std::vector<WarningCount> warnings;  // counted into Trajectory::warnings
+  // Forward sensitivities only (sensitivity.cpp): each round of the impact
+  // law, its closed contacts, velocity before, impulses and restitution.
+  struct ImpactRound {
+    lcs::IndexSet closed;
+    VectorXd v_before, impulse, restitution;
+  };
+  std::vector<ImpactRound> rounds;
 };
 
 // Ends a run that cannot make progress: `limit` consecutive events, each
@@ -213,6 +220,7 @@ class LivelockGuard {
 };
 
 class IntervalSeries;  // monitors.cpp
+class Sensitivity;     // sensitivity.hpp
 
 class EventDriven {
  public:
@@ -233,6 +241,7 @@ class EventDriven {
     rho_A_ = spectral_radius_bound(sys_.A);
     ldcp_.data = &ldcp_data_;
     if (model.is_mechanical() && model.mechanical->has_friction()) init_friction();
+    if (!opt.sensitivity.empty()) init_sensitivity();
   }
 
   Trajectory run(const VectorXd& x0_user);
@@ -367,7 +376,8 @@ class EventDriven {
     double dt_out_;
     GridSampler sampler;
     double t_event = std::numeric_limits<double>::infinity();
-    int trigger = -1;  // the constraint whose monitor gave t_event
+    int trigger = -1;          // the constraint whose monitor gave t_event
+    int trigger_monitor = -1;  // that monitor's index in phase.monitors
   };
   void arm_monitors(PhaseMarch& pm) const;
   double monitor_root(PhaseMarch& pm, size_t j, double ta, double tb, const VectorXd& xa_a,
@@ -435,6 +445,9 @@ class EventDriven {
   MatrixXd Minv_;
   std::vector<int> friction_contacts_;
   std::vector<impact::ContactOutcome> outcome_;
+  // Forward sensitivities (Options::sensitivity; null otherwise).
+  void init_sensitivity();
+  std::shared_ptr<Sensitivity> sens_;
 };
 
 }  // namespace lcsim::sim::detail

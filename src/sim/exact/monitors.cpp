@@ -236,6 +236,7 @@ void EventDriven::first_root(PhaseMarch& pm, double ta, double tb, const VectorX
     if (root < pm.t_event) {
       pm.t_event = root;
       pm.trigger = pm.phase.monitors[j].constraint;
+      pm.trigger_monitor = static_cast<int>(j);
     }
   }
 }

@@ -103,6 +103,7 @@ bool EventDriven::impact_round(double t, ContactScan& scan, bool limit_taken,
       out.friction_impulse(static_cast<Eigen::Index>(f)) +=
           ir.friction_impulse(friction_contacts_[f]);
   out.jumped = true;
+  if (sens_) out.rounds.push_back({in.closed, in.v, ir.impulse, in.restitution});
   record_impacts(in.closed, ir.impulse, t, time_noise);
   return true;
 }

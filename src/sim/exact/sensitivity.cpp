@@ -1,0 +1,443 @@
+// Forward sensitivities of the exact method (docs/sensitivities.md).
+//
+// Along a phase of mode I the state obeys x' = Acl x (augmented for
+// mechanical models, so constant forces are columns of Acl) and
+// S = dx/dtheta obeys S' = Acl S + (dAcl/dtheta) x: S and x are advanced
+// together by the Taylor series of the block-triangular system's exponential
+// (Van Loan), in substeps of norm at most 1 (as Phase::expv).
+// At an event at tau where the monitor h = w x (+ its parameter terms)
+// reaches zero, dtau/dtheta = -(w S- + dh/dtheta)/(w x'-), and S jumps by
+// the saltation matrix S+ = J S- + (J x'- - x'+) dtau/dtheta + dR/dtheta,
+// with J = dR/dx the derivative of the re-initialisation: the identity for
+// releases and contacts, for an impact the composition of the impact law's
+// rounds, each linear in v at its fixed active set.
+#include "sim/exact/sensitivity.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace lcsim::sim::detail {
+
+namespace {
+
+MatrixXd dense(const Eigen::SparseMatrix<double>& A) { return MatrixXd(A); }
+
+}  // namespace
+
+Sensitivity::Sensitivity(const mech::Model& model, const lcs::Lcs& sys, const SensColumns& cols,
+                         const std::string& law)
+    : model_(model), sys_(sys), cols_(cols) {
+  law_ = law == "newton" ? 'n' : law == "inelastic" ? 'i' : 'r';
+  n_ = sys.n();
+  mech_ = model.is_mechanical();
+  N_ = mech_ ? model.mechanical->dofs() : 0;
+  nx0_ = cols.x0 ? static_cast<int>(model.state_size()) : 0;
+  m_ = nx0_ + static_cast<int>(cols.params.size());
+  exists_.assign(static_cast<size_t>(m_), 1);
+  if (mech_) G_ = dense(model.mechanical->M).inverse();
+}
+
+std::vector<std::string> Sensitivity::column_names() const {
+  std::vector<std::string> out;
+  for (int i = 0; i < nx0_; ++i) out.push_back("x0[" + std::to_string(i) + "]");
+  for (const SensParam& p : cols_.params) out.push_back(p.name);
+  return out;
+}
+
+std::string Sensitivity::contact_name(int r) const {
+  if (r < 0) return "";
+  if (mech_) return model_.mechanical->constraints[static_cast<size_t>(r)];
+  return "y" + std::to_string(r);
+}
+
+void Sensitivity::lose(double t, int contact, const std::string& reason,
+                       const std::vector<int>& cols, bool always) {
+  SensitivityLoss l;
+  l.t = t;
+  l.contact = contact_name(contact);
+  l.reason = reason;
+  for (int c : cols)
+    if (exists_[static_cast<size_t>(c)]) {
+      exists_[static_cast<size_t>(c)] = 0;
+      l.columns.push_back(c);
+    }
+  if (!l.columns.empty() || always) losses_.push_back(std::move(l));
+}
+
+void Sensitivity::lose_all(double t, int contact, const std::string& reason) {
+  std::vector<int> all(static_cast<size_t>(m_));
+  for (int c = 0; c < m_; ++c) all[static_cast<size_t>(c)] = c;
+  lose(t, contact, reason, all);
+}
+
+void Sensitivity::start(const VectorXd& xa) {
+  MatrixXd S = MatrixXd::Zero(n_, m_);
+  for (int i = 0; i < nx0_; ++i) S(i, i) = 1.0;
+  S0_ = S;
+  Sc_ = S;
+  t0_ = tc_ = 0.0;
+  x0_ = xa;
+  dtau_ = RowVectorXd::Zero(m_);
+  S_minus_ = S;
+  xdot_minus_ = VectorXd::Zero(n_);
+  if (!mech_) return;
+  // A zero gap at the start: x0 lies on the boundary of the admissible set
+  // E q + g >= 0, where x(t) has one-sided derivatives only (a perturbation
+  // that closes the gap is inadmissible, one that opens it changes the
+  // events); the zero test of infeasible_start (sim.hpp).
+  const mech::MechanicalModel& m = *model_.mechanical;
+  const VectorXd q = xa.head(N_);
+  const VectorXd gap = m.E * q + m.g;
+  const VectorXd scale = m.E.cwiseAbs() * q.cwiseAbs() + m.g.cwiseAbs();
+  for (int r = 0; r < m.num_constraints(); ++r) {
+    if (std::abs(gap(r)) > 1e-9 * scale(r) + 1e-13) continue;
+    std::vector<int> cols;
+    for (int c = 0; c < nx0_; ++c) cols.push_back(c);
+    for (size_t p = 0; p < cols_.params.size(); ++p)
+      if (cols_.params[p].kind == 'g' && cols_.params[p].i == r)
+        cols.push_back(nx0_ + static_cast<int>(p));
+    lose(0.0, r,
+         "zero gap at the start: the initial state is on the boundary of the admissible set, "
+         "where only one-sided derivatives exist",
+         cols, true);
+  }
+}
+
+// dAcl/dtheta and dF_I/dtheta of mode I: with G = M^{-1}, E_I the mode's
+// rows, W = E_I G E_I', Q = G - G E_I' W^{-1} E_I G and H = [-K -D f],
+// Acl's velocity rows are Q H and F_I = -W^{-1} E_I G H (eq. (3.65) with
+// the leading rows of order 2), so dQ = -Q dM Q and
+// dF_I = W^{-1} E_I G (dM Q H - dH).
+// Each parameter moves one or two entries of H or M, so its terms are
+// columns of Q and rows of Q H (O(N n) each, not products of N x N
+// matrices). Kept per mode: Acl, its balancing and these depend on the mode
+// only (frictionless models).
+void Sensitivity::mode_derivatives(const lcs::IndexSet& mode) {
+  const int P = static_cast<int>(cols_.params.size());
+  dAb_.assign(static_cast<size_t>(P), MatrixXd());
+  dF_.assign(static_cast<size_t>(P), MatrixXd());
+  if (!mech_ || P == 0) return;
+  if (const auto it = mode_cache_.find(mode); it != mode_cache_.end()) {
+    dAb_ = it->second.first;
+    dF_ = it->second.second;
+    return;
+  }
+  const mech::MechanicalModel& m = *model_.mechanical;
+  const int kI = static_cast<int>(mode.size());
+  MatrixXd EI(kI, N_);
+  const MatrixXd E = dense(m.E);
+  for (int i = 0; i < kI; ++i) EI.row(i) = E.row(mode[static_cast<size_t>(i)]);
+  MatrixXd Q = G_, WinvEG = MatrixXd::Zero(kI, N_);
+  if (kI > 0) {
+    const MatrixXd W = EI * G_ * EI.transpose();
+    WinvEG = W.ldlt().solve(EI * G_);
+    Q = G_ - G_ * EI.transpose() * WinvEG;
+  }
+  MatrixXd H(N_, n_);
+  H << -dense(m.K), -dense(m.D), m.f;
+  const MatrixXd QH = Q * H;
+  for (int p = 0; p < P; ++p) {
+    const SensParam& sp = cols_.params[static_cast<size_t>(p)];
+    // dH has one entry -1 (K, D) or +1 (f) at (i, col); dM is the unit
+    // entry (i, j) and its mirror.
+    MatrixXd dAv = MatrixXd::Zero(N_, n_), dF = MatrixXd::Zero(kI, n_);
+    if (sp.kind == 'M') {
+      dAv -= Q.col(sp.i) * QH.row(sp.j);
+      dF += WinvEG.col(sp.i) * QH.row(sp.j);
+      if (sp.i != sp.j) {
+        dAv -= Q.col(sp.j) * QH.row(sp.i);
+        dF += WinvEG.col(sp.j) * QH.row(sp.i);
+      }
+    } else {
+      const int col = sp.kind == 'f' ? n_ - 1 : sp.kind == 'K' ? sp.j : N_ + sp.j;
+      const double sign = sp.kind == 'f' ? 1.0 : -1.0;
+      if (sp.kind == 'f' || sp.kind == 'K' || sp.kind == 'D') {
+        dAv.col(col) = sign * Q.col(sp.i);
+        dF.col(col) = -sign * WinvEG.col(sp.i);
+      }
+    }
+    MatrixXd dA = MatrixXd::Zero(n_, n_);
+    dA.middleRows(N_, N_) = dAv;
+    dAb_[static_cast<size_t>(p)] = D_.cwiseInverse().asDiagonal() * dA * D_.asDiagonal();
+    dF_[static_cast<size_t>(p)] = dF;
+  }
+  mode_cache_.emplace(mode, std::make_pair(dAb_, dF_));
+}
+
+void Sensitivity::begin_phase(const Phase& ph, double t0, const VectorXd& xa, const MatrixXd& S) {
+  Acl_ = ph.Acl;
+  Ab_ = ph.Ab;
+  use_sparse_ = ph.use_sparse;
+  if (use_sparse_) Ab_sparse_ = ph.Ab_sparse;
+  D_ = ph.D;
+  mode_ = ph.mode;
+  monitors_ = ph.monitors;
+  for (Monitor& mon : monitors_) mon.w = mon.w.cwiseQuotient(ph.D.transpose());
+  if (std::any_of(exists_.begin(), exists_.end(), [](char e) { return e != 0; }))
+    mode_derivatives(ph.mode);
+  else
+    dAb_.clear(), dF_.assign(cols_.params.size(), MatrixXd());  // at() carries nothing
+  norm1_ = Ab_.cwiseAbs().colwise().sum().maxCoeff();
+  double dnorm = 0.0;
+  for (const MatrixXd& d : dAb_)
+    if (d.size() > 0) dnorm = std::max(dnorm, d.cwiseAbs().colwise().sum().maxCoeff());
+  norm1_ += dnorm;
+  t0_ = tc_ = t0;
+  x0_ = xa;
+  S0_ = S;
+  for (int c = 0; c < m_; ++c)
+    if (!exists_[static_cast<size_t>(c)]) S0_.col(c).setZero();
+  Sc_ = S0_;
+  zc_ = xa.cwiseQuotient(D_);
+}
+
+// S from the cursor to t: the Taylor series of exp(tau [Ab dAb; 0 Ab]) on
+// (S, z) in balanced coordinates, in substeps with norm at most 1, each
+// truncated once two consecutive terms are below eps/4 of the sum.
+const MatrixXd& Sensitivity::at(double t) {
+  if (t < tc_) {  // before the cursor: from the phase start
+    tc_ = t0_;
+    Sc_ = S0_;
+    zc_ = x0_.cwiseQuotient(D_);
+  }
+  const double tau = t - tc_;
+  if (tau == 0.0 || Acl_.size() == 0) return Sc_;
+  if (std::none_of(exists_.begin(), exists_.end(), [](char e) { return e != 0; })) {
+    tc_ = t;  // every column absent: nothing to carry (Sc_ is zero)
+    return Sc_;
+  }
+  const int P = static_cast<int>(cols_.params.size());
+  const long steps = std::max(1L, static_cast<long>(std::ceil(norm1_ * tau)));
+  const double dt = tau / static_cast<double>(steps);
+  MatrixXd Sb = D_.cwiseInverse().asDiagonal() * Sc_;
+  VectorXd z = zc_;
+  for (long st = 0; st < steps; ++st) {
+    MatrixXd tS = Sb, sumS = Sb;
+    VectorXd tz = z, sumz = z;
+    double prev = std::max(tS.cwiseAbs().maxCoeff(), tz.cwiseAbs().maxCoeff());
+    for (int k = 1; k <= 80; ++k) {
+      const double c = dt / static_cast<double>(k);
+      MatrixXd nS = use_sparse_ ? MatrixXd(Ab_sparse_ * tS) : MatrixXd(Ab_ * tS);
+      for (int p = 0; p < P; ++p) nS.col(nx0_ + p) += dAb_[static_cast<size_t>(p)] * tz;
+      tS = nS * c;
+      tz = (use_sparse_ ? VectorXd(Ab_sparse_ * tz) : VectorXd(Ab_ * tz)) * c;
+      sumS += tS;
+      sumz += tz;
+      const double cur = std::max(tS.cwiseAbs().maxCoeff(), tz.cwiseAbs().maxCoeff());
+      const double bound =
+          0.25 * kEps * std::max(sumS.cwiseAbs().maxCoeff(), sumz.cwiseAbs().maxCoeff());
+      if (cur <= bound && prev <= bound) break;
+      prev = cur;
+    }
+    Sb = sumS;
+    z = sumz;
+  }
+  Sc_ = D_.asDiagonal() * Sb;
+  zc_ = z;
+  tc_ = t;
+  return Sc_;
+}
+
+void Sensitivity::fill(double t, MatrixXd& dx, std::vector<char>& exists) {
+  const MatrixXd& S = at(t);
+  dx = S.topRows(mech_ ? 2 * N_ : n_);
+  for (int c = 0; c < m_; ++c)
+    if (!exists_[static_cast<size_t>(c)]) dx.col(c).setZero();
+  exists = exists_;
+}
+
+void Sensitivity::before_event(double tau, const VectorXd& x_minus, int monitor) {
+  S_minus_ = at(tau);
+  xdot_minus_ = Acl_ * x_minus;
+  dtau_ = RowVectorXd::Zero(m_);
+  if (monitor < 0) return;
+  const Monitor& mon = monitors_[static_cast<size_t>(monitor)];
+  trigger_ = mon.constraint;
+  if (mon.multiplier) released_ = mon.constraint;
+  const double rate = mon.w.dot(xdot_minus_);
+  // Grazing: the monitor reaches zero with a zero rate (to sqrt(eps) of its
+  // terms); dtau/dtheta = -(...)/rate does not exist.
+  if (std::abs(rate) <= kSqrtEps * mon.w.cwiseAbs().dot(xdot_minus_.cwiseAbs())) {
+    lose_all(tau, mon.constraint,
+             mon.multiplier ? "the contact force reaches zero with a zero rate (grazing release)"
+                            : "grazing contact: the gap reaches zero with a zero rate");
+    return;
+  }
+  // Another monitor at zero too: coinciding events (an impact as a held
+  // contact's force vanishes, two gaps closing at once), where the event
+  // sequence of nearby runs differs on either side.
+  for (size_t j = 0; j < monitors_.size(); ++j) {
+    const Monitor& other = monitors_[j];
+    if (static_cast<int>(j) == monitor || other.friction >= 0) continue;
+    // Zero to sqrt(eps) of its row times the state's size (a held force's
+    // own terms may all vanish there: springs relaxed, no load).
+    if (std::abs(other.w.dot(x_minus)) <=
+        kSqrtEps * other.w.cwiseAbs().sum() * x_minus.cwiseAbs().maxCoeff())
+      lose_all(tau, other.constraint,
+               other.multiplier
+                   ? "coinciding events: this contact's force vanishes at another event"
+                   : "coinciding events: this contact closes at the same time as another");
+  }
+  RowVectorXd dh = mon.w * S_minus_;
+  for (size_t p = 0; p < cols_.params.size(); ++p) {
+    const SensParam& sp = cols_.params[p];
+    const Eigen::Index c = nx0_ + static_cast<Eigen::Index>(p);
+    if (!mon.multiplier && sp.kind == 'g' && sp.i == mon.constraint) dh(c) += 1.0;
+    if (mon.multiplier && dF_[p].size() > 0) {
+      const auto it = std::find(mode_.begin(), mode_.end(), mon.constraint);
+      dh(c) += dF_[p].row(it - mode_.begin()).dot(x_minus);
+    }
+  }
+  dtau_ = -dh / rate;
+  for (int c = 0; c < m_; ++c)
+    if (!exists_[static_cast<size_t>(c)]) dtau_(c) = 0.0;
+}
+
+// One round of the impact law at its fixed active set A (the closed
+// contacts with a positive impulse): v+ = v + G E_A' mu with
+// mu = -W^{-1} (1 + e) E_A v (moreau-restitution: E_A v+ = -e E_A v) or
+// mu = -(1 + e) W^{-1} E_A v (newton; inelastic: e = 0), W = E_A G E_A'.
+// J (augmented) has the velocity block I + G E_A' dmu/dv, dR the derivative
+// of v+ in each parameter (e of a contact in A, entries of M). False when
+// the active set is not locally constant: a closed contact with a zero
+// impulse and a zero separation rate (several LCP solutions nearby).
+bool Sensitivity::impact_map(double t, const EventResult::ImpactRound& rd, MatrixXd& J,
+                             MatrixXd& dR) {
+  const mech::MechanicalModel& m = *model_.mechanical;
+  const MatrixXd E = dense(m.E);
+  const VectorXd e = law_ == 'i' ? VectorXd::Zero(rd.restitution.size()) : rd.restitution;
+  const VectorXd& v = rd.v_before;
+  double pmax = 0.0, amax = 0.0;
+  for (int r : rd.closed) {
+    pmax = std::max(pmax, std::abs(rd.impulse(r)));
+    amax = std::max(amax, std::abs(E.row(r).dot(v)));
+  }
+  std::vector<int> A;
+  for (int r : rd.closed)
+    if (rd.impulse(r) > kSqrtEps * pmax) A.push_back(r);
+  const int a = static_cast<int>(A.size());
+  MatrixXd EA(a, N_);
+  VectorXd eA(a);
+  for (int i = 0; i < a; ++i) {
+    EA.row(i) = E.row(A[static_cast<size_t>(i)]);
+    eA(i) = e(A[static_cast<size_t>(i)]);
+  }
+  const MatrixXd W = EA * G_ * EA.transpose();
+  const Eigen::LDLT<MatrixXd> Wf(W);
+  const VectorXd aA = EA * v;
+  // The inelastic impulse lambda (newton) and mu.
+  const VectorXd lambda = Wf.solve(-aA);
+  const VectorXd mu = law_ == 'r' ? VectorXd(Wf.solve(-(aA + eA.cwiseProduct(aA))))
+                                  : VectorXd(lambda + eA.cwiseProduct(lambda));
+  const VectorXd vplus = v + G_ * EA.transpose() * mu;
+  const VectorXd vin = v + G_ * EA.transpose() * lambda;  // the inelastic velocity
+  for (int r : rd.closed) {
+    if (std::find(A.begin(), A.end(), r) != A.end()) continue;
+    const double sep =
+        law_ == 'r' ? E.row(r).dot(vplus) + e(r) * E.row(r).dot(v) : E.row(r).dot(vin);
+    if (std::abs(sep) <= kSqrtEps * amax) {
+      lose_all(t, r,
+               "degenerate impact: a zero impulse and a zero separation rate (the impact LCP's "
+               "active set is not locally constant)");
+      return false;
+    }
+  }
+  const VectorXd one_e = (eA.array() + 1.0).matrix();
+  const MatrixXd T = law_ == 'r' ? MatrixXd(Wf.solve(-(one_e.asDiagonal() * EA)))
+                                 : MatrixXd(-(one_e.asDiagonal() * Wf.solve(EA)));
+  J = MatrixXd::Identity(n_, n_);
+  J.block(N_, N_, N_, N_) += G_ * EA.transpose() * T;
+  dR = MatrixXd::Zero(n_, m_);
+  for (size_t p = 0; p < cols_.params.size(); ++p) {
+    const SensParam& sp = cols_.params[p];
+    VectorXd dv = VectorXd::Zero(N_);
+    if (sp.kind == 'e' && law_ != 'i') {
+      const auto it = std::find(A.begin(), A.end(), sp.i);
+      if (it == A.end()) continue;
+      const Eigen::Index i = it - A.begin();
+      VectorXd dmu = VectorXd::Zero(a);
+      if (law_ == 'r') {
+        VectorXd unit = VectorXd::Zero(a);
+        unit(i) = aA(i);
+        dmu = Wf.solve(-unit);
+      } else {
+        dmu(i) = lambda(i);
+      }
+      dv = G_ * EA.transpose() * dmu;
+    } else if (sp.kind == 'M') {
+      MatrixXd dM = MatrixXd::Zero(N_, N_);
+      dM(sp.i, sp.j) = dM(sp.j, sp.i) = 1.0;
+      const MatrixXd dG = -G_ * dM * G_;
+      const MatrixXd dW = EA * dG * EA.transpose();
+      VectorXd dmu =
+          law_ == 'r' ? VectorXd(Wf.solve(-dW * mu))
+                      : VectorXd((eA.array() + 1.0).matrix().cwiseProduct(Wf.solve(-dW * lambda)));
+      dv = dG * EA.transpose() * mu + G_ * EA.transpose() * dmu;
+    } else {
+      continue;
+    }
+    dR.block(N_, nx0_ + static_cast<Eigen::Index>(p), N_, 1) = dv;
+  }
+  return true;
+}
+
+void Sensitivity::after_event(const EventResult& ev, const Phase& next, double t,
+                              const VectorXd& x_plus, const lcs::IndexSet& held, int trigger) {
+  MatrixXd J = MatrixXd::Identity(n_, n_), dR = MatrixXd::Zero(n_, m_);
+  if (ev.accumulation)
+    lose_all(t, trigger, "accumulation of impacts: the derivative of its limit is not computed");
+  if (!mech_ && ev.jumped)
+    lose_all(t, trigger, "a jump of a general LCS (P_I x): its derivative is not computed");
+  if (mech_ && !ev.rounds.empty()) {
+    // Another contact closing at the same time: coinciding events.
+    for (int r : ev.rounds.front().closed)
+      if (r != trigger && t > 0.0 && std::find(held.begin(), held.end(), r) == held.end())
+        lose_all(t, r, "coinciding events: this contact closes at the same time as another");
+    for (const auto& rd : ev.rounds) {
+      MatrixXd Jr, dRr;
+      if (!impact_map(t, rd, Jr, dRr)) break;
+      J = Jr * J;
+      dR = Jr * dR + dRr;
+    }
+  }
+  const VectorXd xdot_plus = next.Acl * x_plus;
+  MatrixXd S = J * S_minus_ + (J * xdot_minus_ - xdot_plus) * dtau_ + dR;
+  begin_phase(next, t, x_plus, S);
+}
+
+void Sensitivity::check_phase_start(const Phase& ph, double t, const std::vector<int>& m0,
+                                    const lcs::IndexSet& undetermined) {
+  const int released = released_, trigger = trigger_;
+  released_ = trigger_ = -1;
+  if (!undetermined.empty())
+    lose_all(t, undetermined.front(),
+             "mode selection left a constraint undetermined (its multiplier and output vanish "
+             "identically)");
+  for (size_t j = 0; j < ph.monitors.size() && j < m0.size(); ++j) {
+    const Monitor& mon = ph.monitors[j];
+    if (mon.friction >= 0 || m0[j] == 0) continue;
+    // A multiplier starting at zero (with a nonzero rate for the contact
+    // whose output just reached zero: a general LCS's continuous contact),
+    // or a free output zero to the second derivative (third for the
+    // contact just released): the multiplier and the gap's acceleration
+    // both vanish.
+    const bool degenerate =
+        mon.multiplier ? !(m0[j] == 1 && mon.constraint == trigger)
+                       : m0[j] < 0 || m0[j] > 3 || (m0[j] == 3 && mon.constraint != released);
+    if (degenerate)
+      lose_all(t, mon.constraint,
+               "degenerate mode: the multiplier and the gap's acceleration both vanish (several "
+               "mode selections nearby)");
+  }
+}
+
+void Sensitivity::graze(double t, int trigger) {
+  lose_all(t, trigger, "grazing: the event changed no mode");
+}
+
+void Sensitivity::fill_event(Event& e) const {
+  e.dt = dtau_;
+  e.dt_exists = exists_;
+}
+
+}  // namespace lcsim::sim::detail

@@ -1,0 +1,118 @@
+// Private to src/sim: forward sensitivities of the exact event-driven method
+// (docs/sensitivities.md).
+//   sensitivity_names.cpp  the columns asked ("x0", "f[1]", "e[stop]"):
+//                          parsing and the run's check (check_sensitivity)
+//   sensitivity.cpp        their propagation: along a phase the variational
+//                          equation S' = Acl S + (dAcl/dtheta) x, at an event
+//                          the saltation matrix
+#pragma once
+
+#include <Eigen/Dense>
+#include <lcsim/sim/sim.hpp>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "sim/exact/event_driven_detail.hpp"
+
+namespace lcsim::sim::detail {
+
+// A named parameter: f[i], g[c], e[c], K[i][j], D[i][j], M[i][j] (0-based
+// indices resolved from names).
+struct SensParam {
+  char kind = 'f';
+  int i = -1, j = -1;
+  std::string name;  // as asked
+};
+
+// The columns asked: x0 (every entry of the initial state) first, then the
+// parameters in the order asked. `error` is "" or the input error.
+struct SensColumns {
+  bool x0 = false;
+  std::vector<SensParam> params;
+  std::string error;
+};
+SensColumns parse_sensitivity(const mech::Model& model, const std::vector<std::string>& asked);
+
+// The sensitivity S = dx/dtheta (augmented state x n columns) of one run,
+// carried along beside the state by EventDriven's stages.
+class Sensitivity {
+ public:
+  Sensitivity(const mech::Model& model, const lcs::Lcs& sys, const SensColumns& cols,
+              const std::string& law);
+  std::vector<std::string> column_names() const;
+  // At t = 0: S = dx0/dtheta, and the losses of a start on the boundary of
+  // the admissible set (a zero gap).
+  void start(const VectorXd& xa);
+  // S at t (within the current phase, t >= its start), augmented rows.
+  const MatrixXd& at(double t);
+  // Fills a sample's or the final dx and its existence flags.
+  void fill(double t, MatrixXd& dx, std::vector<char>& exists);
+  // Before the re-initialisation at tau: S-, and dtau/dtheta from the
+  // monitor `monitor` of the ending phase (-1 at t = 0).
+  void before_event(double tau, const VectorXd& x_minus, int monitor);
+  // After it: the saltation into the new phase from x_plus. `held`: the
+  // constraints the ending phase kept closed; `released`: the constraint a
+  // multiplier monitor released (-1 if none), kept for check_phase_start.
+  void after_event(const EventResult& ev, const Phase& next, double t, const VectorXd& x_plus,
+                   const lcs::IndexSet& held, int trigger);
+  // A phase start where a monitor is zero with the wrong order (m0: the
+  // order of its first nonzero derivative) or the mode selection left some
+  // constraint undetermined: the active set is not locally constant.
+  void check_phase_start(const Phase& ph, double t, const std::vector<int>& m0,
+                         const lcs::IndexSet& undetermined);
+  // An event that changed no mode (a graze).
+  void graze(double t, int trigger);
+  // The last event's dtau/dtheta.
+  void fill_event(Event& e) const;
+  const std::vector<SensitivityLoss>& losses() const { return losses_; }
+
+ private:
+  void begin_phase(const Phase& ph, double t0, const VectorXd& xa, const MatrixXd& S);
+  // Marks `cols` absent from t on; the loss is recorded when it ends some
+  // column, or `always`.
+  void lose(double t, int contact, const std::string& reason, const std::vector<int>& cols,
+            bool always = false);
+  void lose_all(double t, int contact, const std::string& reason);
+  bool impact_map(double t, const EventResult::ImpactRound& round, MatrixXd& J, MatrixXd& dR);
+  // dAcl/dtheta and dF/dtheta of a mode for each parameter (mechanical).
+  void mode_derivatives(const lcs::IndexSet& mode);
+  std::string contact_name(int r) const;
+
+  const mech::Model& model_;
+  const lcs::Lcs& sys_;
+  SensColumns cols_;
+  char law_ = 'r';  // 'r' moreau-restitution, 'n' newton, 'i' inelastic
+  int n_ = 0, N_ = 0, nx0_ = 0, m_ = 0;
+  bool mech_ = false;
+  MatrixXd G_;  // M^{-1} (mechanical)
+  std::vector<char> exists_;
+  std::vector<SensitivityLoss> losses_;
+  // The current phase: start, closed loop, balancing, monitors, derivatives.
+  double t0_ = 0.0;
+  MatrixXd S0_;
+  VectorXd x0_;
+  MatrixXd Acl_, Ab_;
+  Eigen::SparseMatrix<double, Eigen::RowMajor> Ab_sparse_;  // when the phase uses it
+  bool use_sparse_ = false;
+  std::map<lcs::IndexSet, std::pair<std::vector<MatrixXd>, std::vector<MatrixXd>>> mode_cache_;
+  VectorXd D_;
+  double norm1_ = 0.0;
+  std::vector<MatrixXd> dAb_;  // balanced dAcl/dtheta per parameter
+  std::vector<MatrixXd> dF_;   // dF_I/dtheta per parameter (unbalanced)
+  lcs::IndexSet mode_;
+  std::vector<Monitor> monitors_;  // unbalanced w
+  // The cursor: S and the balanced state at tc_.
+  double tc_ = 0.0;
+  MatrixXd Sc_;
+  VectorXd zc_;
+  // The pending event.
+  MatrixXd S_minus_;
+  VectorXd xdot_minus_;
+  RowVectorXd dtau_;
+  int released_ = -1;  // the constraint the last event released (-1 if none)
+  int trigger_ = -1;   // the constraint whose monitor ended the last phase
+};
+
+}  // namespace lcsim::sim::detail

@@ -1,0 +1,114 @@
+// The columns of a forward-sensitivity run (Options::sensitivity) and the
+// run's check of them (check_sensitivity): "x0", and parameters of a
+// frictionless mechanical model named f[i], g[c], e[c], K[i][j], D[i][j],
+// M[i][j] with i, j a coordinate's 0-based index or name and c a
+// constraint's (docs/sensitivities.md).
+#include <algorithm>
+#include <lcsim/sim/sim.hpp>
+#include <set>
+
+#include "sim/exact/sensitivity.hpp"
+
+namespace lcsim::sim {
+
+namespace detail {
+
+namespace {
+
+// The index of `key` among `names` (a 0-based number or a name), or -1.
+int resolve(const std::string& key, const std::vector<std::string>& names) {
+  for (size_t i = 0; i < names.size(); ++i)
+    if (names[i] == key) return static_cast<int>(i);
+  if (key.empty() ||
+      !std::all_of(key.begin(), key.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    return -1;
+  if (key.size() > 9) return -1;
+  const int i = std::stoi(key);
+  return i < static_cast<int>(names.size()) ? i : -1;
+}
+
+// The bracketed keys of "K[0][1]" after the kind letter: {"0", "1"}; empty
+// when the text is not of that form.
+std::vector<std::string> keys(const std::string& s) {
+  std::vector<std::string> out;
+  size_t p = 1;
+  while (p < s.size()) {
+    if (s[p] != '[') return {};
+    const size_t close = s.find(']', p);
+    if (close == std::string::npos) return {};
+    out.push_back(s.substr(p + 1, close - p - 1));
+    p = close + 1;
+  }
+  return out;
+}
+
+std::string parse_one(const mech::MechanicalModel& m, const std::string& s, SensParam& p) {
+  const std::string bad = "sensitivity '" + s + "': ";
+  if (s.size() < 2 || std::string("fgeKDM").find(s[0]) == std::string::npos)
+    return bad + "not a parameter name (x0, f[i], g[c], e[c], K[i][j], D[i][j], M[i][j])";
+  p.kind = s[0];
+  p.name = s;
+  const std::vector<std::string> k = keys(s);
+  const bool matrix = p.kind == 'K' || p.kind == 'D' || p.kind == 'M';
+  if (k.size() != (matrix ? 2u : 1u))
+    return bad + (matrix ? "expected two indices, as " + std::string(1, p.kind) + "[0][1]"
+                         : "expected one index, as " + std::string(1, p.kind) + "[0]");
+  const bool on_constraint = p.kind == 'g' || p.kind == 'e';
+  const auto& names = on_constraint ? m.constraints : m.coordinates;
+  p.i = resolve(k[0], names);
+  if (p.i < 0)
+    return bad + "no " + (on_constraint ? "constraint" : "coordinate") + " '" + k[0] + "'";
+  if (matrix) {
+    p.j = resolve(k[1], m.coordinates);
+    if (p.j < 0) return bad + "no coordinate '" + k[1] + "'";
+  }
+  return "";
+}
+
+}  // namespace
+
+SensColumns parse_sensitivity(const mech::Model& model, const std::vector<std::string>& asked) {
+  SensColumns c;
+  std::set<std::string> seen;
+  for (const std::string& s : asked) {
+    if (!seen.insert(s).second) {
+      c.error = "sensitivity '" + s + "': asked twice";
+      return c;
+    }
+    if (s == "x0") {
+      c.x0 = true;
+      continue;
+    }
+    if (!model.is_mechanical()) {
+      c.error = "sensitivity '" + s + "': parameters are named for mechanical models only ('" +
+                model.name + "' is a general LCS; ask x0)";
+      return c;
+    }
+    SensParam p;
+    c.error = parse_one(*model.mechanical, s, p);
+    if (!c.error.empty()) return c;
+    c.params.push_back(p);
+  }
+  return c;
+}
+
+}  // namespace detail
+
+std::string check_sensitivity(const mech::Model& model, const Options& opt, std::string_view method,
+                              const OptionsUsed& used) {
+  if (opt.sensitivity.empty()) return "";
+  if (!used.sensitivity)
+    return "method '" + std::string(method) +
+           "' does not compute Options::sensitivity (the exact method 'event' does)";
+  if (model.is_mechanical() && model.mechanical->has_friction())
+    return "Options::sensitivity: model '" + model.name +
+           "' has mechanical.friction; sensitivities through stick / slip are not computed";
+  const std::string law = impact::make_impact_law(opt.impact)->name();
+  if (model.is_mechanical() && law != "moreau-restitution" && law != "newton" && law != "inelastic")
+    return "Options::sensitivity: impact law '" + opt.impact +
+           "' has no derivative computed (moreau-restitution, newton and inelastic are linear "
+           "at a fixed active set)";
+  return detail::parse_sensitivity(model, opt.sensitivity).error;
+}
+
+}  // namespace lcsim::sim
