@@ -24,6 +24,8 @@ const char* to_string(ContactOutcome o) {
       return "slip+";
     case ContactOutcome::kSlipNegative:
       return "slip-";
+    case ContactOutcome::kSlip:
+      return "slip";
   }
   return "?";
 }
@@ -238,6 +240,9 @@ void flag_energy_gain(const ClosedFriction& c, const VectorXd& lambda_T, ImpactR
 }  // namespace
 
 ImpactResult moreau_friction(const ImpactInput& in, const lcp::Solver& solver) {
+  // Two tangents somewhere: the general cone (planar contacts as d = 1);
+  // planar models keep this path and its numbers.
+  if (in.model != nullptr && in.model->has_friction_3d()) return moreau_friction_cone(in, solver);
   ImpactResult out;
   const auto s = detail::prepare(in, out, /*handles_friction=*/true);
   if (in.model != nullptr && out.v_after.size() == in.model->dofs()) {

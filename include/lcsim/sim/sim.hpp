@@ -197,6 +197,10 @@ struct OptionsUsed {
   // The method handles mechanical.friction (planar Coulomb, issue 17); a
   // method without it refuses a model with friction (check_run).
   bool friction = false;
+  // The method also handles 3-D contacts (two tangents, a polyhedral cone:
+  // mech::FrictionalContact::is_3d, issue 27); a method with friction but
+  // not this refuses a model that has one (check_run).
+  bool friction_3d = false;
 };
 
 class Integrator {
