@@ -193,8 +193,9 @@ std::string check_run(const mech::Model& model, const VectorXd& x0, const Option
   if (used.needs_mechanical && !model.is_mechanical())
     return "method '" + std::string(method) + "' needs a mechanical model ('" + model.name +
            "' is a general LCS; the methods 'event' and 'euler' take one)";
-  if (std::string m = refuse_friction(model, method, used); !m.empty()) return m;
+  // 3-D first: a planar refusal would name methods that refuse 3-D friction too.
   if (std::string m = refuse_friction_3d(model, method, used); !m.empty()) return m;
+  if (std::string m = refuse_friction(model, method, used); !m.empty()) return m;
   if (used.dense_lcs && model.lcs_state_size() > mech::kMaxDenseLcsState)
     return "method '" + std::string(method) +
            "' works on the dense LCS (matrix exponentials and LCPs of size n = 2N + 1), and " +
