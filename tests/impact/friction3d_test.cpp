@@ -8,6 +8,7 @@
 #include <cmath>
 #include <lcsim/impact/impact.hpp>
 #include <random>
+#include <vector>
 
 #include "friction_test_util.hpp"
 #include "impact_test_util.hpp"
@@ -69,6 +70,60 @@ TEST(Friction3dImpact, DOneReproducesThePlanarLaw) {
     }
     EXPECT_GT(compared, 200) << painleve << " Painlevé-type draws";
   }
+}
+
+// d = 1 on the planar tests' closed-form cases (friction_test.cpp): the
+// spinning disk at every sliding velocity it tries, mu = 0, the Painlevé
+// case and its solvable neighbour, and Kane's paradox (an energy gain at
+// e = 1): the same velocities, impulses, outcomes and diagnoses.
+mech::MechanicalModel disk(double mu, double e) {
+  const double m = 2.0, R = 0.5, beta = 0.5;
+  Eigen::MatrixXd M = Eigen::Vector3d(m, m, beta * m * R * R).asDiagonal();
+  mech::MechanicalModel model = testing::make_model(M, Eigen::RowVector3d(0, 1, 0));
+  model.g = vec({-R});
+  model.restitution = vec({e});
+  model.friction.push_back({0, vec({1, 0, R}), mu});
+  return model;
+}
+
+mech::MechanicalModel skew(double a, double mu, double e) {
+  mech::MechanicalModel m =
+      testing::make_model(Eigen::Matrix2d::Identity(), Eigen::RowVector2d(1, 0));
+  m.restitution = vec({e});
+  m.friction.push_back({0, vec({a, 1}), mu});
+  return m;
+}
+
+TEST(Friction3dImpact, DOneReproducesThePlanarClosedFormCases) {
+  struct Case {
+    mech::MechanicalModel model;
+    VectorXd v;
+  };
+  std::vector<Case> cases;
+  for (const double uT : {-6.0, -4.1, -4.0, -1.0, 0.0, 0.7, 4.0, 4.04, 4.06, 5.0, 9.0})
+    cases.push_back({disk(0.3, 0.5), vec({uT - 0.5 * 2.0, -3.0, 2.0})});
+  cases.push_back({disk(0.0, 0.5), vec({1, -3, 2})});
+  cases.push_back({skew(0.5, 2.5, 0.0), vec({-1, 3})});
+  cases.push_back({skew(0.5, 1.9, 0.0), vec({-1, 3})});
+  cases.push_back({skew(0.5, 0.5, 1.0), vec({-1, -0.2})});
+  int painleve = 0, gains = 0;
+  for (const Case& c : cases) {
+    const VectorXd& e = c.model.restitution;
+    const ImpactResult a = by("planar", c.model, c.v, e), b = by("cone", c.model, c.v, e);
+    ASSERT_EQ(a.ok(), b.ok()) << a.message << " | " << b.message;
+    ASSERT_EQ(a.painleve, b.painleve);
+    painleve += a.painleve;
+    if (!a.ok()) continue;
+    // Unit-scale data, 3 and 4 unknowns: a few ulps, as the closed forms' 1e-12.
+    EXPECT_LE((a.v_after - b.v_after).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_LE((a.impulse - b.impulse).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_LE((a.friction_impulse - b.friction_impulse).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_EQ(a.outcome, b.outcome);
+    EXPECT_EQ(a.energy_gain, b.energy_gain);
+    gains += b.energy_gain;
+  }
+  EXPECT_EQ(painleve, 1);
+  EXPECT_EQ(gains, 1);  // Kane's paradox, flagged by both
 }
 
 // A point mass (x, y, z) of mass m on the floor z >= 0 (normal row (0, 0, 1),
