@@ -53,3 +53,28 @@ def test_a_bad_cone_is_one_line_and_exit_2(tmp_path, lcsim_binary):
     assert r.returncode == 2
     assert r.stderr.count("\n") == 1
     assert "mechanical.friction[0].d: must be a whole number >= 1" in r.stderr
+
+
+def test_a_three_dimensional_contact_built_in_python():
+    """`friction=[{..., "tangents": [t, t2], "d": 4}]` as the YAML entry: the same
+    impact as the file's (the bisector case above), and a bad entry is InputError."""
+    import pytest
+    a = math.pi / 8
+    model = lcsim.Model.mechanical(
+        M=np.eye(3), E=np.array([[0.0, 0.0, 1.0]]), constraint_names=["floor"],
+        friction=[{"contact": "floor", "tangents": [[1, 0, 0], [0, 1, 0]], "mu": 0.5,
+                   "d": 4}])
+    r = lcsim.impacts(model, [0, 0, 0, 3 * math.cos(a), 3 * math.sin(a), -2],
+                      rules=["inelastic"])["inelastic"]
+    assert r.friction_mode == ["slip-face-4"]
+    assert abs(r.friction_impulse2[0] + math.cos(a) * math.sin(a)) < 1e-12
+    with pytest.raises(lcsim.InputError) as e:
+        lcsim.Model.mechanical(
+            M=np.eye(3), E=np.array([[0.0, 0.0, 1.0]]),
+            friction=[{"contact": 0, "tangents": [[1, 0, 0], [0, 1, 0.5]], "mu": 0.5}])
+    assert "tangents[1] and the normal row E[0] are not orthogonal" in str(e.value)
+    with pytest.raises(lcsim.InputError) as e:
+        lcsim.Model.mechanical(
+            M=np.eye(3), E=np.array([[0.0, 0.0, 1.0]]),
+            friction=[{"contact": 0, "tangents": [[1, 0, 0], [0, 1, 0]], "mu": 0.5, "d": 0}])
+    assert str(e.value) == "friction[0].d: must be >= 1 (got 0)"
