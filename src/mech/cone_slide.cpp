@@ -60,24 +60,4 @@ ConeSlide cone_slide(double s0, double psi, double mu, double g, int d) {
   return out;
 }
 
-Model sliding_block_3d_model(double m, double mu, double g, int d, double s0, double psi) {
-  MechanicalModel mm;
-  mm.M = (m * Eigen::MatrixXd::Identity(3, 3)).sparseView();
-  mm.E = Eigen::RowVector3d(0, 0, 1).sparseView();
-  mm.f = Eigen::Vector3d(0, 0, -m * g);
-  FrictionalContact c(0, Eigen::Vector3d(1, 0, 0), mu);
-  c.tangent2 = Eigen::Vector3d(0, 1, 0).sparseView();
-  c.edges = d;
-  mm.friction.push_back(c);
-  mm.coordinates = {"x", "y", "z"};
-  mm.constraints = {"floor"};
-  Model model = model_of(mm, "sliding_block_3d");
-  model.initial = Eigen::VectorXd::Zero(6);
-  model.initial(3) = s0 * std::cos(psi);
-  model.initial(4) = s0 * std::sin(psi);
-  const double t = cone_slide(s0, psi, mu, g, d).t_stop;
-  model.t_end = std::isfinite(t) ? 1.5 * t : 10.0;
-  return model;
-}
-
 }  // namespace lcsim::mech

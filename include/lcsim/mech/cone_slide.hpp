@@ -36,10 +36,4 @@ struct ConeSlide {
 // s0 > 0, mu > 0, g > 0, d >= 1 (std::invalid_argument otherwise).
 ConeSlide cone_slide(double s0, double psi, double mu, double g, int d);
 
-// The block of cone_slide as a model: q = (x, y, z), M = m I, the floor
-// z >= 0, gravity f = (0, 0, -m g), a 3-D contact with tangents (1, 0, 0) and
-// (0, 1, 0), mu and d; initial state on the floor with velocity s0 (cos psi,
-// sin psi, 0), t_end = 1.5 times the stop time (10 s when it never stops).
-Model sliding_block_3d_model(double m, double mu, double g, int d, double s0, double psi);
-
 }  // namespace lcsim::mech
