@@ -253,30 +253,14 @@ void set_cone_outcomes(const mech::MechanicalModel& m, const ImpactInput& in, co
   }
 }
 
-// Mode threshold as friction.cpp's: rounding of the largest approach rate
-// through the diagonal of W.
-double cone_mode_threshold(const detail::Setup& s) {
-  double tiny = 0.0;
-  for (Eigen::Index i = 0; i < s.W.rows(); ++i)
-    if (s.W(i, i) > 0.0) tiny = std::max(tiny, std::abs(s.a(i)) / s.W(i, i));
-  return tiny * kRelTol;
-}
-
-// Flags a rise of kinetic energy beyond the work of moving surfaces (the
-// planar law's test and message: only restitution can make it positive).
-void flag_cone_energy_gain(const mech::MechanicalModel& m, const ClosedCone& c, ImpactResult& out) {
-  double surface_work = 0.0;
+// The work of moving surfaces on the body (J): planar contacts' belts.
+double surface_work(const mech::MechanicalModel& m, const ClosedCone& c, const ImpactResult& out) {
+  double w = 0.0;
   for (size_t f = 0; f < c.index.size(); ++f) {
     const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(c.index[f])];
-    surface_work += fc.velocity * out.friction_impulse(fc.contact);
+    w += fc.velocity * out.friction_impulse(fc.contact);
   }
-  if (out.energy_after - surface_work > out.energy_before * (1.0 + 1e-12) + 1e-300) {
-    out.energy_gain = true;
-    out.message = text("kinetic energy rose through the impact, ", out.energy_before, " -> ",
-                       out.energy_after,
-                       " J: Newton restitution with coupled normal and tangential "
-                       "directions (W_NT != 0) can create energy (Kane's paradox)");
-  }
+  return w;
 }
 
 }  // namespace
@@ -320,11 +304,11 @@ ImpactResult moreau_friction_cone(const ImpactInput& in, const lcp::Solver& solv
   }
   const VectorXd lambda_N = res.z.head(nj), beta = res.z.segment(nj, ne);
   const VectorXd v_after = in.v + s->MinvEt * lambda_N + MinvDt * beta;
-  const double tiny = cone_mode_threshold(*s);
+  const double tiny = detail::friction_mode_threshold(*s);
   detail::finish(in, *s, lambda_N, v_after, tiny, out);
   set_cone_outcomes(m, in, c, lambda_N, beta, tiny, out);
   out.status = Status::kOk;
-  flag_cone_energy_gain(m, c, out);
+  detail::flag_friction_energy_gain(surface_work(m, c, out), out);
   return out;
 }
 
