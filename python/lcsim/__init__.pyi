@@ -129,6 +129,10 @@ class ImpactResult:
     energy_after: float
     worst_rate: float
     admissible: bool
+    friction_impulse: np.ndarray
+    friction_impulse2: np.ndarray
+    friction_outcome: list[str]
+    friction_mode: list[str]
 
 class LcpResult:
     """The solution of an LCP w = M z + q."""

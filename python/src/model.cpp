@@ -41,14 +41,20 @@ mech::FrictionalContact frictional_contact(const py::handle& entry, std::size_t 
   if (!py::isinstance<py::dict>(entry))
     throw io::InputError(at + ": expected a dict {contact, tangent, mu[, velocity]}");
   const auto d = py::reinterpret_borrow<py::dict>(entry);
-  for (const char* key : {"contact", "tangent", "mu"})
+  for (const char* key : {"contact", "mu"})
     if (!d.contains(key)) throw io::InputError(at + "." + key + ": missing");
+  if (d.contains("tangent") == d.contains("tangents"))
+    throw io::InputError(at + ": expected one of tangent (planar) or tangents (two rows, 3-D)");
   for (const auto& item : d) {
     const std::string key = py::str(item.first);
-    if (key != "contact" && key != "tangent" && key != "mu" && key != "velocity")
-      throw io::InputError(at + "." + key +
-                           ": unknown key (expected contact, tangent, mu, velocity)");
+    if (key != "contact" && key != "tangent" && key != "tangents" && key != "d" && key != "mu" &&
+        key != "velocity")
+      throw io::InputError(
+          at + "." + key +
+          ": unknown key (expected contact, tangent or tangents, d, mu, velocity)");
   }
+  if (d.contains("d") && !d.contains("tangents"))
+    throw io::InputError(at + ".d: applies to an entry with tangents (a planar contact is d = 1)");
   mech::FrictionalContact c;
   const py::object contact = d["contact"];
   if (py::isinstance<py::str>(contact)) {
@@ -60,7 +66,22 @@ mech::FrictionalContact frictional_contact(const py::handle& entry, std::size_t 
   } else {
     c.contact = contact.cast<int>();
   }
-  c.tangent = d["tangent"].cast<VectorXd>().sparseView();
+  if (d.contains("tangent")) {
+    c.tangent = d["tangent"].cast<VectorXd>().sparseView();
+  } else {  // the two rows of a 3-D contact (issue 27), checked by mech::check_model
+    const auto rows = d["tangents"].cast<std::vector<VectorXd>>();
+    if (rows.size() != 2)
+      throw io::InputError(at + ".tangents: expected two tangent rows (got " +
+                           std::to_string(rows.size()) + ")");
+    if (rows[1].size() == 0) throw io::InputError(at + ".tangents[1]: empty");
+    c.tangent = rows[0].sparseView();
+    c.tangent2 = rows[1].sparseView();
+    if (d.contains("d")) {
+      c.edges = d["d"].cast<int>();
+      if (c.edges < 1)
+        throw io::InputError(at + ".d: must be >= 1 (got " + std::to_string(c.edges) + ")");
+    }
+  }
   c.mu = d["mu"].cast<double>();
   if (d.contains("velocity")) c.velocity = d["velocity"].cast<double>();
   return c;
@@ -127,7 +148,8 @@ Omitted D, K, f, g and restitution are zero; names default to q1.., constraint n
 `initial` is a default state (q then v), `t_end` a default horizon (s).
 `friction` lists frictional contacts as dicts {contact: 0-based row of E or its name,
 tangent: N numbers, mu: >= 0, velocity: the surface's velocity along the tangent
-(optional, 0)}, as the YAML `friction:` list (docs/model-format.md).
+(optional, 0)}, or for a 3-D contact {contact, tangents: [t, t2], mu, d (optional, 4)},
+as the YAML `friction:` list (docs/model-format.md).
 Raises InputError (the library's message) when sizes disagree, M is not symmetric
 positive definite, a restitution lies outside [0, 1], ...)");
   c.def_static("lcs", &make_lcs, py::arg("A"), py::arg("B"), py::arg("C"), py::arg("D"),

@@ -128,6 +128,30 @@ void bind_results(py::module_& m) {
                   "Most negative E_J v+ (0 if none).");
   ir.def_readonly("admissible", &impact::ImpactResult::admissible,
                   "False when the result is not an admissible impact.");
+  ir.def_readonly("friction_impulse", &impact::ImpactResult::friction_impulse,
+                  "Friction impulse per constraint along its (first) tangent (N s); empty "
+                  "without friction.");
+  ir.def_readonly("friction_impulse2", &impact::ImpactResult::friction_impulse2,
+                  "Friction impulse per constraint along the second tangent of a 3-D contact "
+                  "(N s); empty unless the model has one.");
+  ir.def_property_readonly(
+      "friction_outcome",
+      [](const impact::ImpactResult& r) {
+        std::vector<std::string> out;
+        for (const auto o : r.outcome) out.emplace_back(impact::to_string(o));
+        return out;
+      },
+      "Per constraint: 'none', 'no-impulse', 'stick', 'slip+', 'slip-' or 'slip' (3-D).");
+  ir.def_property_readonly(
+      "friction_mode",
+      [](const impact::ImpactResult& r) {
+        std::vector<std::string> out;
+        for (size_t i = 0; i < r.facet.size(); ++i)
+          out.push_back(impact::cone_mode_text(r.outcome[i], r.facet[i]));
+        return out;
+      },
+      "Models with a 3-D contact, per constraint: 'open', 'stick', 'slip-edge-<i>' or "
+      "'slip-face-<i>' (the cone's facet that holds the friction impulse); empty otherwise.");
   py::class_<lcp::Result> lr(m, "LcpResult", "The solution of an LCP w = M z + q.");
   lr.def_property_readonly(
       "status",

@@ -69,6 +69,21 @@ nlohmann::json result_json(const mech::MechanicalModel& m, const Eigen::VectorXd
   j["friction_impulse"] = io::to_json(
       r.friction_impulse.size() ? r.friction_impulse : Eigen::VectorXd::Zero(m.num_constraints()));
   j["friction_outcome"] = outcome;
+  if (m.has_friction_3d()) {  // planar models' output unchanged
+    // The impulse along each 3-D contact's second tangent, and every
+    // frictional contact's mode with its cone facet (impact::cone_mode_text).
+    nlohmann::json mode = nlohmann::json::object();
+    for (const auto& fc : m.friction)
+      mode[m.constraints[fc.contact]] =
+          r.outcome.empty()
+              ? "open"
+              : impact::cone_mode_text(r.outcome[fc.contact],
+                                       r.facet.empty() ? impact::ConeFacet{} : r.facet[fc.contact]);
+    j["friction_impulse2"] =
+        io::to_json(r.friction_impulse2.size() ? r.friction_impulse2
+                                               : Eigen::VectorXd::Zero(m.num_constraints()));
+    j["friction_mode"] = mode;
+  }
   j["painleve"] = r.painleve;
   j["energy_gain"] = r.energy_gain;
   return j;

@@ -104,7 +104,13 @@ void print_table(const mech::Model& model, const app::ImpactsAtState& r) {
                 fmt_vec(res.v_after).c_str(), fmt_vec(res.impulse).c_str(),
                 mode_text(m, res.mode, ",").c_str(), res.energy_before, res.energy_after,
                 res.worst_rate, note.c_str());
-    if (m.has_friction() && res.friction_impulse.size())  // frictionless output unchanged
+    if (m.has_friction_3d() && res.friction_impulse2.size())  // planar output unchanged
+      for (const auto& fc : m.friction)
+        std::printf("%-19s friction at %s: P_T = (%.6g, %.6g), %s\n", "",
+                    m.constraints[fc.contact].c_str(), res.friction_impulse(fc.contact),
+                    res.friction_impulse2(fc.contact),
+                    impact::cone_mode_text(res.outcome[fc.contact], res.facet[fc.contact]).c_str());
+    else if (m.has_friction() && res.friction_impulse.size())  // frictionless output unchanged
       for (const auto& fc : m.friction)
         std::printf("%-19s friction at %s: P_T = %.6g, %s\n", "", m.constraints[fc.contact].c_str(),
                     res.friction_impulse(fc.contact), impact::to_string(res.outcome[fc.contact]));

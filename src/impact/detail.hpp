@@ -60,4 +60,12 @@ struct Refined {
 std::optional<Refined> refine_on_active_set(const Setup& s, const VectorXd& v,
                                             const VectorXd& e_target, const VectorXd& z);
 
+// Shared by the friction laws (friction.cpp, friction_cone.cpp): the
+// threshold of a positive normal impulse (rounding of the largest approach
+// rate through the diagonal of W), and the flag and message of an impact
+// that raised the kinetic energy beyond `surface_work`, the work of moving
+// surfaces (J; Kane's paradox, only restitution can cause it).
+double friction_mode_threshold(const Setup& s);
+void flag_friction_energy_gain(double surface_work, ImpactResult& out);
+
 }  // namespace lcsim::impact::detail

@@ -24,6 +24,8 @@ const char* to_string(ContactOutcome o) {
       return "slip+";
     case ContactOutcome::kSlipNegative:
       return "slip-";
+    case ContactOutcome::kSlip:
+      return "slip";
   }
   return "?";
 }
@@ -208,15 +210,6 @@ MatrixXd delassus(const detail::Setup& s, const ClosedFriction& c, const MatrixX
   return Wg;
 }
 
-// Mode threshold as moreau_newton's: rounding of the largest approach rate
-// through the diagonal of W.
-double mode_threshold(const detail::Setup& s) {
-  double tiny = 0.0;
-  for (Eigen::Index i = 0; i < s.W.rows(); ++i)
-    if (s.W(i, i) > 0.0) tiny = std::max(tiny, std::abs(s.a(i)) / s.W(i, i));
-  return tiny * kRelTol;
-}
-
 // Flags, and says in out.message, an impact that raised the kinetic energy
 // beyond the work of moving surfaces.
 void flag_energy_gain(const ClosedFriction& c, const VectorXd& lambda_T, ImpactResult& out) {
@@ -224,20 +217,15 @@ void flag_energy_gain(const ClosedFriction& c, const VectorXd& lambda_T, ImpactR
   // tangential rates; lambda_T (u_T+ - velocity) <= 0 and lambda_N u_N+ = 0
   // for e = 0, so beyond the work of moving surfaces on the body
   // (lambda_T' velocity, a belt) only restitution can make it positive.
-  // Beyond rounding: 1e-12 relative (a few hundred eps of the kinetic energy).
-  const double surface_work = c.velocity.dot(lambda_T);
-  if (out.energy_after - surface_work > out.energy_before * (1.0 + 1e-12) + 1e-300) {
-    out.energy_gain = true;
-    out.message = text("kinetic energy rose through the impact, ", out.energy_before, " -> ",
-                       out.energy_after,
-                       " J: Newton restitution with coupled normal and tangential "
-                       "directions (W_NT != 0) can create energy (Kane's paradox)");
-  }
+  detail::flag_friction_energy_gain(c.velocity.dot(lambda_T), out);
 }
 
 }  // namespace
 
 ImpactResult moreau_friction(const ImpactInput& in, const lcp::Solver& solver) {
+  // Two tangents somewhere: the general cone (planar contacts as d = 1);
+  // planar models keep this path and its numbers.
+  if (in.model != nullptr && in.model->has_friction_3d()) return moreau_friction_cone(in, solver);
   ImpactResult out;
   const auto s = detail::prepare(in, out, /*handles_friction=*/true);
   if (in.model != nullptr && out.v_after.size() == in.model->dofs()) {
@@ -274,12 +262,36 @@ ImpactResult moreau_friction(const ImpactInput& in, const lcp::Solver& solver) {
   VectorXd lambda_N, lambda_T;
   friction_impulses(*z, static_cast<int>(nj), c.normal_of, c.mu, lambda_N, lambda_T);
   const VectorXd v_after = in.v + s->MinvEt * lambda_N + MinvTt * lambda_T;
-  const double tiny = mode_threshold(*s);
+  const double tiny = detail::friction_mode_threshold(*s);
   detail::finish(in, *s, lambda_N, v_after, tiny, out);
   set_outcomes(m, in, c, lambda_N, lambda_T, tiny, out);
   out.status = Status::kOk;
   flag_energy_gain(c, lambda_T, out);
   return out;
 }
+
+namespace detail {
+
+// Rounding of the largest approach rate through the diagonal of W (as
+// moreau_newton's).
+double friction_mode_threshold(const Setup& s) {
+  double tiny = 0.0;
+  for (Eigen::Index i = 0; i < s.W.rows(); ++i)
+    if (s.W(i, i) > 0.0) tiny = std::max(tiny, std::abs(s.a(i)) / s.W(i, i));
+  return tiny * kRelTol;
+}
+
+void flag_friction_energy_gain(double surface_work, ImpactResult& out) {
+  // Beyond rounding: 1e-12 relative (a few hundred eps of the kinetic energy).
+  if (out.energy_after - surface_work > out.energy_before * (1.0 + 1e-12) + 1e-300) {
+    out.energy_gain = true;
+    out.message = text("kinetic energy rose through the impact, ", out.energy_before, " -> ",
+                       out.energy_after,
+                       " J: Newton restitution with coupled normal and tangential "
+                       "directions (W_NT != 0) can create energy (Kane's paradox)");
+  }
+}
+
+}  // namespace detail
 
 }  // namespace lcsim::impact

@@ -82,11 +82,17 @@ std::string model_yaml(const mech::Model& model, const std::string& header) {
   if (m.has_friction()) {
     out << "  friction:\n";
     for (const mech::FrictionalContact& c : m.friction)
-      out << "    - {contact: " << c.contact << ", tangent: " << list(VectorXd(c.tangent))
+      out << "    - {contact: " << c.contact
+          << (c.is_3d() ? ", tangents: [" + list(VectorXd(c.tangent)) + ", " +
+                              list(VectorXd(c.tangent2)) + "]" +
+                              (c.edges > 0 ? ", d: " + std::to_string(c.edges) : std::string())
+                        : ", tangent: " + list(VectorXd(c.tangent)))
           << ", mu: " << format_number(c.mu)
           << (c.velocity != 0.0 ? ", velocity: " + format_number(c.velocity) : std::string())
           << "}\n";
   }
+  if (m.cone_edges != mech::MechanicalModel::kDefaultConeEdges)
+    out << "  friction_d: " << m.cone_edges << "\n";
   out << "  coordinates: " << names(m.coordinates) << "\n";
   if (model.initial.size() > 0) out << "initial: " << list(model.initial) << "\n";
   if (std::isfinite(model.t_end)) out << "t_end: " << format_number(model.t_end) << "\n";

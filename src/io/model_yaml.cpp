@@ -139,8 +139,46 @@ std::vector<std::string> names(const YAML::Node& n, Eigen::Index size, const std
   return out;
 }
 
+// A cone's d (`friction_d`, an entry's `d`): a whole number in [1, kMaxConeEdges].
+constexpr double kMaxConeEdges = 1024;  // 2048 edges: far past any use (docs/friction.md)
+int cone_edges(const YAML::Node& n, const std::string& source, const std::string& key) {
+  const double x = number(n, source, key);
+  if (!(x >= 1.0 && x == std::floor(x) && x <= kMaxConeEdges))
+    fail(source, key,
+         "must be a whole number >= 1 and <= " + format_number(kMaxConeEdges) + " (got '" +
+             n.Scalar() + "')");
+  return static_cast<int>(x);
+}
+
+// An entry's tangent rows: `tangent: [N numbers]` (planar) or `tangents:
+// [[N numbers], [N numbers]]` with optional `d` (three-dimensional), never both.
+void parse_tangents(const Keys& keys, const std::string& source, const std::string& ikey,
+                    mech::FrictionalContact& c) {
+  if (keys.count("tangent") && keys.count("tangents"))
+    fail(source, ikey, "has both tangent and tangents (one tangent row is planar, two are 3-D)");
+  if (!keys.count("tangent") && !keys.count("tangents"))
+    fail(source, ikey + ".tangent", "missing (tangent: one row, or tangents: two rows)");
+  if (keys.count("tangent")) {
+    if (keys.count("d"))
+      fail(source, ikey + ".d", "applies to an entry with tangents: (a planar contact is d = 1)");
+    c.tangent = vector(keys.at("tangent"), source, ikey + ".tangent").sparseView();
+    return;
+  }
+  const YAML::Node& tn = keys.at("tangents");
+  if (!tn.IsSequence() || tn.size() != 2)
+    fail(source, ikey + ".tangents",
+         "expected two tangent rows [[...], [...]] (got " + describe(tn) + ")");
+  c.tangent = vector(tn[0], source, ikey + ".tangents[0]").sparseView();
+  c.tangent2 = vector(tn[1], source, ikey + ".tangents[1]").sparseView();
+  // An all-zero second row keeps its length: is_3d() holds and the check names it.
+  if (c.tangent2.size() == 0) fail(source, ikey + ".tangents[1]", "empty");
+  if (keys.count("d")) c.edges = cone_edges(keys.at("d"), source, ikey + ".d");
+}
+
 // `friction: [{contact: <0-based row of E or its name>, tangent: [N numbers],
-// mu: <number>, velocity: <number, optional>}]` (docs/model-format.md). Names resolve against the
+// mu: <number>, velocity: <number, optional>}]`, or with `tangents: [[N
+// numbers], [N numbers]]` and `d: <whole number, optional>` in place of
+// `tangent` for a 3-D contact (docs/model-format.md). Names resolve against the
 // model's constraint names, so this runs after fill_defaults; the sizes, ranges and duplicates are
 // mech::check_mechanical's.
 std::vector<mech::FrictionalContact> parse_friction(const YAML::Node& n,
@@ -152,8 +190,9 @@ std::vector<mech::FrictionalContact> parse_friction(const YAML::Node& n,
   std::vector<mech::FrictionalContact> out;
   for (std::size_t i = 0; i < n.size(); ++i) {
     const std::string ikey = key + "[" + std::to_string(i) + "]";
-    const Keys keys = mapping(n[i], source, ikey, {"contact", "tangent", "mu", "velocity"});
-    for (const char* k : {"contact", "tangent", "mu"})
+    const Keys keys =
+        mapping(n[i], source, ikey, {"contact", "tangent", "tangents", "d", "mu", "velocity"});
+    for (const char* k : {"contact", "mu"})
       if (!keys.count(k)) fail(source, ikey + "." + k, "missing");
     mech::FrictionalContact c;
     const YAML::Node& cn = keys.at("contact");
@@ -172,7 +211,7 @@ std::vector<mech::FrictionalContact> parse_friction(const YAML::Node& n,
              "no constraint named '" + text + "' (the constraints: " + join(m.constraints) + ")");
       c.contact = static_cast<int>(it - m.constraints.begin());
     }
-    c.tangent = vector(keys.at("tangent"), source, ikey + ".tangent").sparseView();
+    parse_tangents(keys, source, ikey, c);
     c.mu = number(keys.at("mu"), source, ikey + ".mu");
     if (keys.count("velocity"))
       c.velocity = number(keys.at("velocity"), source, ikey + ".velocity");
@@ -182,9 +221,9 @@ std::vector<mech::FrictionalContact> parse_friction(const YAML::Node& n,
 }
 
 mech::MechanicalModel parse_mechanical(const YAML::Node& node, const std::string& source) {
-  const Keys keys = mapping(
-      node, source, "mechanical",
-      {"M", "D", "K", "E", "g", "f", "restitution", "coordinates", "constraints", "friction"});
+  const Keys keys = mapping(node, source, "mechanical",
+                            {"M", "D", "K", "E", "g", "f", "restitution", "coordinates",
+                             "constraints", "friction", "friction_d"});
   const auto has = [&](const char* k) { return keys.count(k) > 0; };
   mech::MechanicalModel m;
   if (!has("M")) fail(source, "mechanical.M", "missing (the mass matrix is required)");
@@ -232,6 +271,8 @@ mech::MechanicalModel parse_mechanical(const YAML::Node& node, const std::string
   // k, so a model without constraints (E omitted or []) is complete as well.
   mech::fill_defaults(m);
   if (has("friction")) m.friction = parse_friction(keys.at("friction"), m, source);
+  if (has("friction_d"))
+    m.cone_edges = cone_edges(keys.at("friction_d"), source, "mechanical.friction_d");
   // What the file's structure did not already refuse: M symmetric positive
   // definite, restitution in [0, 1], finite entries, no all-zero row of E.
   if (auto p = mech::check_mechanical(m)) fail(source, p->field, p->what);

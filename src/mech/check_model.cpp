@@ -49,8 +49,72 @@ std::optional<std::string> non_finite_vector(const VectorXd& v) {
 // cheap enough for every run to repeat (Integrator::run checks the model).
 constexpr Eigen::Index kDenseMassCheckMax = 64;
 
+// A tangent row: length N, finite, not all zero. `key` is "tangent" or
+// "tangents[1]" (the second tangent of a 3-D contact).
+std::optional<ModelProblem> check_tangent(const Eigen::SparseVector<double>& t, Eigen::Index N,
+                                          const std::string& at) {
+  if (t.size() != N)
+    return ModelProblem{at, "expected " + std::to_string(N) + " entries (N = " + std::to_string(N) +
+                                " coordinates, from M) (got " + std::to_string(t.size()) + ")"};
+  double largest = 0.0;
+  for (Eigen::SparseVector<double>::InnerIterator it(t); it; ++it) {
+    if (!std::isfinite(it.value()))
+      return ModelProblem{at + "[" + std::to_string(it.index()) + "] = " + short_number(it.value()),
+                          "not finite"};
+    largest = std::max(largest, std::abs(it.value()));
+  }
+  if (!(largest > 0.0)) return ModelProblem{at, "all zero (it measures no sliding)"};
+  return std::nullopt;
+}
+
+// The cosine of the angle between a and b (Euclidean); both non-zero.
+double cosine(const Eigen::SparseVector<double>& a, const Eigen::SparseVector<double>& b) {
+  return a.dot(b) / (a.norm() * b.norm());
+}
+
+// A three-dimensional contact (FrictionalContact::is_3d): t2 checked as t,
+// d >= 0 (0: the model's default), no moving surface, and the normal row n,
+// t and t2 pairwise orthogonal with |t| = |t2| (Euclidean, to
+// kTangentOrthogonality): the cone's edges are at the angles pi i/d from t
+// in the plane of t and t2, which are angles only in an orthonormal frame
+// (up to a common scale, which scales mu as for a planar tangent). The
+// Euclidean metric, not M^-1's: W_NT = n M^-1 t' = 0 would forbid the
+// coupled contacts planar friction accepts (a rod's corner: sliding turns
+// the rod and moves the normal), and it depends on the masses, not on the
+// contact's geometry; for a matrix model in the contact point's Cartesian
+// coordinates the Euclidean test is the geometric one.
+std::optional<ModelProblem> check_friction_3d(const MechanicalModel& m, const FrictionalContact& c,
+                                              const std::string& at) {
+  const Eigen::Index N = m.M.rows();
+  if (auto p = check_tangent(c.tangent2, N, at + ".tangents[1]")) return p;
+  if (c.edges < 0)
+    return ModelProblem{at + ".d", "must be >= 1 (got " + std::to_string(c.edges) + ")"};
+  if (c.velocity != 0.0)
+    return ModelProblem{at + ".velocity", "a moving surface is planar only (got " +
+                                              short_number(c.velocity) + " with two tangents)"};
+  const Eigen::SparseVector<double> n = m.E.row(c.contact).transpose();
+  const std::string row = "the normal row E[" + std::to_string(c.contact) + "]";
+  const std::pair<std::string, double> pairs[] = {
+      {"tangents[0] and " + row, cosine(n, c.tangent)},
+      {"tangents[1] and " + row, cosine(n, c.tangent2)},
+      {"tangents[0] and tangents[1]", cosine(c.tangent, c.tangent2)}};
+  for (const auto& [which, cos] : pairs)
+    if (!(std::abs(cos) <= kTangentOrthogonality))
+      return ModelProblem{at + ".tangents", which + " are not orthogonal: cosine " +
+                                                short_number(cos) + ", more than " +
+                                                short_number(kTangentOrthogonality) +
+                                                " (Euclidean, in the model's coordinates)"};
+  const double n1 = c.tangent.norm(), n2 = c.tangent2.norm();
+  if (!(std::abs(n1 - n2) <= kTangentOrthogonality * n1))
+    return ModelProblem{at + ".tangents",
+                        "tangents[0] and tangents[1] must have equal lengths (got " +
+                            short_number(n1) + " and " + short_number(n2) +
+                            "): the cone's edges are at angles pi i/d"};
+  return std::nullopt;
+}
+
 // Frictional contacts: a row of E each, at most one per row, a finite
-// tangent row of length N, a finite mu >= 0.
+// tangent row of length N, a finite mu >= 0; 3-D ones check_friction_3d.
 std::optional<ModelProblem> check_friction(const MechanicalModel& m) {
   const Eigen::Index N = m.M.rows(), k = m.E.rows();
   std::vector<int> owner(static_cast<size_t>(k), -1);
@@ -68,26 +132,20 @@ std::optional<ModelProblem> check_friction(const MechanicalModel& m) {
                               "') already has friction (mechanical.friction[" +
                               std::to_string(owner[static_cast<size_t>(c.contact)]) + "])"};
     owner[static_cast<size_t>(c.contact)] = static_cast<int>(f);
-    if (c.tangent.size() != N)
-      return ModelProblem{at + ".tangent", "expected " + std::to_string(N) + " entries (N = " +
-                                               std::to_string(N) + " coordinates, from M) (got " +
-                                               std::to_string(c.tangent.size()) + ")"};
-    double largest = 0.0;
-    for (Eigen::SparseVector<double>::InnerIterator it(c.tangent); it; ++it) {
-      if (!std::isfinite(it.value()))
-        return ModelProblem{
-            at + ".tangent[" + std::to_string(it.index()) + "] = " + short_number(it.value()),
-            "not finite"};
-      largest = std::max(largest, std::abs(it.value()));
-    }
-    if (!(largest > 0.0)) return ModelProblem{at + ".tangent", "all zero (it measures no sliding)"};
+    if (auto p = check_tangent(c.tangent, N, at + (c.is_3d() ? ".tangents[0]" : ".tangent")))
+      return p;
     if (!std::isfinite(c.mu))
       return ModelProblem{at + ".mu", "not finite (got " + short_number(c.mu) + ")"};
     if (c.mu < 0.0)
       return ModelProblem{at + ".mu", "must be >= 0 (got " + short_number(c.mu) + ")"};
     if (!std::isfinite(c.velocity))
       return ModelProblem{at + ".velocity", "not finite (got " + short_number(c.velocity) + ")"};
+    if (c.is_3d())
+      if (auto p = check_friction_3d(m, c, at)) return p;
   }
+  if (m.cone_edges < 1)
+    return ModelProblem{"mechanical.friction_d",
+                        "must be >= 1 (got " + std::to_string(m.cone_edges) + ")"};
   return std::nullopt;
 }
 

@@ -22,6 +22,11 @@ void fill_defaults(MechanicalModel& m) {
     for (int i = 0; i < k; ++i) m.constraints.push_back("c" + std::to_string(i + 1));
 }
 
+bool MechanicalModel::has_friction_3d() const {
+  return std::any_of(friction.begin(), friction.end(),
+                     [](const FrictionalContact& c) { return c.is_3d(); });
+}
+
 lcs::Lcs to_lcs(const MechanicalModel& m) {
   const int n = m.dofs();
   const int k = m.num_constraints();

@@ -1,6 +1,7 @@
 // The one check of a run's input (sim::check_run): whatever calls an
 // integrator — the CLI, the Python module, a study, a user's program — goes
 // through Integrator::run and so through this.
+#include <algorithm>
 #include <cmath>
 #include <lcsim/core/format.hpp>
 #include <lcsim/impact/impact.hpp>
@@ -131,6 +132,27 @@ std::string refuse_friction(const mech::Model& model, std::string_view method,
                        : "use method " + with);
 }
 
+// A model with 3-D friction (two tangents) and a method that handles planar
+// friction only: refused, naming the methods that handle it (those whose
+// OptionsUsed::friction_3d is set) or, with none, the impact laws.
+std::string refuse_friction_3d(const mech::Model& model, std::string_view method,
+                               const OptionsUsed& used) {
+  if (used.friction_3d || !model.is_mechanical() || !model.mechanical->has_friction_3d()) return "";
+  const auto& fr = model.mechanical->friction;
+  const auto it = std::find_if(fr.begin(), fr.end(),
+                               [](const mech::FrictionalContact& c) { return c.is_3d(); });
+  std::string with;
+  for (const std::string& name : integrators().names())
+    if (auto integ = integrators().make(name); integ && integ->options_used().friction_3d)
+      with += (with.empty() ? "'" : ", '") + name + "'";
+  return "method '" + std::string(method) + "' does not yet handle 3-D friction (model '" +
+         model.name + "' has two tangents at mechanical.friction[" +
+         std::to_string(it - fr.begin()) + "]); " +
+         (with.empty() ? std::string("no simulation method handles it yet (the impact laws "
+                                     "'newton', 'inelastic' and 'moreau-restitution' do)")
+                       : "method " + with + " does");
+}
+
 // A method that applies an impact law to a model with friction: the law must
 // handle friction, else the run would fail at its first impact.
 std::string refuse_friction_law(const mech::Model& model, const Options& opt,
@@ -172,6 +194,8 @@ std::string check_run(const mech::Model& model, const VectorXd& x0, const Option
   if (used.needs_mechanical && !model.is_mechanical())
     return "method '" + std::string(method) + "' needs a mechanical model ('" + model.name +
            "' is a general LCS; the methods 'event' and 'euler' take one)";
+  // 3-D first: a planar refusal would name methods that refuse 3-D friction too.
+  if (std::string m = refuse_friction_3d(model, method, used); !m.empty()) return m;
   if (std::string m = refuse_friction(model, method, used); !m.empty()) return m;
   if (used.dense_lcs && model.lcs_state_size() > mech::kMaxDenseLcsState)
     return "method '" + std::string(method) +

@@ -12,6 +12,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace lcsim::impact {
@@ -27,8 +28,34 @@ enum class ContactOutcome {
   kStick,         // tangential velocity zero after the impact, |P_T| <= mu P_N
   kSlipPositive,  // slides along +t after the impact, P_T = -mu P_N
   kSlipNegative,  // slides along -t after the impact, P_T = +mu P_N
+  // A 3-D contact (mech::FrictionalContact::is_3d) slides after the impact;
+  // its friction impulse lies on the cone's boundary at ImpactResult::facet.
+  kSlip,
 };
-const char* to_string(ContactOutcome o);  // "none", "no-impulse", "stick", "slip+", "slip-"
+// "none", "no-impulse", "stick", "slip+", "slip-", "slip"
+const char* to_string(ContactOutcome o);
+
+// Where a sliding 3-D contact's friction acts on its polyhedral cone of 2d
+// edges (edge i at the angle pi i/d from the first tangent): on edge i, or
+// on the face between edges i and i+1 (mod 2d), the one of maximal
+// dissipation (the force F of the polygon minimising F.u for the sliding
+// velocity u). edge = -1: none (not sliding, or planar).
+struct ConeFacet {
+  int edge = -1;
+  bool face = false;
+};
+// The facet of maximal dissipation for the sliding velocity u = (u1, u2)
+// along (t, t2), u != 0: the edge i minimising D_i.u, D_i = (cos, sin)(pi i/d);
+// the face (i, i+1) when its neighbour ties to 1e-9 |u| (u within about
+// 1e-9 / sin(pi/d) rad of the face's bisector, rounding of a velocity that
+// is on it).
+ConeFacet cone_facet(double u1, double u2, int d);
+// A 3-D contact's mode as outputs write it: "open" (kNone, kNoImpulse),
+// "stick", "slip-edge-<i>" or "slip-face-<i>" (between edges i and i+1).
+std::string cone_mode_text(ContactOutcome o, ConeFacet facet);
+// The direction (cos, sin)(pi i/d) of edge i, exact where it is a multiple
+// of pi/2 (cos(pi) = -1, sin(pi) = 0, not 1.2e-16).
+std::pair<double, double> cone_edge(int i, int d);
 
 // kOk when computed; the message says why not.
 struct ImpactResult : OutcomeStartingAs<Status::kNumericalFailure> {
@@ -52,6 +79,11 @@ struct ImpactResult : OutcomeStartingAs<Status::kNumericalFailure> {
   // tangent row; 0 without friction) and the outcome per constraint (k).
   VectorXd friction_impulse;
   std::vector<ContactOutcome> outcome;
+  // Models with 3-D friction (mech::MechanicalModel::has_friction_3d; empty
+  // otherwise): the friction impulse along the second tangent (k, N s) and
+  // the cone's facet of each sliding 3-D contact (k).
+  VectorXd friction_impulse2;
+  std::vector<ConeFacet> facet;
   // Painlevé-type case: some closed frictional contact has W_NN - mu |W_NT|
   // <= 0; the impact LCP then may have no solution or several, so no
   // result is computed (ok = false, message names the contact).
@@ -114,6 +146,25 @@ ImpactResult moreau_newton(const ImpactInput& in, const lcp::Solver& solver);
 // Painlevé-type cases (ImpactResult::painleve) and flags a gain of energy
 // (ImpactResult::energy_gain; impossible for e = 0).
 ImpactResult moreau_friction(const ImpactInput& in, const lcp::Solver& solver);
+
+// The same law on a model with 3-D friction (has_friction_3d; moreau_friction
+// comes here for one): one LCP in Stewart and Trinkle's form with, per closed
+// frictional contact f with d edges-pairs (planar: d = 1, edges +t and -t),
+// the normal impulse lambda_N, an impulse beta_i >= 0 on each of the 2d
+// edges D_i = cos(pi i/d) t + sin(pi i/d) t2, and the slack xi (the sliding
+// speed in the polygon's dual norm, max_i -D_i.u+):
+//   0 <= u_N+ + e u_N-                  ⟂ lambda_N >= 0
+//   0 <= D_i.v+ - velocity_i + xi       ⟂ beta_i >= 0
+//   0 <= mu lambda_N - sum_i beta_i     ⟂ xi >= 0
+// with v+ = v + M^{-1} (E_J' lambda_N + sum D_i' beta_i). The friction impulse
+// sum beta_i D_i lies in the cone and, when the contact slides, on the edges
+// most opposed to the sliding (maximal dissipation over the polygon); it
+// does work -xi mu lambda_N <= 0. On a planar model it is the planar law
+// with four unknowns in place of three (the same numbers to rounding,
+// tests/impact/friction3d_test.cpp). Painlevé: the single-contact test
+// W_NN - mu max_i |W_N D_i| <= 0, and the P-matrix test over one edge per
+// contact while there are at most 256 such choices.
+ImpactResult moreau_friction_cone(const ImpactInput& in, const lcp::Solver& solver);
 
 // The friction LCP above from its data, for the impact law and the
 // time-stepping methods: Wg = G M^{-1} G' (n_N + n_F square, normal rows

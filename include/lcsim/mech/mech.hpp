@@ -43,6 +43,18 @@ struct FrictionalContact {
   double velocity = 0.0;
   // The sliding velocity at generalised velocity v.
   double sliding(const VectorXd& v) const { return tangent.dot(v) - velocity; }
+  // Coulomb friction in three dimensions (issue 27; docs/friction.md): a
+  // second tangent row t2 (length N; empty for a planar contact, whose
+  // friction acts along `tangent` alone) and the cone's edge count d: the
+  // friction impulse lies in the polyhedral cone whose 2d edges are
+  // mu P_N (cos(pi i/d) t + sin(pi i/d) t2), i = 0 .. 2d-1, inscribed in the
+  // circular cone. t and t2 are orthogonal to the normal row and to each
+  // other, of equal length (Euclidean, check_mechanical). d = 0 takes the
+  // model's default (MechanicalModel::cone_edges). A planar contact is
+  // the case d = 1 (edges +t and -t).
+  Eigen::SparseVector<double> tangent2;
+  int edges = 0;  // d >= 1, or 0 for the model's default
+  bool is_3d() const { return tangent2.size() > 0; }
 
   FrictionalContact() = default;
   // A dense tangent is stored without its zeros.
@@ -66,7 +78,18 @@ struct MechanicalModel {
   std::vector<std::string> constraints;  // names (k); "c1".. if omitted
   // Frictional contacts, at most one per row of E (empty: frictionless model).
   std::vector<FrictionalContact> friction;
+  // The default d of three-dimensional contacts (FrictionalContact::edges =
+  // 0): 2d = 8 edges, whose cone's worst-case deceleration is cos(pi/8) =
+  // 0.924 of the circular cone's (docs/friction.md, "The cone's error").
+  int cone_edges = kDefaultConeEdges;
+  static constexpr int kDefaultConeEdges = 4;
   bool has_friction() const { return !friction.empty(); }
+  // Whether some frictional contact has two tangents (FrictionalContact::is_3d).
+  bool has_friction_3d() const;
+  // d of frictional contact f: 1 when planar, else its own or cone_edges.
+  int edges_of(const FrictionalContact& c) const {
+    return !c.is_3d() ? 1 : (c.edges > 0 ? c.edges : cone_edges);
+  }
   int dofs() const { return static_cast<int>(M.rows()); }
   int num_constraints() const { return static_cast<int>(E.rows()); }
 };
@@ -143,9 +166,16 @@ struct ModelProblem {
 // or LDL' pivot above 64 coordinates, above N eps of the largest),
 // restitution in [0, 1], no all-zero row of E, frictional contacts naming
 // distinct rows of E with a finite tangent row of length N and a finite
-// mu >= 0, an initial state of the right size and a finite t_end > 0 when
+// mu >= 0 (three-dimensional ones: t2 as t, d >= 0, cone_edges >= 1, no
+// velocity, and t, t2 and the normal row pairwise orthogonal with |t| = |t2|
+// to kTangentOrthogonality), an initial state of the right size and a finite t_end > 0 when
 // set. nullopt when usable.
 std::optional<ModelProblem> check_model(const Model& model);
+// Relative tolerance of the orthogonality of a 3-D contact's rows: |a.b| <=
+// this |a| |b| (Euclidean, in the model's coordinates), and ||t| - |t2|| <=
+// this |t|. Rows typed with 16 digits pass; 0.7071 for 1/sqrt(2) does not
+// (an angle of 1e-5 rad would let friction work on the normal at that order).
+inline constexpr double kTangentOrthogonality = 1e-9;
 std::optional<ModelProblem> check_mechanical(const MechanicalModel& m);
 std::optional<ModelProblem> check_lcs(const lcs::Lcs& s);
 std::optional<ModelProblem> check_mass_matrix(const SparseMatrix& M);

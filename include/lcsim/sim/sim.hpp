@@ -240,6 +240,10 @@ struct OptionsUsed {
   bool friction = false;
   // The method computes Options::sensitivity (the exact method).
   bool sensitivity = false;
+  // The method also handles 3-D contacts (two tangents, a polyhedral cone:
+  // mech::FrictionalContact::is_3d, issue 27); a method with friction but
+  // not this refuses a model that has one (check_run).
+  bool friction_3d = false;
 };
 
 // "" when `opt.sensitivity` is empty or asks what the model and the method

@@ -1,0 +1,315 @@
+// Coulomb friction in three dimensions at an impact (issue 27): the
+// polyhedral cone of Stewart and Trinkle (an inscribed pyramid of 2d edges)
+// as one LCP with Moreau's LCP (3.69)-(3.70) on the normals and Newton's
+// restitution on the approaching normals, as the planar law (friction.cpp,
+// thesis §2.5.3); see impact.hpp, moreau_friction_cone.
+#include <algorithm>
+#include <cmath>
+#include <lcsim/core/format.hpp>
+#include <lcsim/impact/impact.hpp>
+#include <limits>
+
+#include "impact/detail.hpp"
+
+namespace lcsim::impact {
+
+std::pair<double, double> cone_edge(int i, int d) {
+  // Angle pi i/d = (2i/d) pi/2: exact at the quarter turns.
+  if ((2 * i) % d == 0) {
+    switch (((2 * i) / d) % 4) {
+      case 0:
+        return {1.0, 0.0};
+      case 1:
+        return {0.0, 1.0};
+      case 2:
+        return {-1.0, 0.0};
+      default:
+        return {0.0, -1.0};
+    }
+  }
+  const double a = std::acos(-1.0) * i / d;
+  return {std::cos(a), std::sin(a)};
+}
+
+ConeFacet cone_facet(double u1, double u2, int d) {
+  const int n = 2 * d;
+  const auto along = [&](int i) {
+    const auto [c, s] = cone_edge(((i % n) + n) % n, d);
+    return c * u1 + s * u2;
+  };
+  int best = 0;
+  for (int i = 1; i < n; ++i)
+    if (along(i) < along(best)) best = i;
+  const double speed = std::hypot(u1, u2);
+  const int prev = (best + n - 1) % n, next = (best + 1) % n;
+  ConeFacet f{best, false};
+  // Ties to rounding of a velocity on the face's bisector (cone_facet's comment).
+  if (along(next) - along(best) <= 1e-9 * speed)
+    f.face = true;
+  else if (along(prev) - along(best) <= 1e-9 * speed)
+    f = ConeFacet{prev, true};
+  // d = 1: the polygon is a segment with two sides, faces 0 and 1 (outward
+  // normals +t2 and -t2); the one opposing u.
+  if (f.face && d == 1) f.edge = u2 > 0 ? 1 : 0;
+  return f;
+}
+
+std::string cone_mode_text(ContactOutcome o, ConeFacet facet) {
+  switch (o) {
+    case ContactOutcome::kStick:
+      return "stick";
+    case ContactOutcome::kSlip:
+      return (facet.face ? "slip-face-" : "slip-edge-") + std::to_string(facet.edge);
+    case ContactOutcome::kSlipPositive:
+    case ContactOutcome::kSlipNegative:
+      return to_string(o);
+    default:
+      return "open";
+  }
+}
+
+namespace {
+
+// The closed frictional contacts: normal row in J, index in model.friction,
+// d, first edge row, the edge rows D (n_E x N), mu, the surfaces' velocity
+// along each edge (cos(pi i/d) times a planar contact's belt velocity).
+struct ClosedCone {
+  std::vector<int> normal_of, index, d, first;
+  MatrixXd D;
+  VectorXd mu, edge_velocity;
+  Eigen::Index edges() const { return D.rows(); }
+};
+
+ClosedCone closed_cone(const mech::MechanicalModel& m, const IndexSet& closed) {
+  ClosedCone c;
+  int ne = 0;
+  for (size_t f = 0; f < m.friction.size(); ++f) {
+    const auto it = std::lower_bound(closed.begin(), closed.end(), m.friction[f].contact);
+    if (it == closed.end() || *it != m.friction[f].contact) continue;
+    c.normal_of.push_back(static_cast<int>(it - closed.begin()));
+    c.index.push_back(static_cast<int>(f));
+    c.d.push_back(m.edges_of(m.friction[f]));
+    c.first.push_back(ne);
+    ne += 2 * c.d.back();
+  }
+  const Eigen::Index nf = static_cast<Eigen::Index>(c.index.size());
+  c.D.resize(ne, m.dofs());
+  c.mu.resize(nf);
+  c.edge_velocity.resize(ne);
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    const size_t fs = static_cast<size_t>(f);
+    const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(c.index[fs])];
+    const VectorXd t1 = VectorXd(fc.tangent);
+    const VectorXd t2 = fc.is_3d() ? VectorXd(fc.tangent2) : VectorXd::Zero(m.dofs());
+    for (int i = 0; i < 2 * c.d[fs]; ++i) {
+      const auto [cs, sn] = cone_edge(i, c.d[fs]);
+      c.D.row(c.first[fs] + i) = (cs * t1 + sn * t2).transpose();
+      c.edge_velocity(c.first[fs] + i) = cs * fc.velocity;
+    }
+    c.mu(f) = fc.mu;
+  }
+  return c;
+}
+
+// Stewart and Trinkle's LCP (impact.hpp) from Wb = B M^-1 B', B = [E_J; D].
+FrictionLcp cone_lcp(const MatrixXd& Wb, const VectorXd& rate_N, const VectorXd& rate_D,
+                     const ClosedCone& c) {
+  const Eigen::Index nn = rate_N.size(), ne = rate_D.size(), nf = c.mu.size();
+  const Eigen::Index n = nn + ne + nf;
+  FrictionLcp out;
+  out.M = MatrixXd::Zero(n, n);
+  out.q = VectorXd::Zero(n);
+  out.M.topLeftCorner(nn + ne, nn + ne) = Wb;
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    const size_t fs = static_cast<size_t>(f);
+    out.M(nn + ne + f, c.normal_of[fs]) = c.mu(f);
+    for (int i = 0; i < 2 * c.d[fs]; ++i) {
+      out.M(nn + c.first[fs] + i, nn + ne + f) = 1.0;
+      out.M(nn + ne + f, nn + c.first[fs] + i) = -1.0;
+    }
+  }
+  out.q.head(nn) = rate_N;
+  out.q.segment(nn, ne) = rate_D;
+  return out;
+}
+
+// Solves the cone's LCP: impact::solve_friction_lcp, and where its row-scaled
+// acceptance refuses, Lemke's z accepted on the natural residual relative to
+// the whole problem: 0 <= z, w = M z + q >= -tol, |z_i w_i| <= tol |z|_inf
+// with tol = 1e-12 (|q|_inf + |M|_inf |z|_inf). The row-scaled test measures
+// a row against its own terms, and the row of an edge orthogonal to the
+// velocity (sticking with the velocity along an edge or a bisector) is
+// formed of products cos(pi/2) |D||v| ~ 1e-17: its rounding, 1e-16, is
+// then 30% of its terms although it is 1e-16 of the problem's.
+lcp::Result solve_cone_lcp(const FrictionLcp& p, const lcp::Solver& solver, int* solves,
+                           std::string* tried) {
+  lcp::Result res = solve_friction_lcp(p, solver, solves, tried);
+  if (res.ok()) return res;
+  lcp::Options opt;
+  lcp::Result r = lcp::make_solver("lemke")->solve(p.M, p.q, opt);
+  if (solves) ++*solves;
+  if (tried) *tried += ", lemke (natural residual)";
+  if (r.z.size() != p.q.size() || !r.z.allFinite()) return res;
+  r.z = r.z.cwiseMax(0.0);
+  const VectorXd w = p.M * r.z + p.q;
+  const double zmax = r.z.cwiseAbs().maxCoeff();
+  const double tol =
+      1e-12 * (p.q.cwiseAbs().maxCoeff() + p.M.cwiseAbs().rowwise().sum().maxCoeff() * zmax);
+  for (Eigen::Index i = 0; i < w.size(); ++i)
+    if (w(i) < -tol || std::abs(w(i) * r.z(i)) > tol * zmax) return res;
+  r.status = lcp::Status::kSolved;
+  r.message.clear();
+  return r;
+}
+
+// Painlevé-type cases (friction.cpp's painleve, with one edge per contact in
+// place of one sign): a contact alone with W_NN - mu max_i |W_N D_i| <= 0,
+// then the normal matrix W_NN + sum_f mu_f W_N D_(i_f) e_f' over every
+// choice of edges i_f while there are at most kMaxPatterns choices and
+// kMaxPatternNormals closed contacts. "" when there is none.
+constexpr long kMaxPatterns = 256, kMaxPatternNormals = 12;
+
+std::string cone_painleve(const mech::MechanicalModel& m, const IndexSet& closed,
+                          const ClosedCone& c, const MatrixXd& W, const MatrixXd& WND) {
+  const std::string tail =
+      "; the friction impact LCP may have no solution or several (not resolved)";
+  long patterns = 1;
+  for (size_t f = 0; f < c.index.size(); ++f) {
+    const int j = c.normal_of[f], n = 2 * c.d[f];
+    Eigen::Index worst = 0;
+    const double w = WND.row(j).segment(c.first[f], n).cwiseAbs().maxCoeff(&worst);
+    const double mu = c.mu(static_cast<Eigen::Index>(f)), coef = W(j, j) - mu * w;
+    patterns = std::min(patterns * n, kMaxPatterns + 1);
+    // Relative to the terms that form it: below that it is zero to rounding.
+    if (coef > 1e-12 * (W(j, j) + mu * w)) continue;
+    const int row = closed[static_cast<size_t>(j)];
+    return text("Painlevé-type case at contact ", row, " ('", m.constraints[row],
+                "'): W_NN - mu max_i |W_N D_i| = ", W(j, j), " - ", mu, " * ", w, " = ", coef,
+                " <= 0, so friction on the edge ", static_cast<int>(worst),
+                " or its opposite presses the contact shut", tail);
+  }
+  if (c.index.empty() || patterns > kMaxPatterns || W.rows() > kMaxPatternNormals ||
+      (c.index.size() == 1 && W.rows() == 1))
+    return "";
+  for (long p = 0; p < patterns; ++p) {
+    MatrixXd Ns = W;
+    std::string which;
+    long rest = p;
+    for (size_t f = 0; f < c.index.size(); ++f) {
+      const int n = 2 * c.d[f], i = static_cast<int>(rest % n);
+      rest /= n;
+      Ns.col(c.normal_of[f]) += c.mu(static_cast<Eigen::Index>(f)) * WND.col(c.first[f] + i);
+      which += text(" ", closed[static_cast<size_t>(c.normal_of[f])], " (edge ", i, ")");
+    }
+    if (lcp::is_p_matrix(Ns)) continue;
+    return "Painlevé-type case at contacts" + which +
+           ": with friction on these edges the normal matrix W_NN + W_ND diag(mu) is not a "
+           "P-matrix" +
+           tail;
+  }
+  return "";
+}
+
+// The friction impulse along t and t2 of contact f from its edge impulses.
+std::pair<double, double> tangential(const ClosedCone& c, size_t f, const VectorXd& beta) {
+  double p1 = 0.0, p2 = 0.0;
+  for (int i = 0; i < 2 * c.d[f]; ++i) {
+    const auto [cs, sn] = cone_edge(i, c.d[f]);
+    p1 += cs * beta(c.first[f] + i);
+    p2 += sn * beta(c.first[f] + i);
+  }
+  return {p1, p2};
+}
+
+// Impulses, outcomes and facets per constraint; planar contacts as
+// friction.cpp's set_outcomes (stick, slip+, slip-), 3-D ones stick or slip
+// with cone_facet of the post-impact sliding velocity.
+void set_cone_outcomes(const mech::MechanicalModel& m, const ImpactInput& in, const ClosedCone& c,
+                       const VectorXd& lambda_N, const VectorXd& beta, double tiny,
+                       ImpactResult& out) {
+  for (size_t f = 0; f < c.index.size(); ++f) {
+    const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(c.index[f])];
+    const auto row = static_cast<size_t>(fc.contact);
+    std::tie(out.friction_impulse(fc.contact), out.friction_impulse2(fc.contact)) =
+        tangential(c, f, beta);
+    if (!(lambda_N(c.normal_of[f]) > tiny)) {
+      out.outcome[row] = ContactOutcome::kNoImpulse;
+      continue;
+    }
+    const VectorXd vv = in.v.cwiseAbs() + out.v_after.cwiseAbs();
+    const double u1 = fc.tangent.dot(out.v_after) - fc.velocity;
+    const double u2 = fc.is_3d() ? fc.tangent2.dot(out.v_after) : 0.0;
+    // Zero to rounding: the terms of t'v+ and t'v-, as friction.cpp's.
+    double scale = fc.tangent.cwiseAbs().dot(vv) + std::abs(fc.velocity);
+    if (fc.is_3d()) scale += fc.tangent2.cwiseAbs().dot(vv);
+    if (std::hypot(u1, u2) <= mech::zero_tolerance(scale))
+      out.outcome[row] = ContactOutcome::kStick;
+    else if (!fc.is_3d())
+      out.outcome[row] = u1 > 0 ? ContactOutcome::kSlipPositive : ContactOutcome::kSlipNegative;
+    else {
+      out.outcome[row] = ContactOutcome::kSlip;
+      out.facet[row] = cone_facet(u1, u2, c.d[f]);
+    }
+  }
+}
+
+// The work of moving surfaces on the body (J): planar contacts' belts.
+double surface_work(const mech::MechanicalModel& m, const ClosedCone& c, const ImpactResult& out) {
+  double w = 0.0;
+  for (size_t f = 0; f < c.index.size(); ++f) {
+    const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(c.index[f])];
+    w += fc.velocity * out.friction_impulse(fc.contact);
+  }
+  return w;
+}
+
+}  // namespace
+
+ImpactResult moreau_friction_cone(const ImpactInput& in, const lcp::Solver& solver) {
+  ImpactResult out;
+  const auto s = detail::prepare(in, out, /*handles_friction=*/true);
+  if (in.model != nullptr && out.v_after.size() == in.model->dofs()) {
+    const int k = in.model->num_constraints();
+    out.friction_impulse = out.friction_impulse2 = VectorXd::Zero(k);
+    out.outcome.assign(static_cast<size_t>(k), ContactOutcome::kNone);
+    out.facet.assign(static_cast<size_t>(k), ConeFacet{});
+  }
+  if (!s) return out;
+  const mech::MechanicalModel& m = *in.model;
+  const ClosedCone c = closed_cone(m, in.closed);
+  const Eigen::Index nj = s->W.rows(), ne = c.edges();
+  MatrixXd MinvDt = c.D.transpose();
+  s->L.triangularView<Eigen::Lower>().solveInPlace(MinvDt);
+  s->L.transpose().triangularView<Eigen::Upper>().solveInPlace(MinvDt);
+  MatrixXd Wb(nj + ne, nj + ne);
+  Wb.topLeftCorner(nj, nj) = s->W;
+  Wb.topRightCorner(nj, ne) = s->EJ * MinvDt;
+  Wb.bottomLeftCorner(ne, nj) = Wb.topRightCorner(nj, ne).transpose();
+  Wb.bottomRightCorner(ne, ne) = c.D * MinvDt;
+  if (std::string p = cone_painleve(m, in.closed, c, s->W, Wb.topRightCorner(nj, ne)); !p.empty()) {
+    out.painleve = true;
+    out.message = p;
+    return out;
+  }
+  const VectorXd rate_N = s->a + s->e_J.cwiseProduct(s->a.cwiseMin(0.0));
+  const FrictionLcp lcp = cone_lcp(Wb, rate_N, c.D * in.v - c.edge_velocity, c);
+  std::string tried;
+  const lcp::Result res = solve_cone_lcp(lcp, solver, &out.lcp_solves, &tried);
+  out.lcp_status = res.status;
+  if (!res.ok()) {
+    out.message = "friction impact LCP failed (" + tried +
+                  "): " + std::string(lcp::to_string(res.status, "solved")) +
+                  (res.message.empty() ? "" : " (" + res.message + ")");
+    return out;
+  }
+  const VectorXd lambda_N = res.z.head(nj), beta = res.z.segment(nj, ne);
+  const VectorXd v_after = in.v + s->MinvEt * lambda_N + MinvDt * beta;
+  const double tiny = detail::friction_mode_threshold(*s);
+  detail::finish(in, *s, lambda_N, v_after, tiny, out);
+  set_cone_outcomes(m, in, c, lambda_N, beta, tiny, out);
+  out.status = Status::kOk;
+  detail::flag_friction_energy_gain(surface_work(m, c, out), out);
+  return out;
+}
+
+}  // namespace lcsim::impact

@@ -1,0 +1,50 @@
+// Three-dimensional friction (issue 27) in the simulation methods: none
+// integrates it yet (the impact laws do), so every method refuses a model
+// with a two-tangent contact by one input-error line naming the entry (the
+// methods without friction too: they refuse friction of any kind).
+#include <gtest/gtest.h>
+
+#include <lcsim/mech/mech.hpp>
+#include <lcsim/sim/sim.hpp>
+#include <string>
+
+namespace lcsim {
+namespace {
+
+// A point mass (x, y, z) resting on the floor z >= 0 under gravity, sliding
+// along x with mu = 0.3, d = 4.
+mech::Model block3d() {
+  mech::MechanicalModel m;
+  m.M = Eigen::MatrixXd::Identity(3, 3).sparseView();
+  m.E = Eigen::RowVector3d(0, 0, 1).sparseView();
+  m.f = Eigen::Vector3d(0, 0, -9.81);
+  mech::FrictionalContact c(0, Eigen::Vector3d(1, 0, 0), 0.3);
+  c.tangent2 = Eigen::Vector3d(0, 1, 0).sparseView();
+  m.friction.push_back(c);
+  return mech::model_of(m, "block3d");
+}
+
+TEST(Friction3dRefusal, EveryMethodRefusesAModelWithTwoTangents) {
+  const mech::Model model = block3d();
+  ASSERT_FALSE(mech::check_model(model));
+  const Eigen::VectorXd x0 = (Eigen::VectorXd(6) << 0, 0, 0, 1, 0, 0).finished();
+  sim::Options o;
+  o.t_end = 0.1;
+  int refused = 0;
+  for (const std::string& name : sim::integrators().names()) {
+    const sim::Trajectory tr = sim::make_integrator(name)->run(model, x0, o);
+    EXPECT_EQ(tr.status, Status::kInvalidInput) << name;
+    // Every method, with friction or not: the 3-D refusal comes first (the
+    // planar one would name 'event' and 'moreau-jean', which refuse it too).
+    EXPECT_EQ(tr.message, "method '" + name +
+                              "' does not yet handle 3-D friction (model 'block3d' has two "
+                              "tangents at mechanical.friction[0]); no simulation method handles "
+                              "it yet (the impact laws 'newton', 'inelastic' and "
+                              "'moreau-restitution' do)");
+    ++refused;
+  }
+  EXPECT_GE(refused, 3);  // 'event', 'euler', 'moreau-jean' at least
+}
+
+}  // namespace
+}  // namespace lcsim
