@@ -49,12 +49,15 @@ struct SimulateArgs {
 std::string fmt_vec(const Eigen::VectorXd& v) { return "(" + number_list(v, 10) + ")"; }
 
 // "{0 hook, 1 wall}": index and name of each constraint of a mechanical
-// model; "{0,1}" for an LCS (its complementarity pairs have no names).
+// model or of an LCS that names its pairs (a circuit's diodes); "{0,1}" for
+// an LCS without names.
 std::string fmt_set(const mech::Model& model, const std::vector<int>& s) {
+  const bool named = model.is_mechanical() || !model.pair_names.empty();
   std::string r = "{";
   for (size_t i = 0; i < s.size(); ++i) {
-    r += (i ? (model.is_mechanical() ? ", " : ",") : "") + std::to_string(s[i]);
+    r += (i ? (named ? ", " : ",") : "") + std::to_string(s[i]);
     if (model.is_mechanical()) r += " " + model.mechanical->constraints[s[i]];
+    if (!model.is_mechanical() && named) r += " " + model.pair_names[s[i]];
   }
   return r + "}";
 }
