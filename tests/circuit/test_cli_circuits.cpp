@@ -35,10 +35,10 @@ TEST(CliCircuits, SimulateWritesVoltagesAndCurrentsByName) {
 TEST(CliCircuits, RefusedNetlistExitsTwoAndWritesNothing) {
   const auto cir = private_temp("bad", ".cir"), csv = private_temp("bad", ".csv"),
              err = private_temp("bad", ".err");
-  { std::ofstream(cir) << "title\nV1 a 0 1\nR1 a 0 1k\nC1 a b 10q\nR2 b 0 1k\n"; }
+  { std::ofstream(cir) << "title\nV1 a 0 1\nR1 a 0 1k\nC1 a b x10\nR2 b 0 1k\n"; }
   const auto r = run_lcsim("simulate '" + cir.string() + "' --out '" + csv.string() + "'", err);
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_EQ(r.err, "lcsim: error: " + cir.string() + ":4: C1: non-numeric value '10q'\n");
+  EXPECT_EQ(r.err, "lcsim: error: " + cir.string() + ":4: C1: non-numeric value 'x10'\n");
   EXPECT_FALSE(std::filesystem::exists(csv));
   std::filesystem::remove(cir);
 }
