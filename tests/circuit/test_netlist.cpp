@@ -150,3 +150,48 @@ TEST(Netlist, OperatingPointSolvesTheDiodes) {
 
 }  // namespace
 }  // namespace lcsim
+
+namespace lcsim {
+namespace {
+
+// The linear controlled sources against values by hand, at the operating
+// point (no diodes: the outputs are output_x times the initial state).
+TEST(Netlist, ControlledSourcesByHand) {
+  const char* text = R"(controlled sources
+V1 in 0 2
+R1 in 0 1k
+E1 e 0 in 0 3
+Re e 0 1k
+G1 0 g in 0 1m
+Rg g 0 1k
+F1 0 f V1 2
+Rf f 0 1k
+H1 h 0 V1 500
+Rh h 0 1k
+R2 in c 1k
+C1 c 0 1u
+)";
+  const circuit::Circuit c = parse_circuit(text, "ctl.cir");
+  const mech::Model& m = c.model;
+  const auto value = [&](const std::string& name) {
+    for (std::size_t i = 0; i < m.output_names.size(); ++i)
+      if (m.output_names[i] == name) return (m.output_x.row(i) * m.initial)(0);
+    ADD_FAILURE() << "no output " << name;
+    return 0.0;
+  };
+  // I(V1): the current entering V1's + terminal, -2 mA (R1 draws 2 mA; C1
+  // draws none at the operating point). E: 3 * 2 V; G: 1 mS * 2 V into g
+  // (its current flows from n+ = 0 through it to n- = g); F: 2 * I(V1) from
+  // 0 into f; H: 500 ohm * I(V1). Rounding only: 1e-12.
+  EXPECT_NEAR(value("I(V1)"), -2e-3, 1e-15);
+  EXPECT_NEAR(value("V(e)"), 6.0, 1e-12);
+  EXPECT_NEAR(value("V(g)"), 2.0, 1e-12);
+  EXPECT_NEAR(value("V(f)"), -4.0, 1e-12);
+  EXPECT_NEAR(value("V(h)"), -1.0, 1e-12);
+  EXPECT_NEAR(value("V(c)"), 2.0, 1e-12);
+  EXPECT_NEAR(value("I(G1)"), 2e-3, 1e-15);
+  EXPECT_NEAR(value("I(F1)"), -4e-3, 1e-15);
+}
+
+}  // namespace
+}  // namespace lcsim
