@@ -93,10 +93,10 @@ VectorXd initial_state(const Circuit& c, std::string& note) {
         states += (states.empty() ? "" : ", ") + c.model.state_names[R[i]];
     throw InputError(net.source +
                      ": operating point: the DC equations (capacitors open, inductors "
-                     "shorted) do not determine " +
+                     "shorted) have no unique solution for " +
                      states +
-                     " (a capacitor without a DC path, or a loop of inductors): give .ic values "
-                     "or use `.tran ... uic`");
+                     " (a capacitor without a DC path, a loop of inductors, or an inductor "
+                     "across a voltage that .ic holds): give .ic values or use `.tran ... uic`");
   }
   const VectorXd T = nr > 0 ? VectorXd(lu.solve(ARG * xG)) : VectorXd::Zero(0);
   const MatrixXd U = nr > 0 ? MatrixXd(lu.solve(BR)) : MatrixXd::Zero(0, k);

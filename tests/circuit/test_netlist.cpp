@@ -131,9 +131,9 @@ TEST(Netlist, OperatingPointNeedsADcPath) {
   const char* text = "t\nV1 a 0 1\nR1 a b 1k\nC1 b c 1u\nC2 c 0 1u\n.tran 1u 1m\n";
   EXPECT_EQ(
       error_of(text),
-      "bad.cir: operating point: the DC equations (capacitors open, inductors shorted) do "
-      "not determine C1.v, C2.v (a capacitor without a DC path, or a loop of inductors): give .ic "
-      "values or use `.tran ... uic`");
+      "bad.cir: operating point: the DC equations (capacitors open, inductors shorted) have "
+      "no unique solution for C1.v, C2.v (a capacitor without a DC path, a loop of inductors, "
+      "or an inductor across a voltage that .ic holds): give .ic values or use `.tran ... uic`");
   const std::string uic = std::string(text) + ".tran 1u 1m uic\n";
   EXPECT_EQ(error_of(uic), "");
 }
