@@ -90,7 +90,9 @@ PassivityReport judge_passivity(const Circuit& c) {
   if (!r.controllable) fails += (fails.empty() ? "" : ", ") + std::string("(A, B) controllable");
   if (!r.observable) fails += (fails.empty() ? "" : ", ") + std::string("(C, A) observable");
   r.verdict = "Theorems 5.5.2-5.5.3 do not apply: " + fails + " fails; Theorem 3.6.3 " +
-              (r.locally_well_posed ? "gives local well-posedness" : "does not apply either");
+              (r.locally_well_posed ? "gives local well-posedness"
+                                    : "does not apply either: the exact method's mode selection "
+                                      "is not guaranteed (a run may end in a numerical failure)");
   return r;
 }
 
