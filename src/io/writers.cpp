@@ -251,14 +251,15 @@ void append_csv_friction_modes(std::string& out, const sim::Sample& s, int nf, s
 }
 
 // The outputs z = output_x x + output_u u of an LCS model (blank cells when
-// the sample records no u); nothing for a model without outputs.
+// the model has pairs and the sample records no u); nothing for a model
+// without outputs.
 void append_csv_outputs(std::string& out, const sim::Sample& s, const CsvOutputs& o) {
   if (o.names == 0) return;
-  if (s.u.size() == 0) {
+  if (s.u.size() == 0 && o.u.cols() > 0) {
     out.append(static_cast<std::size_t>(o.names), ',');
     return;
   }
-  const VectorXd z = o.x * s.x + o.u * s.u;
+  const VectorXd z = o.u.cols() > 0 ? VectorXd(o.x * s.x + o.u * s.u) : VectorXd(o.x * s.x);
   for (Eigen::Index j = 0; j < z.size(); ++j) {
     out += ',';
     append_number(out, z(j), kCsvDigits);

@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <lcsim/circuit/circuit.hpp>
+#include <lcsim/io/csv.hpp>
+#include <lcsim/io/text.hpp>
+#include <lcsim/sim/sim.hpp>
 #include <string>
 
 namespace lcsim {
@@ -191,6 +194,53 @@ C1 c 0 1u
   EXPECT_NEAR(value("V(c)"), 2.0, 1e-12);
   EXPECT_NEAR(value("I(G1)"), 2e-3, 1e-15);
   EXPECT_NEAR(value("I(F1)"), -4e-3, 1e-15);
+}
+
+}  // namespace
+}  // namespace lcsim
+
+namespace lcsim {
+namespace {
+
+// Subcircuits inside subcircuits: names and nodes get each instance's path;
+// the values by hand (two halving dividers in a row, the second loading the
+// first: V(q) = 8/5, V(XQ.m) = 2 V(q)). A circuit without diodes writes its
+// outputs from the state alone.
+TEST(Netlist, NestedSubcircuitsAndOutputsWithoutDiodes) {
+  const char* text = R"(nested
+.subckt half in out
+R1 in out 1k
+R2 out 0 1k
+.ends
+.subckt quarter a b
+X1 a m half
+X2 m b half
+.ends
+V1 top 0 8
+XQ top q quarter
+C1 q 0 1u
+.tran 1u 1m
+)";
+  const circuit::Circuit c = parse_circuit(text, "nested.cir");
+  EXPECT_EQ(c.netlist.elements[2].name, "XQ.X1.R2");
+  EXPECT_NEAR(c.model.initial(0), 1.6, 1e-15);
+  sim::Options opt;
+  opt.t_end = 1e-3;
+  opt.dt_out = 1e-3;
+  const sim::Trajectory tr = sim::simulate(c.model, opt);
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  const std::string csv = io::trajectory_csv(c.model, tr);
+  const std::size_t row = csv.find('\n') + 1;
+  EXPECT_EQ(csv.substr(0, row - 1),
+            "t,C1.v,1,V(top),V(q),V(XQ.m),I(V1),I(XQ.X1.R1),I(XQ.X1.R2),I(XQ.X2.R1),I(XQ.X2.R2),"
+            "I(C1),mode");
+  // Row 0 is the operating point, every output filled: V(top) = 8, V(q) =
+  // 1.6, V(XQ.m) = 3.2, I(V1) = -4.8 mA (rounding only: 1e-12 relative).
+  const std::vector<std::string> cells = io::split(csv.substr(row, csv.find('\n', row) - row), ',');
+  ASSERT_EQ(cells.size(), 12u);  // the empty mode cell last (no diode) is not split out
+  const double expected[] = {0, 1.6, 1, 8, 1.6, 3.2, -4.8e-3, 4.8e-3, 3.2e-3, 1.6e-3, 1.6e-3, 0};
+  for (std::size_t i = 0; i < 12; ++i)
+    EXPECT_NEAR(std::stod(cells[i]), expected[i], 1e-12 * 8) << "column " << i;
 }
 
 }  // namespace
