@@ -14,7 +14,8 @@ circuit::PassivityReport judge(const std::string& file) {
 }
 
 TEST(Passivity, ShippedCircuitsArePassive) {
-  for (const char* f : {"diode_bridge.cir", "half_wave_rectifier.cir", "diode_clamp.cir"}) {
+  for (const char* f :
+       {"diode_bridge.cir", "half_wave_rectifier.cir", "diode_clamp.cir", "half_wave_rlc.cir"}) {
     const circuit::PassivityReport r = judge(f);
     EXPECT_EQ(r.passive, "yes") << f << ": " << r.passive_reason;
     EXPECT_TRUE(r.negative_elements.empty()) << f;
