@@ -110,23 +110,45 @@ TEST(DiodeBridge, EachConductingPairPresentsTheLoad) {
     EXPECT_LT((mode_dynamics(c, I) - rlc).norm(), 1e-12 * rlc.norm()) << mode_dynamics(c, I);
 }
 
-// Known limitation (docs/circuits.md): at each zero of V(a) all four ideal
-// diodes switch at once, and the LCS's leading coefficient matrix (D, rows of
-// parallel diodes equal) is no P-matrix, so the exact method's mode
-// selection (§3.5.2, Theorem 3.6.7) is not guaranteed and picks a wrong mode.
-// The run must then end with a failure, never a false "completed".
-TEST(DiodeBridge, ExactRunNeverClaimsAWrongWaveform) {
+// The bridge over 5 ms against the parallel RLC: the closed form's events are
+// the zeros of V(a), t1 = atan(wd/alpha)/wd and then every pi/wd; after each
+// the other pair conducts (D2, D3 while V(a) < 0, D1, D4 while V(a) > 0).
+// At each zero all four diodes switch at once and the LCS's D has a zero
+// diagonal (D1 in voltage form) and equal rows (D3, D4): D + D' >= 0, no
+// P-matrix; the LDCP picks the mode through D's columns (src/lcs/ldcp.cpp).
+// Tolerances: kEventTol and kVoltTol above; the inductor current to
+// kVoltTol / R = 1e-12 A (0.09 A at the first zero, rounding ~1e-16 A), and
+// the load through the same outputs the CSV writes.
+TEST(DiodeBridge, ExactRunIsTheParallelRlcOverFiveMilliseconds) {
   const Circuit c = circuit::parse_circuit(kBridge, "bridge.cir");
-  sim::Options opt;
-  opt.dt_out = 1e-5;
-  const sim::Trajectory tr = sim::simulate(c.model, opt);
-  if (tr.ok()) {  // should the mode selection resolve it, the waveform must be right
-    for (const sim::Sample& s : tr.samples)
-      EXPECT_NEAR(output(c.model, s, "V(a)"), damped(10.0, 0.0, s.t).first, kVoltTol);
-  } else {  // a failure says what failed
-    EXPECT_NE(tr.status, Status::kInvalidInput) << tr.message;
-    EXPECT_FALSE(tr.message.empty());
+  const double t_end = 5e-3;
+  const sim::Trajectory tr = run(c, t_end, 1e-6);
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  std::vector<double> zeros;
+  for (double t = std::atan(kWd / kAlpha) / kWd; t < t_end; t += pi / kWd) zeros.push_back(t);
+  ASSERT_EQ(zeros.size(), 16u);  // 5 ms holds 16 half periods after t1
+  std::vector<const sim::Event*> events;
+  for (const sim::Event& e : tr.events)
+    if (e.type != sim::EventType::kStart) events.push_back(&e);
+  ASSERT_EQ(events.size(), zeros.size());
+  const std::vector<std::string> negative{"D2", "D3"}, positive{"D1", "D4"};
+  for (std::size_t j = 0; j < zeros.size(); ++j) {
+    EXPECT_NEAR(events[j]->t, zeros[j], kEventTol) << "event " << j;
+    EXPECT_EQ(c.conducting(events[j]->mode_after), j % 2 == 0 ? negative : positive) << j;
+    EXPECT_NEAR(events[j]->state_after(0), 0.0, kVoltTol) << "event " << j;
+    EXPECT_NEAR(events[j]->state_after(1), damped(10.0, 0.0, zeros[j]).second, kVoltTol / kR) << j;
   }
+  EXPECT_GE(tr.samples.size(), 5001u);  // the grid, and each event's samples
+  for (const sim::Sample& s : tr.samples) {
+    const auto [v, i] = damped(10.0, 0.0, s.t);
+    EXPECT_NEAR(output(c.model, s, "V(a)"), v, kVoltTol) << "t = " << s.t;
+    EXPECT_NEAR(s.x(1), i, kVoltTol / kR) << "t = " << s.t;
+    // The load always sees |V(a)|, the full-wave rectified tank voltage.
+    EXPECT_NEAR(output(c.model, s, "V(p)") - output(c.model, s, "V(m)"), std::abs(v), kVoltTol)
+        << "t = " << s.t;
+    EXPECT_NEAR(output(c.model, s, "I(R1)"), std::abs(v) / kR, kVoltTol / kR) << "t = " << s.t;
+  }
+  EXPECT_DOUBLE_EQ(tr.samples.back().t, t_end);
 }
 
 const char* kHalfWave = R"(half-wave RLC
