@@ -198,6 +198,25 @@ TEST(HalfWaveRlc, DampedWhileConductingUndampedWhileNot) {
   }
 }
 
+// Two ideal diodes in parallel share a current that is not unique (only the
+// sum is: D has equal rows and columns, B rank 1); the state is (Ch. 4-5),
+// so the waveform is the one diode's, sample for sample. Tolerance: kVoltTol.
+TEST(HalfWaveRlc, ParallelDiodesGiveTheOneDiodeWaveform) {
+  const std::string one = kHalfWave;
+  std::string two = one;
+  two.insert(two.find("R1 m 0"), "D2 a m ideal\n");
+  const Circuit c1 = circuit::parse_circuit(one, "one.cir");
+  const Circuit c2 = circuit::parse_circuit(two, "two.cir");
+  ASSERT_EQ(c2.diode_form.size(), 2u);
+  const sim::Trajectory t1 = run(c1, 3e-3, 1e-5), t2 = run(c2, 3e-3, 1e-5);
+  ASSERT_EQ(t1.samples.size(), t2.samples.size());
+  for (std::size_t j = 0; j < t1.samples.size(); ++j) {
+    ASSERT_EQ(t1.samples[j].t, t2.samples[j].t);
+    EXPECT_NEAR(t2.samples[j].x(0), t1.samples[j].x(0), kVoltTol) << "t = " << t1.samples[j].t;
+    EXPECT_NEAR(t2.samples[j].x(1), t1.samples[j].x(1), kVoltTol / kR) << "t = " << t1.samples[j].t;
+  }
+}
+
 // RC low-pass from rest driven by VA exp(-theta t) sin(w t + phi): the
 // closed form of v' = (u(t) - v)/tau by the complex exponential response.
 double rc_response(double VA, double w, double theta, double phi, double tau, double t) {
