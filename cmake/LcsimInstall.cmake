@@ -11,7 +11,7 @@
 # (lcsimConfig.cmake.in loads the components asked for and those below).
 include(CMakePackageConfigHelpers)
 set(LCSIM_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/lcsim)
-set(LCSIM_COMPONENTS core lcp lcs mech impact ipopt sim io scene bullet study app)
+set(LCSIM_COMPONENTS core lcp lcs mech impact ipopt sim io circuit scene bullet study app)
 
 foreach(c ${LCSIM_COMPONENTS} all)
   set(name ${c})

@@ -119,7 +119,7 @@ print("lcsim: the installed Python package imports and runs:", lcsim.__file__)
   export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp:print_suppressions=0"
   cmake -S . -B build-san -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo "${launcher[@]}" \
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DLCSIM_FUZZ=ON \
-    -DLCSIM_BUILD_BENCH=OFF -DLCSIM_TESTS="lcp;lcs;mech;impact;sim;io;scene;app;cli"
+    -DLCSIM_BUILD_BENCH=OFF -DLCSIM_TESTS="lcp;lcs;mech;impact;sim;io;circuit;scene;app;cli"
   cmake --build build-san -j"$jobs"
   ctest --test-dir build-san --output-on-failure -j"$jobs"
 

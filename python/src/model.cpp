@@ -29,7 +29,8 @@ ModelHandle checked(mech::Model model, const OptVector& initial, std::optional<d
   if (t_end) model.t_end = *t_end;
   if (auto p = mech::check_model(model))
     throw io::InputError("model '" + model.name + "': " + p->field + ": " + p->what);
-  return std::make_shared<scene::LoadedModel>(scene::LoadedModel{std::move(model), std::nullopt});
+  return std::make_shared<scene::LoadedModel>(
+      scene::LoadedModel{std::move(model), std::nullopt, nullptr});
 }
 
 // One entry of Model.mechanical's `friction`: {contact: index or name,
@@ -231,7 +232,8 @@ or a general LCS x' = A x + B u, y = C x + D u, 0 <= y _|_ u >= 0. Built by lcsi
   def_properties(c);
   def_mechanical_fields(c);
   m.def("load", &load, py::arg("path"),
-        "Reads a YAML model file or a URDF scene (scene::load_model_and_scene). Raises InputError "
+        "Reads a YAML model file, a URDF scene or a SPICE netlist (.cir, .sp, .net; "
+        "scene::load_model_and_scene). Raises InputError "
         "naming the file, the key and the value when it is invalid.");
 }
 

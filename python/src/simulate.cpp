@@ -131,7 +131,8 @@ std::shared_ptr<Run> simulate(const ModelHandle& model, const std::optional<Vect
                               const std::vector<std::string>& sensitivity) {
   app::RunRequest req;
   req.method = method;
-  req.x0 = x0;  // unset: the model's
+  req.x0 = x0;                                    // unset: the model's
+  if (x0) req.x0 = model->model.full_state(*x0);  // a circuit's sources are the model's
   sim::Options& opt = req.options;
   opt.t_end = t_end;
   opt.dt_out = dt_out;

@@ -7,8 +7,10 @@
 #include <algorithm>
 #include <cstdio>
 #include <lcsim/app/analysis.hpp>
+#include <lcsim/circuit/circuit.hpp>
 #include <lcsim/core/format.hpp>
 #include <lcsim/io/json.hpp>
+#include <lcsim/io/yaml.hpp>
 #include <lcsim/lcp/lcp.hpp>
 #include <lcsim/lcs/lcs.hpp>
 #include <lcsim/mech/mech.hpp>
@@ -280,6 +282,43 @@ void lcs_section(Draft& d, const lcs::Lcs& sys) {
   d.j["C_rank"] = rank_c;
 }
 
+// A SPICE netlist's circuit (issue 29): thesis Ch. 5's passivity, then
+// well-posedness or the condition that fails, on the circuit with its
+// sources set to zero (the exosystem's states left out).
+void circuit_section(Draft& d, const circuit::Circuit& c) {
+  const circuit::PassivityReport r = circuit::judge_passivity(c);
+  nlohmann::json diodes = nlohmann::json::array();
+  std::string forms;
+  for (std::size_t p = 0; p < c.diode_element.size(); ++p) {
+    const bool voltage = c.diode_form[p] == circuit::DiodeForm::kVoltage;
+    const std::string& name = c.netlist.elements[c.diode_element[p]].name;
+    diodes.push_back({{"name", name}, {"form", voltage ? "voltage" : "current"}});
+    forms += (p ? ", " : "") + name + (voltage ? " (voltage form)" : "");
+  }
+  d.j["circuit"] = {{"title", c.netlist.title},
+                    {"circuit_states", c.circuit_states},
+                    {"exosystem_states", c.model.exo_states},
+                    {"diodes", diodes},
+                    {"initial_state", c.initial_note},
+                    {"passive", r.passive},
+                    {"passive_reason", r.passive_reason},
+                    {"negative_elements", r.negative_elements},
+                    {"B_full_column_rank", r.full_column_rank_b},
+                    {"controllable", r.controllable},
+                    {"observable", r.observable},
+                    {"globally_well_posed", r.globally_well_posed},
+                    {"locally_well_posed", r.locally_well_posed},
+                    {"verdict", r.verdict}};
+  d.out << "circuit:     " << c.netlist.title << "\n"
+        << "             " << c.circuit_states << " circuit states, " << c.model.exo_states
+        << " exosystem states (sources), diodes: " << (forms.empty() ? "none" : forms) << "\n"
+        << "initial:     " << c.initial_note << "\n"
+        << "passive:     " << r.passive << " (sources set to zero): " << r.passive_reason << "\n";
+  if (!r.negative_elements.empty())
+    d.out << "             negative values: " << io::yaml::join(r.negative_elements) << "\n";
+  d.out << "well posed:  " << r.verdict << "\n";
+}
+
 void notes_section(Draft& d, const std::vector<std::string>& notes) {
   d.j["notes"] = notes;
   d.out << "notes:";
@@ -430,6 +469,7 @@ AnalysisReport analysis_report(const scene::LoadedModel& loaded, const AnalysisO
     mechanical_section(d, model, sys);
   else
     lcs_section(d, sys);
+  if (loaded.circuit) circuit_section(d, *loaded.circuit);
   notes_section(d, notes);
   const LeftOut wp_left = options.full ? LeftOut{} : lcs::summary_left_out(wp);
   well_posedness_json(d, wp, wp_left);

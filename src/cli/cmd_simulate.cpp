@@ -51,12 +51,15 @@ struct SimulateArgs {
 std::string fmt_vec(const Eigen::VectorXd& v) { return "(" + number_list(v, 10) + ")"; }
 
 // "{0 hook, 1 wall}": index and name of each constraint of a mechanical
-// model; "{0,1}" for an LCS (its complementarity pairs have no names).
+// model or of an LCS that names its pairs (a circuit's diodes); "{0,1}" for
+// an LCS without names.
 std::string fmt_set(const mech::Model& model, const std::vector<int>& s) {
+  const bool named = model.is_mechanical() || !model.pair_names.empty();
   std::string r = "{";
   for (size_t i = 0; i < s.size(); ++i) {
-    r += (i ? (model.is_mechanical() ? ", " : ",") : "") + std::to_string(s[i]);
+    r += (i ? (named ? ", " : ",") : "") + std::to_string(s[i]);
     if (model.is_mechanical()) r += " " + model.mechanical->constraints[s[i]];
+    if (!model.is_mechanical() && named) r += " " + model.pair_names[s[i]];
   }
   return r + "}";
 }
@@ -87,8 +90,18 @@ sim::Options run_options(const SimulateArgs& a, const mech::Model& model) {
   return opt;
 }
 
+// A circuit's conducting diodes after an event (a voltage-form diode is in
+// the mode while it blocks, docs/circuits.md): "" for other models.
+std::string conducting_note(const circuit::Circuit* c, const sim::Event& e) {
+  if (!c) return "";
+  std::string s;
+  for (const std::string& d : c->conducting(e.mode_after)) s += (s.empty() ? "" : ", ") + d;
+  return "      conducting: " + (s.empty() ? std::string("none") : s) + "\n";
+}
+
 void print_summary(const SimulateArgs& a, const mech::Model& model, const sim::Trajectory& tr,
-                   const std::optional<scene::LinearisationCheck>& lin, bool written) {
+                   const std::optional<scene::LinearisationCheck>& lin, bool written,
+                   const circuit::Circuit* circuit) {
   std::printf("model %s, method %s, t_end %g\n", model.name.c_str(), tr.method.c_str(), tr.t_end);
   if (!tr.impact_law.empty()) std::printf("impact law %s\n", tr.impact_law.c_str());
   for (const auto& e : tr.events) {
@@ -96,6 +109,7 @@ void print_summary(const SimulateArgs& a, const mech::Model& model, const sim::T
                 std::string(sim::to_string(e.type)).c_str(), fmt_vec(e.state_before).c_str(),
                 fmt_vec(e.state_after).c_str(), fmt_set(model, e.mode_after).c_str());
     if (!e.note.empty()) std::printf("      (%s)\n", e.note.c_str());
+    std::printf("%s", conducting_note(circuit, e).c_str());
   }
   if (tr.events_not_recorded > 0)
     std::printf("  ... and %ld more events, counted, not recorded\n", tr.events_not_recorded);
@@ -172,7 +186,7 @@ void run_simulate(const SimulateArgs& a) {
   if (a.json)
     std::cout << app::run_json(model, tr, run.linearisation).dump(2) << "\n";
   else
-    print_summary(a, model, tr, run.linearisation, run.csv_written);
+    print_summary(a, model, tr, run.linearisation, run.csv_written, loaded.circuit.get());
   if (!a.json) print_sensitivity(tr, run.csv_written ? req.sensitivity_csv_path : "");
   if (!run.linearisation_warning.empty())
     std::cerr << "lcsim: warning: " << run.linearisation_warning << "\n";

@@ -11,6 +11,7 @@ Eigen::VectorXd resolve_initial_state(const mech::Model& model, const std::strin
   if (!x0_text.empty()) x0 = io::parse_vector(x0_text, "--x0");
   if (x0.size() == 0)
     throw io::InputError(model_path + ": no " + what + ": give --x0 or `initial` in the model");
+  x0 = model.full_state(x0);  // an exosystem's states (a circuit's sources) are the model's
   if (x0.size() != model.state_size())
     throw io::InputError("--x0: has " + std::to_string(x0.size()) + " entries, the model '" +
                          model.name + "' has a state of size " +

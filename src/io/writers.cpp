@@ -198,9 +198,16 @@ std::vector<std::string> csv_header(const mech::Model& model) {
     for (const auto& f : m.friction) header.push_back("ut_" + m.constraints[f.contact]);
     for (const auto& f : m.friction) header.push_back("fm_" + m.constraints[f.contact]);
   } else {
-    for (int i = 1; i <= n; ++i) header.push_back(prefixed("x", std::to_string(i)));
-    for (int i = 1; i <= k; ++i) header.push_back(prefixed("u", std::to_string(i)));
-    for (int i = 1; i <= k; ++i) header.push_back(prefixed("y", std::to_string(i)));
+    // Names when the model gives them (circuits), else x1.., u1.., y1...
+    const auto& xs = model.state_names;
+    const auto& ps = model.pair_names;
+    for (int i = 1; i <= n; ++i)
+      header.push_back(xs.empty() ? prefixed("x", std::to_string(i)) : xs[i - 1]);
+    for (int i = 1; i <= k; ++i)
+      header.push_back(ps.empty() ? prefixed("u", std::to_string(i)) : "u_" + ps[i - 1]);
+    for (int i = 1; i <= k; ++i)
+      header.push_back(ps.empty() ? prefixed("y", std::to_string(i)) : "y_" + ps[i - 1]);
+    for (const auto& o : model.output_names) header.push_back(o);
   }
   header.push_back("mode");
   return header;
@@ -243,9 +250,31 @@ void append_csv_friction_modes(std::string& out, const sim::Sample& s, int nf, s
   }
 }
 
-// Row `r` of the CSV: t, x, u, y, the tangential multipliers and friction
-// modes (nf of each, models with friction only), mode.
-void append_csv_row(std::string& out, const sim::Sample& s, int n, int k, int nf, std::size_t r) {
+// The outputs z = output_x x + output_u u of an LCS model (blank cells when
+// the model has pairs and the sample records no u); nothing for a model
+// without outputs.
+void append_csv_outputs(std::string& out, const sim::Sample& s, const CsvOutputs& o) {
+  if (o.names == 0) return;
+  if (s.u.size() == 0 && o.u.cols() > 0) {
+    out.append(static_cast<std::size_t>(o.names), ',');
+    return;
+  }
+  const VectorXd z = o.u.cols() > 0 ? VectorXd(o.x * s.x + o.u * s.u) : VectorXd(o.x * s.x);
+  for (Eigen::Index j = 0; j < z.size(); ++j) {
+    out += ',';
+    append_number(out, z(j), kCsvDigits);
+  }
+}
+
+CsvOutputs csv_outputs(const mech::Model& model) {
+  return {static_cast<int>(model.output_names.size()), model.output_x, model.output_u};
+}
+
+// Row `r` of the CSV: t, x, u, y, the outputs (LCS models that have them),
+// the tangential multipliers and friction modes (nf of each, models with
+// friction only), mode.
+void append_csv_row(std::string& out, const sim::Sample& s, int n, int k, int nf, std::size_t r,
+                    const CsvOutputs& outputs) {
   if (s.x.size() != n)
     throw std::logic_error("trajectory_csv: sample " + std::to_string(r) + " has a state of size " +
                            std::to_string(s.x.size()) + ", expected " + std::to_string(n));
@@ -253,6 +282,7 @@ void append_csv_row(std::string& out, const sim::Sample& s, int n, int k, int nf
   append_csv_vector(out, s.x, n, "x", r);
   append_csv_vector(out, s.u, k, "u", r);
   append_csv_vector(out, s.y, k, "y", r);
+  append_csv_outputs(out, s, outputs);
   if (nf > 0) {
     append_csv_vector(out, s.u_t, nf, "u_t", r);
     append_csv_friction_modes(out, s, nf, r);
@@ -276,8 +306,9 @@ std::string trajectory_csv(const mech::Model& model, const sim::Trajectory& traj
   std::string out;
   append_csv_header(out, model);
   const int n = model.state_size(), k = model.num_constraints(), nf = friction_count(model);
+  const CsvOutputs outputs = csv_outputs(model);
   for (std::size_t r = 0; r < traj.samples.size(); ++r)
-    append_csv_row(out, traj.samples[r], n, k, nf, r);
+    append_csv_row(out, traj.samples[r], n, k, nf, r, outputs);
   return out;
 }
 
@@ -288,7 +319,8 @@ TrajectoryCsvWriter::TrajectoryCsvWriter(const std::filesystem::path& path,
     : path_(path.string()),
       n_(model.state_size()),
       k_(model.num_constraints()),
-      nf_(friction_count(model)) {
+      nf_(friction_count(model)),
+      outputs_(csv_outputs(model)) {
   TemporaryFile t = temporary_beside(path);
   fd_ = t.fd;
   temporary_ = std::move(t.name);
@@ -305,7 +337,7 @@ TrajectoryCsvWriter::~TrajectoryCsvWriter() {
 void TrajectoryCsvWriter::write(const sim::Sample& s) noexcept {
   if (fd_ < 0 || error_ != 0 || !logic_error_.empty()) return;
   try {
-    append_csv_row(buffer_, s, n_, k_, nf_, rows_++);
+    append_csv_row(buffer_, s, n_, k_, nf_, rows_++, outputs_);
   } catch (const std::exception& e) {
     logic_error_ = e.what();
     return;
@@ -343,6 +375,11 @@ nlohmann::json trajectory_json(const mech::Model& model, const sim::Trajectory& 
                       {"mode_after", index_set_json(e.mode_after)},
                       {"impulse", to_json(e.impulse)}});
     if (!e.note.empty()) events.back()["note"] = e.note;
+    if (!model.pair_names.empty()) {  // models without names keep their keys
+      nlohmann::json names = nlohmann::json::array();
+      for (int i : e.mode_after) names.push_back(model.pair_names[static_cast<std::size_t>(i)]);
+      events.back()["mode_after_names"] = std::move(names);
+    }
     if (friction_count(model) > 0) {  // frictionless models keep their keys
       events.back()["friction_impulse"] = to_json(e.friction_impulse);
       nlohmann::json modes = nlohmann::json::array();

@@ -223,14 +223,34 @@ std::string solve_level(const Ldcp& s, const Level& l, VectorXd& up, int& lcp_so
   return "";
 }
 
+// The rounding of u_r^p: the u_r whose term in the coefficients y^p is within
+// their rounding. Through the diagonal, tol_y(r) / |M_rr|, as long as the
+// diagonal is not negligible in its column. A zero diagonal (a skew coupling,
+// as between a diode in voltage form and one in current form: a passive LCS
+// has D + D' >= 0, not a P-matrix D; or one left at 1e-17 by the rounding of
+// a circuit's reduction) says nothing of u_r's size, and dividing by it would
+// discard a u_r that is not rounding: then the smallest tol_y(i) / |M_ir|
+// over the rows i that u_r moves. A zero column leaves u_r out of y^p.
+double u_tolerance(const Ldcp& s, const Level& l, int r) {
+  const MatrixXd& Mlead = s.data.Mlead;
+  const double diagonal = std::abs(Mlead(r, r));
+  const double column = Mlead.col(r).cwiseAbs().maxCoeff();
+  constexpr double kNegligible = 1e-12;  // relative to the column: rounding of the reduction
+  if (diagonal > kNegligible * column) return l.tol_y(r, s.opt) / std::max(diagonal, 1e-300);
+  double tol = l.tol_y(r, s.opt) / std::max(diagonal, 1e-300);
+  for (int i = 0; i < static_cast<int>(Mlead.rows()); ++i)
+    if (std::abs(Mlead(i, r)) > kNegligible * column)
+      tol = std::min(tol, l.tol_y(i, s.opt) / std::abs(Mlead(i, r)));
+  return tol;
+}
+
 // An undecided row becomes active when u_r^p > 0, inactive when y_r^p > 0
 // (the lexicographic signs of §3.5.2); u_r^p within rounding is set to 0.
 void classify_undecided(Ldcp& s, const Level& l, VectorXd& up) {
   const MatrixXd& Mlead = s.data.Mlead;
   const VectorXd y = l.xi + Mlead * up;
   for (int r : l.K) {
-    const double d = std::max(std::abs(Mlead(r, r)), 1e-300);
-    if (up(r) > l.tol_y(r, s.opt) / d) {
+    if (up(r) > u_tolerance(s, l, r)) {
       s.state[r] = RowState::kActive;
     } else {
       up(r) = 0.0;  // rounding noise, not an impulse or force

@@ -301,12 +301,51 @@ std::optional<ModelProblem> check_lcs(const lcs::Lcs& s) {
   return std::nullopt;
 }
 
+namespace {
+// The names, exosystem and outputs of an `lcs:` model (all empty for any
+// other): sizes that agree, finite entries, an exosystem driven by itself.
+std::optional<ModelProblem> check_lcs_labels(const Model& model) {
+  const bool labelled = !model.state_names.empty() || !model.pair_names.empty() ||
+                        model.exo_states != 0 || !model.output_names.empty();
+  if (!labelled) return std::nullopt;
+  if (!model.lcs)
+    return ModelProblem{"model", "state names, exosystem and outputs are for LCS models"};
+  const int n = model.lcs->n(), k = model.lcs->k(), e = model.exo_states;
+  const auto size_problem = [](const char* field, std::size_t want, std::size_t got) {
+    return ModelProblem{
+        field, "expected " + std::to_string(want) + " entries (got " + std::to_string(got) + ")"};
+  };
+  if (!model.state_names.empty() && model.state_names.size() != static_cast<std::size_t>(n))
+    return size_problem("lcs.states", n, model.state_names.size());
+  if (!model.pair_names.empty() && model.pair_names.size() != static_cast<std::size_t>(k))
+    return size_problem("lcs.pairs", k, model.pair_names.size());
+  if (e < 0 || e > n || model.exo_initial.size() != e)
+    return ModelProblem{"lcs.exosystem", "expected at most " + std::to_string(n) +
+                                             " states with as many initial values"};
+  if (e > 0 && (model.lcs->A.bottomLeftCorner(e, n - e).cwiseAbs().sum() != 0.0 ||
+                model.lcs->B.bottomRows(e).cwiseAbs().sum() != 0.0))
+    return ModelProblem{"lcs.exosystem", "its states must be driven by themselves only"};
+  if (auto at = non_finite_vector(model.exo_initial))
+    return ModelProblem{"lcs.exosystem" + *at, "not finite"};
+  const auto m = static_cast<Eigen::Index>(model.output_names.size());
+  if (model.output_x.rows() != m || model.output_u.rows() != m ||
+      (m > 0 && (model.output_x.cols() != n || model.output_u.cols() != k)))
+    return ModelProblem{"lcs.outputs", "expected " + std::to_string(m) + " rows of " +
+                                           std::to_string(n) + " and " + std::to_string(k) +
+                                           " entries"};
+  if (auto at = non_finite(model.output_x)) return ModelProblem{"lcs.outputs" + *at, "not finite"};
+  if (auto at = non_finite(model.output_u)) return ModelProblem{"lcs.outputs" + *at, "not finite"};
+  return std::nullopt;
+}
+}  // namespace
+
 std::optional<ModelProblem> check_model(const Model& model) {
   if (model.mechanical.has_value() == model.lcs.has_value())
     return ModelProblem{"model", model.mechanical ? "holds both a mechanical model and an LCS"
                                                   : "holds neither a mechanical model nor an LCS"};
   auto p = model.mechanical ? check_mechanical(*model.mechanical) : check_lcs(*model.lcs);
   if (p) return p;
+  if (auto q = check_lcs_labels(model)) return q;
   if (model.initial.size() > 0) {
     if (model.initial.size() != model.state_size())
       return ModelProblem{"initial", "expected " + std::to_string(model.state_size()) +

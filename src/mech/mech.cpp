@@ -133,6 +133,14 @@ int Model::state_size() const {
   return 0;
 }
 
+VectorXd Model::full_state(const VectorXd& x) const {
+  const int n = state_size();
+  if (exo_states <= 0 || x.size() != n - exo_states) return x;
+  VectorXd full(n);
+  full << x, exo_initial;
+  return full;
+}
+
 int Model::num_constraints() const {
   if (mechanical) return mechanical->num_constraints();
   if (lcs) return lcs->k();

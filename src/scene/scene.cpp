@@ -184,6 +184,8 @@ mech::Model parse_scene(const std::string& yaml_text, const std::string& source)
 }
 
 mech::Model parse_model(const std::string& yaml_text, const std::string& source) {
+  // A SPICE netlist (.cir, .sp, .net, ...) is a circuit (docs/circuits.md).
+  if (circuit::is_netlist_path(source)) return circuit::parse_circuit(yaml_text, source).model;
   const YAML::Node root = io::load_model_root(yaml_text, source);
   // A top-level `urdf:` key makes the file a scene.
   if (io::is_scene(root)) {
@@ -202,12 +204,16 @@ mech::Model load_model(const std::filesystem::path& path) {
 
 LoadedModel load_model_and_scene(const std::filesystem::path& path) {
   const std::string text = read_file(path);
+  if (circuit::is_netlist_path(path)) {
+    auto c = std::make_shared<const circuit::Circuit>(circuit::parse_circuit(text, path.string()));
+    return {c->model, std::nullopt, c};
+  }
   const YAML::Node root = load_model_root(text, path.string());
-  if (!is_scene(root)) return {io::parse_matrix_model(root, path.string()), std::nullopt};
+  if (!is_scene(root)) return {io::parse_matrix_model(root, path.string()), std::nullopt, nullptr};
   try {
     Scene scene = read_scene(text, path.string());
     mech::Model model = scene.model;
-    return {std::move(model), std::move(scene)};
+    return {std::move(model), std::move(scene), nullptr};
   } catch (const InputError& e) {
     throw InputError(one_line(e.what()));  // as load_model: URDF names may hold newlines
   }

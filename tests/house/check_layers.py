@@ -27,14 +27,15 @@ LAYERS = {
     "ipopt": {"core", "lcp", "lcs", "mech", "impact"},
     "sim": {"core", "lcp", "lcs", "mech", "impact"},
     "io": {"core", "lcp", "lcs", "mech", "impact", "sim"},
-    "scene": {"core", "lcp", "lcs", "mech", "impact", "sim", "io"},
-    "bullet": {"core", "lcp", "lcs", "mech", "impact", "sim", "io", "scene"},
-    "study": {"core", "lcp", "lcs", "mech", "impact", "sim", "io", "scene"},
-    "app": {"core", "lcp", "lcs", "mech", "impact", "sim", "io", "scene", "study"},
-    "cli": {"core", "lcp", "lcs", "mech", "impact", "ipopt", "sim", "io", "scene", "bullet",
-            "study", "app"},
-    "python": {"core", "lcp", "lcs", "mech", "impact", "ipopt", "sim", "io", "scene", "bullet",
-               "study", "app"},
+    "circuit": {"core", "lcp", "lcs", "mech", "impact", "sim", "io"},
+    "scene": {"core", "lcp", "lcs", "mech", "impact", "sim", "io", "circuit"},
+    "bullet": {"core", "lcp", "lcs", "mech", "impact", "sim", "io", "circuit", "scene"},
+    "study": {"core", "lcp", "lcs", "mech", "impact", "sim", "io", "circuit", "scene"},
+    "app": {"core", "lcp", "lcs", "mech", "impact", "sim", "io", "circuit", "scene", "study"},
+    "cli": {"core", "lcp", "lcs", "mech", "impact", "ipopt", "sim", "io", "circuit", "scene",
+            "bullet", "study", "app"},
+    "python": {"core", "lcp", "lcs", "mech", "impact", "ipopt", "sim", "io", "circuit", "scene",
+               "bullet", "study", "app"},
 }
 
 # (includer, private header's layer): why it is tolerated.

@@ -105,5 +105,53 @@ TEST(Ldcp, TripleIntegratorDeltaPrime) {
   EXPECT_LE(sel.x_plus.norm(), 1e-12);
 }
 
+// An ideal full-wave diode bridge (Siconos's DiodeBridge) in units where the
+// tank's C and L and the load's R are 1: x = (v, i), the tank voltage and
+// inductor current; diode 1 (a -> p) in voltage form (u1 = its reverse
+// voltage, y1 = its current), diodes 2..4 in current form. By hand from
+// Kirchhoff's laws: C v' = -i + u2 - u4, L i' = v, y1 = -u2 + u3 + u4,
+// y2 = v + u1, y3 = -u1 + R (u3 + u4), y4 = -v - u1 + R (u3 + u4). D has a
+// zero diagonal in rows 1 and 2 (the skew coupling of the two forms) and
+// equal rows 3 and 4: D + D' >= 0 (passive) but D is no P-matrix.
+Lcs diode_bridge() {
+  Lcs s;
+  s.A.resize(2, 2);
+  s.A << 0, -1, 1, 0;
+  s.B.resize(2, 4);
+  s.B << 0, 1, 0, -1, 0, 0, 0, 0;
+  s.C.resize(4, 2);
+  s.C << 0, 0, 1, 0, 0, 0, -1, 0;
+  s.D.resize(4, 4);
+  s.D << 0, -1, 1, 1, 1, 0, 0, 0, -1, 0, 1, 1, -1, 0, 1, 1;
+  return s;
+}
+
+// At a zero of v the bridge's four diodes switch at once. With i = 1 the tank
+// voltage falls (v' = -1): diodes 2 and 3 conduct and 1 blocks, mode {0, 1, 2};
+// the level-2 LCP (y^2 = C A x0 + D u^2) has the unique solution
+// u^2 = (1, 1, 1, 0), y^2 = (0, 0, 0, 1) (by hand). With i = -1 it rises: 1
+// and 4 conduct, mode {3}, u^2 = (0, 0, 0, 1). Before the fix the zero
+// diagonal of D made u1 and u2 "rounding" (tol / 1e-300) and the mode {2}.
+TEST(Ldcp, DiodeBridgeZeroDiagonalSkewCoupling) {
+  const Lcs s = diode_bridge();
+  for (const bool regular : {false, true}) {
+    LdcpOptions o;
+    o.regular_only = regular;
+    const auto falling = select_mode(s, Eigen::Vector2d(0, 1), o);
+    ASSERT_TRUE(falling.ok()) << falling.message;
+    EXPECT_EQ(falling.mode, (IndexSet{0, 1, 2}));
+    EXPECT_TRUE(falling.undetermined.empty());
+    const auto rising = select_mode(s, Eigen::Vector2d(0, -1), o);
+    ASSERT_TRUE(rising.ok()) << rising.message;
+    EXPECT_EQ(rising.mode, (IndexSet{3}));
+    EXPECT_TRUE(rising.undetermined.empty());
+    // Away from a zero the sign of v alone decides (level 1).
+    EXPECT_EQ(select_mode(s, Eigen::Vector2d(1, 0), o).mode, (IndexSet{3}));
+    EXPECT_EQ(select_mode(s, Eigen::Vector2d(-1, 0), o).mode, (IndexSet{0, 1, 2}));
+    // No jump: the state is regular (exactly: no impulse is computed at all).
+    EXPECT_EQ(falling.x_plus, Eigen::Vector2d(0, 1));
+  }
+}
+
 }  // namespace
 }  // namespace lcsim::lcs

@@ -11,7 +11,8 @@
 namespace lcsim::io {
 
 // CSV with header t, state (q names then v names for mechanical models, x1..
-// otherwise), u1.., y1.., mode (active constraints joined by ';').
+// or the model's state names otherwise), u1.. (u_<pair>), y1.. (y_<pair>),
+// the model's outputs, mode (active constraints joined by ';').
 std::string trajectory_csv(const mech::Model& model, const sim::Trajectory& traj);
 
 // The same CSV streamed to disk as a run goes (sim::Options::sample_sink), so
@@ -22,6 +23,13 @@ std::string trajectory_csv(const mech::Model& model, const sim::Trajectory& traj
 // The constructor throws InputError when no file can be created beside
 // `path`; write() never throws (a sink must not): a write error is kept and
 // thrown by commit() as InputError "<path>: cannot write: <reason>".
+// The output columns of an LCS model (mech::Model::output_names): how many,
+// and z = x x + u u.
+struct CsvOutputs {
+  int names = 0;
+  Eigen::MatrixXd x, u;
+};
+
 class TrajectoryCsvWriter {
  public:
   TrajectoryCsvWriter(const std::filesystem::path& path, const mech::Model& model);
@@ -38,6 +46,7 @@ class TrajectoryCsvWriter {
   std::string path_, temporary_, buffer_, logic_error_;
   int n_ = 0, k_ = 0, nf_ = 0, fd_ = -1, error_ = 0;  // nf_: frictional contacts
   std::size_t rows_ = 0;
+  CsvOutputs outputs_;
 };
 
 }  // namespace lcsim::io

@@ -144,6 +144,25 @@ struct Model {
   std::optional<lcs::Lcs> lcs;  // set for `lcs:` models
   VectorXd initial;             // full state (q then v for mechanical); empty if unset
   double t_end = std::numeric_limits<double>::quiet_NaN();  // NaN if unset
+  // `lcs:` models only (issue 29, circuits; docs/model-format.md), each empty
+  // or zero by default, so a model without them is what it always was:
+  // - names of the states (n; default x1..xn) and of the complementarity
+  //   pairs (k; default 1..k): CSV columns x, u_<pair>, y_<pair>, events;
+  // - an exosystem: the last `exo_states` states are inputs w' = S w (S the
+  //   lower-right block of A, no coupling from the other states), a constant
+  //   (w' = 0) or a damped sine (a 2-state oscillator), so that each phase is
+  //   still a matrix exponential. Their initial values are `exo_initial`,
+  //   always: a user's initial state gives the other states (full_state);
+  // - outputs z = output_x x + output_u u (output_names, one row each),
+  //   written as CSV columns after y (a circuit's V(node) and I(element)).
+  std::vector<std::string> state_names, pair_names;
+  int exo_states = 0;
+  VectorXd exo_initial;
+  std::vector<std::string> output_names;
+  MatrixXd output_x, output_u;
+  // The full state from `x`: `x` itself when of size state_size(), `x`
+  // followed by exo_initial when of size state_size() - exo_states (> 0).
+  VectorXd full_state(const VectorXd& x) const;
   bool is_mechanical() const { return mechanical.has_value(); }
   int state_size() const;  // 2N for mechanical, n for LCS
   int num_constraints() const;

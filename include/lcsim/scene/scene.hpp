@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 #include <filesystem>
+#include <lcsim/circuit/circuit.hpp>
 #include <lcsim/io/input_error.hpp>
 #include <lcsim/mech/mech.hpp>
 #include <lcsim/scene/contacts.hpp>
@@ -19,8 +20,9 @@ namespace lcsim::scene {
 
 using io::InputError;
 
-// Any model file: a matrix model (io::parse_matrix_model) or, with a
-// top-level `urdf:` key, a scene (load_scene). Every command reads its model
+// Any model file: a matrix model (io::parse_matrix_model), with a top-level
+// `urdf:` key a scene (load_scene), or by its extension (.cir, .sp, .net,
+// ...) a SPICE netlist (circuit::load_circuit). Every command reads its model
 // through these. InputError names the file, the key and the value.
 mech::Model load_model(const std::filesystem::path& path);
 // The same from YAML text; `source` names it in messages (and a scene's URDF
@@ -59,6 +61,9 @@ std::optional<Scene> load_scene_details(const std::filesystem::path& path);
 struct LoadedModel {
   mech::Model model;
   std::optional<Scene> scene;
+  // For a SPICE netlist (.cir, .sp, .net, ...): the circuit the model was
+  // reduced from (names, diode forms, passivity; docs/circuits.md).
+  std::shared_ptr<const circuit::Circuit> circuit = nullptr;
 };
 LoadedModel load_model_and_scene(const std::filesystem::path& path);
 // model_notes of the model, after the scene's notes (what loading repaired):

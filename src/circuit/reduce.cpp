@@ -1,0 +1,330 @@
+// Modified nodal analysis reduced to an LCS in state form (thesis §2.2, §5.2).
+//
+// Each capacitor is a voltage source of its state's value, each inductor a
+// current source of its state's value, each current-form diode a current
+// source u_i, each voltage-form diode a voltage source von + ron i - u_i,
+// each independent source its exosystem row. What is left is a resistive
+// network with controlled sources, whose MNA equations M z = N p (z: node
+// voltages, then the currents of the voltage-defined branches; p = (x, w, u))
+// give every voltage and current as a linear function of the state and of
+// the diode variables: Z = M^{-1} N. Then C dv/dt = i_C, L di/dt = v_L,
+// w' = S w, and y per diode.
+#include "circuit/reduce.hpp"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <lcsim/circuit/circuit.hpp>
+#include <lcsim/core/format.hpp>
+#include <lcsim/io/yaml.hpp>
+#include <numbers>
+
+#include "circuit/lines.hpp"
+
+namespace lcsim::circuit {
+namespace {
+
+using RowVector = Eigen::RowVectorXd;
+
+// Where each quantity sits: states, exosystem, pairs, MNA unknowns.
+struct Layout {
+  int nodes = 0;                            // non-ground nodes
+  std::vector<int> branch;                  // per element: its MNA branch (-1: none)
+  std::vector<int> state;                   // per element: its circuit state (-1: none)
+  std::vector<int> pair;                    // per element: its complementarity pair (-1: none)
+  std::vector<int> exo;                     // per element: its first exosystem state (sine), -1
+  int branches = 0, nc = 0, nw = 1, k = 0;  // nw: the constant state "1" first
+  int n() const { return nc + nw; }
+  int unknowns() const { return nodes + branches; }
+};
+
+Layout lay_out(const Netlist& net, const std::vector<DiodeForm>& forms) {
+  Layout L;
+  L.nodes = static_cast<int>(net.nodes.size()) - 1;
+  const std::size_t ne = net.elements.size();
+  L.branch.assign(ne, -1);
+  L.state.assign(ne, -1);
+  L.pair.assign(ne, -1);
+  L.exo.assign(ne, -1);
+  for (std::size_t i = 0; i < ne; ++i) {
+    const Element& e = net.elements[i];
+    if (e.kind == ElementKind::kCapacitor || e.kind == ElementKind::kInductor) L.state[i] = L.nc++;
+    if (e.kind == ElementKind::kDiode) L.pair[i] = L.k++;
+    const bool vform = e.kind == ElementKind::kDiode && forms[L.pair[i]] == DiodeForm::kVoltage;
+    if (detail::voltage_defined(e.kind) || vform) L.branch[i] = L.branches++;
+  }
+  for (std::size_t i = 0; i < ne; ++i)
+    if (net.elements[i].wave.sine) {
+      L.exo[i] = L.nw;
+      L.nw += 2;
+    }
+  return L;
+}
+
+// The equations M z = N p of the resistive network.
+struct Mna {
+  MatrixXd M, N;
+  const Layout* L;
+  // Row/column of node v (-1: ground).
+  int at(int v) const { return v - 1; }
+  void add(int r, int c, double x) {
+    if (r >= 0 && c >= 0) M(r, c) += x;
+  }
+  // A current `row` (over p) leaving node a and entering node b.
+  void inject(int a, int b, const RowVector& row) {
+    if (at(a) >= 0) N.row(at(a)) -= row;
+    if (at(b) >= 0) N.row(at(b)) += row;
+  }
+  // Branch column j: its current leaves node a, enters node b; its row says
+  // v_a - v_b = ... (the caller adds the rest).
+  void branch(int j, int a, int b) {
+    add(at(a), j, 1.0);
+    add(at(b), j, -1.0);
+    add(j, at(a), 1.0);
+    add(j, at(b), -1.0);
+  }
+};
+
+// The row over p = (x, w, u) of a source's value.
+RowVector source_row(const Element& e, const Layout& L, int exo) {
+  RowVector r = RowVector::Zero(L.n() + L.k);
+  r(L.nc) = e.wave.dc;  // the constant state "1"
+  if (e.wave.sine) r(L.nc + exo) = e.wave.amplitude;
+  return r;
+}
+
+int control_branch(const Netlist& net, const Layout& L, const Element& e) {
+  for (std::size_t j = 0; j < net.elements.size(); ++j)
+    if (net.elements[j].kind == ElementKind::kVoltageSource &&
+        detail::lower(net.elements[j].name) == e.control)
+      return L.nodes + L.branch[j];
+  throw std::logic_error("control_branch: unresolved " + e.control);
+}
+
+// Stamps one element (a long switch over the element kinds, one case each).
+void stamp(Mna& m, const Netlist& net, const Layout& L, std::size_t i) {
+  const Element& e = net.elements[i];
+  const int a = e.nodes[0], b = e.nodes[1], j = L.branch[i] >= 0 ? L.nodes + L.branch[i] : -1;
+  const int P = L.n() + L.k;
+  switch (e.kind) {
+    case ElementKind::kResistor:
+      m.add(m.at(a), m.at(a), 1.0 / e.value), m.add(m.at(b), m.at(b), 1.0 / e.value);
+      m.add(m.at(a), m.at(b), -1.0 / e.value), m.add(m.at(b), m.at(a), -1.0 / e.value);
+      break;
+    case ElementKind::kCapacitor:
+      m.branch(j, a, b);
+      m.N(j, L.state[i]) = 1.0;
+      break;
+    case ElementKind::kInductor:
+      m.inject(a, b, RowVector::Unit(P, L.state[i]));
+      break;
+    case ElementKind::kVoltageSource:
+      m.branch(j, a, b);
+      m.N.row(j) = source_row(e, L, L.exo[i]);
+      break;
+    case ElementKind::kCurrentSource:
+      m.inject(a, b, source_row(e, L, L.exo[i]));
+      break;
+    case ElementKind::kVcvs:
+      m.branch(j, a, b);
+      m.add(j, m.at(e.nodes[2]), -e.value), m.add(j, m.at(e.nodes[3]), e.value);
+      break;
+    case ElementKind::kCcvs:
+      m.branch(j, a, b);
+      m.add(j, control_branch(net, L, e), -e.value);
+      break;
+    case ElementKind::kVccs:
+      m.add(m.at(a), m.at(e.nodes[2]), e.value), m.add(m.at(a), m.at(e.nodes[3]), -e.value);
+      m.add(m.at(b), m.at(e.nodes[2]), -e.value), m.add(m.at(b), m.at(e.nodes[3]), e.value);
+      break;
+    case ElementKind::kCccs: {
+      const int c = control_branch(net, L, e);
+      m.add(m.at(a), c, e.value), m.add(m.at(b), c, -e.value);
+      break;
+    }
+    case ElementKind::kDiode:
+      if (j < 0) {  // current form: u_i flows from anode to cathode
+        m.inject(a, b, RowVector::Unit(P, L.n() + L.pair[i]));
+      } else {  // voltage form: v = von + ron i - u_i
+        m.branch(j, a, b);
+        m.add(j, j, -e.ron);
+        m.N(j, L.nc) = e.von;
+        m.N(j, L.n() + L.pair[i]) = -1.0;
+      }
+      break;
+  }
+}
+
+// Z = M^{-1} N, or InputError when the equations are singular.
+MatrixXd solve_mna(const Netlist& net, const Layout& L) {
+  Mna m;
+  m.L = &L;
+  m.M = MatrixXd::Zero(L.unknowns(), L.unknowns());
+  m.N = MatrixXd::Zero(L.unknowns(), L.n() + L.k);
+  for (std::size_t i = 0; i < net.elements.size(); ++i) stamp(m, net, L, i);
+  Eigen::FullPivLU<MatrixXd> lu(m.M);
+  lu.setThreshold(1e-12 * static_cast<double>(L.unknowns()));
+  if (!lu.isInvertible())
+    throw InputError(net.source + ": the circuit's equations are singular (rank " +
+                     std::to_string(lu.rank()) + " of " + std::to_string(L.unknowns()) +
+                     "): controlled sources that fix a voltage or current twice?");
+  return lu.solve(m.N);
+}
+
+// The row over p of each voltage and current the outputs and the LCS need.
+struct Quantities {
+  const Netlist* net;
+  const Layout* L;
+  MatrixXd Z;
+  RowVector zero() const { return RowVector::Zero(L->n() + L->k); }
+  RowVector node(int v) const { return v == 0 ? zero() : RowVector(Z.row(v - 1)); }
+  RowVector across(const Element& e) const { return node(e.nodes[0]) - node(e.nodes[1]); }
+  RowVector branch(std::size_t i) const { return Z.row(L->nodes + L->branch[i]); }
+  RowVector current(std::size_t i) const;
+};
+
+RowVector Quantities::current(std::size_t i) const {
+  const Element& e = net->elements[i];
+  const int P = L->n() + L->k;
+  switch (e.kind) {
+    case ElementKind::kResistor:
+      return across(e) / e.value;
+    case ElementKind::kInductor:
+      return RowVector::Unit(P, L->state[i]);
+    case ElementKind::kCurrentSource:
+      return source_row(e, *L, L->exo[i]);
+    case ElementKind::kVccs:
+      return e.value * (node(e.nodes[2]) - node(e.nodes[3]));
+    case ElementKind::kCccs:
+      return e.value * RowVector(Z.row(control_branch(*net, *L, e)));
+    case ElementKind::kDiode:
+      if (L->branch[i] < 0) return RowVector::Unit(P, L->n() + L->pair[i]);
+      return branch(i);
+    default:
+      return branch(i);  // C, V, E, H
+  }
+}
+
+// The LCS (A, B, C, D) and the exosystem block.
+lcs::Lcs assemble(const Netlist& net, const Layout& L, const Quantities& q,
+                  const std::vector<DiodeForm>& forms) {
+  const int n = L.n(), k = L.k;
+  MatrixXd AB = MatrixXd::Zero(n, n + k), CD = MatrixXd::Zero(k, n + k);
+  for (std::size_t i = 0; i < net.elements.size(); ++i) {
+    const Element& e = net.elements[i];
+    if (e.kind == ElementKind::kCapacitor) AB.row(L.state[i]) = q.branch(i) / e.value;
+    if (e.kind == ElementKind::kInductor) AB.row(L.state[i]) = q.across(e) / e.value;
+    if (e.wave.sine) {  // s' = -theta s + omega c, c' = -omega s - theta c
+      const int s = L.nc + L.exo[i];
+      const double w = 2.0 * std::numbers::pi * e.wave.frequency, th = e.wave.damping;
+      AB(s, s) = -th, AB(s, s + 1) = w, AB(s + 1, s) = -w, AB(s + 1, s + 1) = -th;
+    }
+    if (e.kind == ElementKind::kDiode) {
+      const int p = L.pair[i];
+      if (forms[p] == DiodeForm::kCurrent) {  // y = von + ron u - v
+        CD.row(p) = -q.across(e);
+        CD(p, L.nc) += e.von;
+        CD(p, n + p) += e.ron;
+      } else {  // y = i
+        CD.row(p) = q.branch(i);
+      }
+    }
+  }
+  lcs::Lcs s;
+  s.A = AB.leftCols(n);
+  s.B = AB.rightCols(k);
+  s.C = CD.leftCols(n);
+  s.D = CD.rightCols(k);
+  return s;
+}
+
+void name_and_output(Circuit& c, const Layout& L, const Quantities& q) {
+  const Netlist& net = c.netlist;
+  mech::Model& m = c.model;
+  m.state_names.assign(L.n(), "");
+  m.exo_initial = VectorXd::Zero(L.nw);
+  m.exo_initial(0) = 1.0;
+  m.state_names[L.nc] = "1";
+  std::vector<RowVector> rows;
+  for (std::size_t v = 1; v < net.nodes.size(); ++v) {
+    m.output_names.push_back("V(" + net.nodes[v] + ")");
+    rows.push_back(q.node(static_cast<int>(v)));
+  }
+  for (std::size_t i = 0; i < net.elements.size(); ++i) {
+    const Element& e = net.elements[i];
+    if (L.state[i] >= 0) {
+      m.state_names[L.state[i]] = e.name + (e.kind == ElementKind::kCapacitor ? ".v" : ".i");
+      c.state_element.push_back(static_cast<int>(i));
+    }
+    if (L.exo[i] >= 0) {
+      m.state_names[L.nc + L.exo[i]] = e.name + ".sin";
+      m.state_names[L.nc + L.exo[i] + 1] = e.name + ".cos";
+      const double phi = e.wave.phase_deg * std::numbers::pi / 180.0;
+      m.exo_initial(L.exo[i]) = std::sin(phi);
+      m.exo_initial(L.exo[i] + 1) = std::cos(phi);
+    }
+    if (L.pair[i] >= 0) {
+      m.pair_names.push_back(e.name);
+      c.diode_element.push_back(static_cast<int>(i));
+    }
+    m.output_names.push_back("I(" + e.name + ")");
+    rows.push_back(q.current(i));
+  }
+  const auto no = static_cast<Eigen::Index>(rows.size());
+  m.output_x.resize(no, L.n());
+  m.output_u.resize(no, L.k);
+  for (Eigen::Index r = 0; r < no; ++r) {
+    m.output_x.row(r) = rows[r].head(L.n());
+    m.output_u.row(r) = rows[r].tail(L.k);
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> Circuit::conducting(const std::vector<int>& mode) const {
+  std::vector<std::string> on;
+  for (std::size_t p = 0; p < diode_element.size(); ++p) {
+    const bool active = std::find(mode.begin(), mode.end(), static_cast<int>(p)) != mode.end();
+    if (active == (diode_form[p] == DiodeForm::kCurrent))
+      on.push_back(netlist.elements[diode_element[p]].name);
+  }
+  return on;
+}
+
+Circuit build_circuit(const Netlist& net) {
+  detail::check_floating(net);
+  detail::check_voltage_loops(net);
+  Circuit c;
+  c.netlist = net;
+  c.diode_form = detail::diode_forms_and_cut_sets(net);
+  const Layout L = lay_out(net, c.diode_form);
+  const Quantities q{&net, &L, solve_mna(net, L)};
+  c.circuit_states = L.nc;
+  c.model.lcs = assemble(net, L, q, c.diode_form);
+  c.model.exo_states = L.nw;
+  c.model.name = std::filesystem::path(net.source).stem().string();
+  c.model.source = net.source;
+  name_and_output(c, L, q);
+  c.energy = MatrixXd::Zero(L.nc, L.nc);
+  for (int s = 0; s < L.nc; ++s) c.energy(s, s) = net.elements[c.state_element[s]].value;
+  if (net.tran) c.model.t_end = net.tstop;
+  c.model.initial = detail::initial_state(c, c.initial_note);
+  if (auto p = mech::check_model(c.model))
+    throw InputError(net.source + ": " + p->field + ": " + p->what);
+  return c;
+}
+
+Circuit parse_circuit(const std::string& text, const std::string& source) {
+  return build_circuit(parse_netlist(text, source));
+}
+
+Circuit load_circuit(const std::filesystem::path& path) {
+  return parse_circuit(io::read_file(path), path.string());
+}
+
+bool is_netlist_path(const std::filesystem::path& path) {
+  const std::string ext = detail::lower(path.extension().string());
+  return ext == ".cir" || ext == ".sp" || ext == ".spi" || ext == ".spice" || ext == ".net";
+}
+
+}  // namespace lcsim::circuit

@@ -1,0 +1,55 @@
+// `lcsim simulate` and `lcsim analyze` on netlists: the CSV columns in the
+// circuit's language, a refused netlist exits 2 with one line and writes
+// nothing.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "support/run_lcsim.hpp"
+
+namespace lcsim {
+namespace {
+
+using cli_test::private_temp;
+using cli_test::run_lcsim;
+using cli_test::slurp;
+
+const std::string kCircuits = std::string(LCSIM_SOURCE_DIR) + "/circuits/";
+
+TEST(CliCircuits, SimulateWritesVoltagesAndCurrentsByName) {
+  const auto csv = private_temp("rect", ".csv"), err = private_temp("rect", ".err");
+  const auto r = run_lcsim("simulate " + kCircuits +
+                               "half_wave_rectifier.cir --dt-out 1e-3 --out '" + csv.string() + "'",
+                           err);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string text = slurp(csv);
+  EXPECT_EQ(text.substr(0, text.find('\n')),
+            "t,C1.v,1,V1.sin,V1.cos,u_D1,y_D1,V(in),V(out),I(V1),I(D1),I(R1),I(C1),mode");
+  // The report names the diode at each event.
+  EXPECT_NE(r.out.find("mode {0 D1}"), std::string::npos) << r.out;
+  std::filesystem::remove(csv);
+}
+
+TEST(CliCircuits, RefusedNetlistExitsTwoAndWritesNothing) {
+  const auto cir = private_temp("bad", ".cir"), csv = private_temp("bad", ".csv"),
+             err = private_temp("bad", ".err");
+  { std::ofstream(cir) << "title\nV1 a 0 1\nR1 a 0 1k\nC1 a b x10\nR2 b 0 1k\n"; }
+  const auto r = run_lcsim("simulate '" + cir.string() + "' --out '" + csv.string() + "'", err);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "lcsim: error: " + cir.string() + ":4: C1: non-numeric value 'x10'\n");
+  EXPECT_FALSE(std::filesystem::exists(csv));
+  std::filesystem::remove(cir);
+}
+
+TEST(CliCircuits, AnalyzeSaysPassiveAndWellPosed) {
+  const auto err = private_temp("an", ".err");
+  const auto r = run_lcsim("analyze " + kCircuits + "half_wave_rectifier.cir --json", err);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"passive\": \"yes\""), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"globally_well_posed\": true"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace lcsim
