@@ -5,6 +5,7 @@
 // the planar step along t.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <lcsim/mech/cone_slide.hpp>
 #include <lcsim/mech/mech.hpp>
@@ -185,6 +186,55 @@ TEST(MjFriction3d, OneEdgePairIsThePlanarStep) {
       for (int j = 0; j < 6; ++j) EXPECT_NEAR(a.samples[i].x(j), b.samples[i].x(j), 1e-12) << i;
     }
   }
+}
+
+// A model with a 3-D and a planar contact (the planar one's second-tangent
+// column is empty): two uncoupled blocks, the 3-D one at psi = 0.4 (d = 4),
+// the planar one along t, each stopping as its closed form says:
+// cone_slide, and s0/(mu g) for the planar block. Bound [0, 2h): the step
+// bound above, plus one step: a step may end with the gap at +1e-21 (the
+// normal impulse m g h to rounding) and the active-set rule (the
+// frictionless step's too) then leaves the contact out for one step, which
+// costs that step's friction, mu g h of speed, one step of stop time.
+TEST(MjFriction3d, MixedPlanarAnd3dContacts) {
+  mech::MechanicalModel m;
+  m.M = Eigen::MatrixXd::Identity(6, 6).sparseView();
+  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(2, 6);
+  E(0, 2) = E(1, 5) = 1.0;
+  m.E = E.sparseView();
+  m.f = (Eigen::VectorXd(6) << 0, 0, -kG, 0, 0, -kG).finished();
+  Eigen::VectorXd t = Eigen::VectorXd::Zero(6), t2 = t, tp = t;
+  t(0) = t2(1) = tp(3) = 1.0;
+  mech::FrictionalContact c3(0, t, kMu);
+  c3.tangent2 = t2.sparseView();
+  c3.edges = 4;
+  m.friction = {c3, mech::FrictionalContact(1, tp, kMu)};
+  const double psi = 0.4, h = 1e-3;
+  const mech::ConeSlide cs = mech::cone_slide(kS0, psi, kMu, kG, 4);
+  const double planar_stop = kS0 / (kMu * kG);
+  Eigen::VectorXd x0 = Eigen::VectorXd::Zero(12);
+  x0(6) = kS0 * std::cos(psi);
+  x0(7) = kS0 * std::sin(psi);
+  x0(9) = kS0;
+  sim::Options o;
+  o.t_end = std::max(cs.t_stop, planar_stop) + 0.05;
+  o.h = h;
+  const sim::Trajectory a =
+      sim::make_integrator("moreau-jean")->run(mech::model_of(m, "mixed"), x0, o);
+  ASSERT_EQ(a.status, Status::kOk) << a.message;
+  double stop3 = -1.0, stop2 = -1.0, heading = 0.0;
+  for (const sim::Sample& s : a.samples) {
+    const bool rest3 = std::hypot(s.x(6), s.x(7)) <= 1e-12 * kS0;
+    if (!rest3) heading = std::atan2(s.x(7), s.x(6));
+    if (rest3 && stop3 < 0.0 && s.t > 0.0) stop3 = s.t;
+    if (std::abs(s.x(9)) <= 1e-12 * kS0 && stop2 < 0.0 && s.t > 0.0) stop2 = s.t;
+    EXPECT_EQ(s.x(10), 0.0);  // no friction across the planar block's t
+  }
+  EXPECT_GE(stop3 - cs.t_stop, -1e-9);
+  EXPECT_LT(stop3 - cs.t_stop, 2 * h);
+  EXPECT_NEAR(rounding_free_heading_error(heading, cs.heading), 0.0, 1e-9);
+  EXPECT_GE(stop2 - planar_stop, -1e-9);
+  EXPECT_LT(stop2 - planar_stop, 2 * h);
 }
 
 }  // namespace
