@@ -37,7 +37,7 @@ from ._lcsim import (
 )
 
 # Trajectory.friction_modes holds indices into this tuple (-1: not determined).
-FRICTION_MODES = ("open", "stick", "slip+", "slip-")
+FRICTION_MODES = ("open", "stick", "slip+", "slip-", "slip")  # "slip": a 3-D contact sliding
 
 __all__ = [
     "FRICTION_MODES", "Event", "ImpactResult", "InputError", "LcpResult", "Model", "Trajectory", "analyze",

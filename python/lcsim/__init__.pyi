@@ -75,7 +75,7 @@ class Event:
     mode: list[int]
     note: str
     friction_impulse: np.ndarray  # per frictional contact (empty without friction)
-    friction_modes: list[str]  # 'open', 'stick', 'slip+' or 'slip-' after the event
+    friction_modes: list[str]  # 'open', 'stick', 'slip+', 'slip-' or 'slip' (3-D) after the event
     dt: list[Optional[float]]  # d t_event / d sensitivity column, None where absent
 
 class Trajectory:

@@ -241,10 +241,11 @@ void bind_samples(RunClass& r) {
   r.def_readonly("u_t", &Run::u_t,
                  "Tangential multipliers of the frictional contacts (model order), shape "
                  "(n, contacts); NaN where a sample records none.");
-  r.def_readonly("friction_modes", &Run::friction_modes,
-                 "Modes of the frictional contacts (model order), shape (n, contacts), int8: 0 "
-                 "open, 1 stick, 2 slip+, 3 slip- (lcsim.FRICTION_MODES); -1 where the method "
-                 "does not determine them.");
+  r.def_readonly(
+      "friction_modes", &Run::friction_modes,
+      "Modes of the frictional contacts (model order), shape (n, contacts), int8: 0 "
+      "open, 1 stick, 2 slip+, 3 slip-, 4 slip (3-D) (lcsim.FRICTION_MODES); -1 where the method "
+      "does not determine them.");
   r.def_readonly("x", &Run::x, "States, shape (n, state size): q then v for mechanical models.");
   r.def_readonly("u", &Run::u,
                  "Multipliers (regular part), shape (n, constraints); NaN where not recorded.");

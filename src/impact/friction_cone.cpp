@@ -68,6 +68,58 @@ std::string cone_mode_text(ContactOutcome o, ConeFacet facet) {
   }
 }
 
+// Stewart and Trinkle's LCP (impact.hpp, friction_cone_lcp).
+FrictionLcp friction_cone_lcp(const MatrixXd& Wb, const VectorXd& rate_N, const VectorXd& rate_D,
+                              const std::vector<int>& normal_of, const std::vector<int>& first,
+                              const std::vector<int>& d, const VectorXd& mu) {
+  const Eigen::Index nn = rate_N.size(), ne = rate_D.size(), nf = mu.size();
+  const Eigen::Index n = nn + ne + nf;
+  FrictionLcp out;
+  out.M = MatrixXd::Zero(n, n);
+  out.q = VectorXd::Zero(n);
+  out.M.topLeftCorner(nn + ne, nn + ne) = Wb;
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    const size_t fs = static_cast<size_t>(f);
+    out.M(nn + ne + f, normal_of[fs]) = mu(f);
+    for (int i = 0; i < 2 * d[fs]; ++i) {
+      out.M(nn + first[fs] + i, nn + ne + f) = 1.0;
+      out.M(nn + ne + f, nn + first[fs] + i) = -1.0;
+    }
+  }
+  out.q.head(nn) = rate_N;
+  out.q.segment(nn, ne) = rate_D;
+  return out;
+}
+
+// Solves the cone's LCP: impact::solve_friction_lcp, and where its row-scaled
+// acceptance refuses, Lemke's z accepted on the natural residual relative to
+// the whole problem: 0 <= z, w = M z + q >= -tol, |z_i w_i| <= tol |z|_inf
+// with tol = 1e-12 (|q|_inf + |M|_inf |z|_inf). The row-scaled test measures
+// a row against its own terms, and the row of an edge orthogonal to the
+// velocity (sticking with the velocity along an edge or a bisector) is
+// formed of products cos(pi/2) |D||v| ~ 1e-17: its rounding, 1e-16, is
+// then 30% of its terms although it is 1e-16 of the problem's.
+lcp::Result solve_friction_cone_lcp(const FrictionLcp& p, const lcp::Solver& solver, int* solves,
+                                    std::string* tried) {
+  lcp::Result res = solve_friction_lcp(p, solver, solves, tried);
+  if (res.ok()) return res;
+  lcp::Options opt;
+  lcp::Result r = lcp::make_solver("lemke")->solve(p.M, p.q, opt);
+  if (solves) ++*solves;
+  if (tried) *tried += ", lemke (natural residual)";
+  if (r.z.size() != p.q.size() || !r.z.allFinite()) return res;
+  r.z = r.z.cwiseMax(0.0);
+  const VectorXd w = p.M * r.z + p.q;
+  const double zmax = r.z.cwiseAbs().maxCoeff();
+  const double tol =
+      1e-12 * (p.q.cwiseAbs().maxCoeff() + p.M.cwiseAbs().rowwise().sum().maxCoeff() * zmax);
+  for (Eigen::Index i = 0; i < w.size(); ++i)
+    if (w(i) < -tol || std::abs(w(i) * r.z(i)) > tol * zmax) return res;
+  r.status = lcp::Status::kSolved;
+  r.message.clear();
+  return r;
+}
+
 namespace {
 
 // The closed frictional contacts: normal row in J, index in model.friction,
@@ -111,55 +163,9 @@ ClosedCone closed_cone(const mech::MechanicalModel& m, const IndexSet& closed) {
   return c;
 }
 
-// Stewart and Trinkle's LCP (impact.hpp) from Wb = B M^-1 B', B = [E_J; D].
 FrictionLcp cone_lcp(const MatrixXd& Wb, const VectorXd& rate_N, const VectorXd& rate_D,
                      const ClosedCone& c) {
-  const Eigen::Index nn = rate_N.size(), ne = rate_D.size(), nf = c.mu.size();
-  const Eigen::Index n = nn + ne + nf;
-  FrictionLcp out;
-  out.M = MatrixXd::Zero(n, n);
-  out.q = VectorXd::Zero(n);
-  out.M.topLeftCorner(nn + ne, nn + ne) = Wb;
-  for (Eigen::Index f = 0; f < nf; ++f) {
-    const size_t fs = static_cast<size_t>(f);
-    out.M(nn + ne + f, c.normal_of[fs]) = c.mu(f);
-    for (int i = 0; i < 2 * c.d[fs]; ++i) {
-      out.M(nn + c.first[fs] + i, nn + ne + f) = 1.0;
-      out.M(nn + ne + f, nn + c.first[fs] + i) = -1.0;
-    }
-  }
-  out.q.head(nn) = rate_N;
-  out.q.segment(nn, ne) = rate_D;
-  return out;
-}
-
-// Solves the cone's LCP: impact::solve_friction_lcp, and where its row-scaled
-// acceptance refuses, Lemke's z accepted on the natural residual relative to
-// the whole problem: 0 <= z, w = M z + q >= -tol, |z_i w_i| <= tol |z|_inf
-// with tol = 1e-12 (|q|_inf + |M|_inf |z|_inf). The row-scaled test measures
-// a row against its own terms, and the row of an edge orthogonal to the
-// velocity (sticking with the velocity along an edge or a bisector) is
-// formed of products cos(pi/2) |D||v| ~ 1e-17: its rounding, 1e-16, is
-// then 30% of its terms although it is 1e-16 of the problem's.
-lcp::Result solve_cone_lcp(const FrictionLcp& p, const lcp::Solver& solver, int* solves,
-                           std::string* tried) {
-  lcp::Result res = solve_friction_lcp(p, solver, solves, tried);
-  if (res.ok()) return res;
-  lcp::Options opt;
-  lcp::Result r = lcp::make_solver("lemke")->solve(p.M, p.q, opt);
-  if (solves) ++*solves;
-  if (tried) *tried += ", lemke (natural residual)";
-  if (r.z.size() != p.q.size() || !r.z.allFinite()) return res;
-  r.z = r.z.cwiseMax(0.0);
-  const VectorXd w = p.M * r.z + p.q;
-  const double zmax = r.z.cwiseAbs().maxCoeff();
-  const double tol =
-      1e-12 * (p.q.cwiseAbs().maxCoeff() + p.M.cwiseAbs().rowwise().sum().maxCoeff() * zmax);
-  for (Eigen::Index i = 0; i < w.size(); ++i)
-    if (w(i) < -tol || std::abs(w(i) * r.z(i)) > tol * zmax) return res;
-  r.status = lcp::Status::kSolved;
-  r.message.clear();
-  return r;
+  return friction_cone_lcp(Wb, rate_N, rate_D, c.normal_of, c.first, c.d, c.mu);
 }
 
 // Painlevé-type cases (friction.cpp's painleve, with one edge per contact in
@@ -294,7 +300,7 @@ ImpactResult moreau_friction_cone(const ImpactInput& in, const lcp::Solver& solv
   const VectorXd rate_N = s->a + s->e_J.cwiseProduct(s->a.cwiseMin(0.0));
   const FrictionLcp lcp = cone_lcp(Wb, rate_N, c.D * in.v - c.edge_velocity, c);
   std::string tried;
-  const lcp::Result res = solve_cone_lcp(lcp, solver, &out.lcp_solves, &tried);
+  const lcp::Result res = solve_friction_cone_lcp(lcp, solver, &out.lcp_solves, &tried);
   out.lcp_status = res.status;
   if (!res.ok()) {
     out.message = "friction impact LCP failed (" + tried +

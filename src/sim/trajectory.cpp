@@ -37,6 +37,8 @@ std::string_view to_string(FrictionMode m) {
       return "slip+";
     case FrictionMode::kSlipNegative:
       return "slip-";
+    case FrictionMode::kSlip:
+      return "slip";
   }
   return "unknown";
 }

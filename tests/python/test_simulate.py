@@ -103,7 +103,7 @@ def test_friction_from_matrices_is_the_model_file(robots):
     assert runs[0].friction_modes.shape == (len(runs[0].t), 1)
     assert runs[0].friction_modes.dtype == np.int8
     assert set(np.unique(runs[0].friction_modes)) <= {-1, 0, 1, 2, 3}
-    assert lcsim.FRICTION_MODES == ("open", "stick", "slip+", "slip-")
+    assert lcsim.FRICTION_MODES == ("open", "stick", "slip+", "slip-", "slip")
 
 
 def test_bad_friction_entries_name_them():

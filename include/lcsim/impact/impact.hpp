@@ -191,6 +191,20 @@ lcp::Result solve_friction_lcp(const FrictionLcp& p, const lcp::Solver& solver, 
 void friction_impulses(const VectorXd& z, int n_normal, const std::vector<int>& normal_of,
                        const VectorXd& mu, VectorXd& lambda_N, VectorXd& lambda_T);
 
+// The cone's LCP above from its data, for the impact law and Moreau–Jean's
+// step with 3-D friction: Wb = B W^{-1} B' over B = [E_J; D] (normal rows,
+// then each frictional contact's 2 d_f edge rows from row first[f] of D),
+// rate_N (n_N, restitution included), rate_D (n_E, the surfaces' velocity
+// removed), normal_of[f] the normal row (0..n_N) of frictional contact f.
+// Unknowns z = (lambda_N, beta (n_E), xi (n_F)).
+FrictionLcp friction_cone_lcp(const MatrixXd& Wb, const VectorXd& rate_N, const VectorXd& rate_D,
+                              const std::vector<int>& normal_of, const std::vector<int>& first,
+                              const std::vector<int>& d, const VectorXd& mu);
+// Solves a friction_cone_lcp: solve_friction_lcp, then Lemke's z accepted
+// on the natural residual relative to the whole problem (friction_cone.cpp).
+lcp::Result solve_friction_cone_lcp(const FrictionLcp& p, const lcp::Solver& solver, int* solves,
+                                    std::string* tried);
+
 // "moreau-restitution": the Moreau–Jean law, restitution inside the LCP:
 // 0 <= E_J v+ + e∘E_J v ⟂ lambda >= 0, v+ = v + M^{-1} E_J' lambda.
 ImpactResult moreau_restitution(const ImpactInput& in, const lcp::Solver& solver);

@@ -32,9 +32,10 @@ std::string_view to_string(EventType t);
 // What a closed frictional contact does in a sample (Sample::friction_mode):
 // kOpen when its normal constraint is not closed; kStick, tangential
 // velocity zero (relative to its surface) and |u_T| <= mu u_N; kSlipPositive
-// / kSlipNegative, sliding along +t / -t with u_T = -/+ mu u_N.
-enum class FrictionMode : signed char { kOpen, kStick, kSlipPositive, kSlipNegative };
-std::string_view to_string(FrictionMode m);  // "open", "stick", "slip+", "slip-"
+// / kSlipNegative, sliding along +t / -t with u_T = -/+ mu u_N; kSlip, a 3-D
+// contact (two tangents) sliding, its friction on the cone's boundary.
+enum class FrictionMode : signed char { kOpen, kStick, kSlipPositive, kSlipNegative, kSlip };
+std::string_view to_string(FrictionMode m);  // "open", "stick", "slip+", "slip-", "slip"
 
 struct Sample {
   double t = 0.0;

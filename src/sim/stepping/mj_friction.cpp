@@ -16,7 +16,11 @@ MjFriction::MjFriction(const mech::MechanicalModel& m, const MjOperators& ops)
       Gc_(ops.rows_transposed().transpose()),
       of_contact_(static_cast<size_t>(m.num_constraints()), -1),
       gpos_(static_cast<size_t>(ops.rows_transposed().cols()), -1),
-      lamT_prev_(VectorXd::Zero(m.num_constraints())) {
+      lamT_prev_(VectorXd::Zero(m.num_constraints())),
+      cone_(m.has_friction_3d()),
+      t2_col_(m.num_constraints() + static_cast<int>(m.friction.size())),
+      empty_(m.dofs(), 1),
+      lamT2_(VectorXd::Zero(m.has_friction_3d() ? m.num_constraints() : 0)) {
   for (size_t f = 0; f < m.friction.size(); ++f)
     of_contact_[static_cast<size_t>(m.friction[f].contact)] = static_cast<int>(f);
   Gc_.makeCompressed();
@@ -36,7 +40,10 @@ bool MjFriction::assemble(MjIteration& f, const IndexSet& A,
                           const std::vector<const SparseCol*>& cols) {
   const int k = m_.num_constraints();
   for (int i : A_) gpos_[static_cast<size_t>(i)] = -1;
-  for (int j : fric_) gpos_[static_cast<size_t>(k + j)] = -1;
+  for (int j : fric_) {
+    gpos_[static_cast<size_t>(k + j)] = -1;
+    if (cone_) gpos_[static_cast<size_t>(t2_col_ + j)] = -1;
+  }
   A_ = A;
   f_ = &f;
   ++version_;
@@ -51,7 +58,7 @@ bool MjFriction::assemble(MjIteration& f, const IndexSet& A,
       fric_.push_back(fi);
     }
   nf_ = static_cast<long>(fric_.size());
-  const long ng = na_ + nf_;
+  const long ng = na_ + (cone_ ? 2 : 1) * nf_;
   gcols_.assign(cols.begin(), cols.end());
   mu_.resize(nf_);
   belt_.resize(nf_);
@@ -64,6 +71,13 @@ bool MjFriction::assemble(MjIteration& f, const IndexSet& A,
     gcols_.push_back(c);
     mu_(j) = m_.friction[static_cast<size_t>(fi)].mu;
     belt_(j) = m_.friction[static_cast<size_t>(fi)].velocity;
+  }
+  for (long j = 0; cone_ && j < nf_; ++j) {  // the second tangents
+    const int fi = fric_[static_cast<size_t>(j)];
+    gpos_[static_cast<size_t>(t2_col_ + fi)] = static_cast<int>(na_ + nf_ + j);
+    const SparseCol* c = &empty_;
+    if (m_.friction[static_cast<size_t>(fi)].is_3d() && !f.column(t2_col_ + fi, c)) return false;
+    gcols_.push_back(c);
   }
   trip_.clear();
   for (long g = 0; g < ng; ++g)
@@ -89,22 +103,97 @@ bool MjFriction::solve_dense(const MatrixXd& Wg, const lcp::Solver& solver, long
     p_.q.head(na_) = b_.head(na_);
     p_.q.segment(na_, nf_) = b_.tail(nf_);
   }
+  if (!solve_kept(false, solver, solves, failed)) return false;
+  for (long a = 0; a < na_; ++a) lam_(a) = zprev_(a);
+  for (long j = 0; j < nf_; ++j)
+    lam_(na_ + j) = zprev_(na_ + j) - mu_(j) * zprev_(normal_of_[static_cast<size_t>(j)]);
+  return true;
+}
+
+// p_ solved into zprev_: on the previous step's basis when A is unchanged
+// (warm()), else by the planar or the cone's solver with its fallbacks.
+bool MjFriction::solve_kept(bool cone, const lcp::Solver& solver, long& solves,
+                            lcp::Result& failed) {
   if (zprev_version_ == version_ && warm()) {
     ++solves;
   } else {
     int attempts = 0;
-    lcp::Result r = impact::solve_friction_lcp(p_, solver, &attempts, nullptr);
+    std::string tried;
+    lcp::Result r = cone ? impact::solve_friction_cone_lcp(p_, solver, &attempts, &tried)
+                         : impact::solve_friction_lcp(p_, solver, &attempts, nullptr);
     solves += attempts;
     if (!r.ok()) {
+      if (cone)
+        r.message =
+            "friction cone LCP (" + tried + ")" + (r.message.empty() ? "" : ": ") + r.message;
       failed = std::move(r);
       return false;
     }
     zprev_ = r.z;
   }
   zprev_version_ = version_;
-  for (long a = 0; a < na_; ++a) lam_(a) = zprev_(a);
+  return true;
+}
+
+// The edges' Delassus matrix Wb = P Wg P' (mj_friction.hpp), once per A.
+void MjFriction::assemble_cone() {
+  d_.resize(static_cast<size_t>(nf_));
+  first_.resize(static_cast<size_t>(nf_));
+  ne_ = 0;
+  for (long j = 0; j < nf_; ++j) {
+    d_[static_cast<size_t>(j)] =
+        m_.edges_of(m_.friction[static_cast<size_t>(fric_[static_cast<size_t>(j)])]);
+    first_[static_cast<size_t>(j)] = static_cast<int>(ne_);
+    ne_ += 2 * d_[static_cast<size_t>(j)];
+  }
+  if (na_ + ne_ + nf_ > kDenseFallbackMax) return;  // refused by solve_cone
+  MatrixXd P = MatrixXd::Zero(na_ + ne_, na_ + 2 * nf_);
+  P.topLeftCorner(na_, na_).setIdentity();
   for (long j = 0; j < nf_; ++j)
-    lam_(na_ + j) = zprev_(na_ + j) - mu_(j) * zprev_(normal_of_[static_cast<size_t>(j)]);
+    for (int i = 0; i < 2 * d_[static_cast<size_t>(j)]; ++i) {
+      const auto [c, s] = impact::cone_edge(i, d_[static_cast<size_t>(j)]);
+      P(na_ + first_[static_cast<size_t>(j)] + i, na_ + j) = c;
+      P(na_ + first_[static_cast<size_t>(j)] + i, na_ + nf_ + j) = s;
+    }
+  Wb_.noalias() = P * (Wg_ * P.transpose());
+}
+
+// The step's cone LCP (mj_friction.hpp); lam_ gets (lambda_N, the impulses
+// along t, along t2) from the edge impulses.
+bool MjFriction::solve_cone(const lcp::Solver& solver, long& solves, lcp::Result& failed) {
+  if (na_ + ne_ + nf_ > kDenseFallbackMax) {
+    failed.status = lcp::Status::kNumericalFailure;
+    failed.message = "the 3-D friction step LCP has " + std::to_string(na_ + ne_ + nf_) +
+                     " unknowns, more than the dense limit " + std::to_string(kDenseFallbackMax) +
+                     " (no sparse solver for the cone yet)";
+    return false;
+  }
+  rate_D_.resize(ne_);
+  for (long j = 0; j < nf_; ++j)
+    for (int i = 0; i < 2 * d_[static_cast<size_t>(j)]; ++i) {
+      const auto [c, s] = impact::cone_edge(i, d_[static_cast<size_t>(j)]);
+      rate_D_(first_[static_cast<size_t>(j)] + i) = c * b_(na_ + j) + s * b_(na_ + nf_ + j);
+    }
+  if (p_version_ != version_) {
+    p_ = impact::friction_cone_lcp(Wb_, b_.head(na_), rate_D_, normal_of_, first_, d_, mu_);
+    p_version_ = version_;
+  } else {
+    p_.q.head(na_) = b_.head(na_);
+    p_.q.segment(na_, ne_) = rate_D_;
+  }
+  if (!solve_kept(true, solver, solves, failed)) return false;
+  lam_.head(na_) = zprev_.head(na_);
+  for (long j = 0; j < nf_; ++j) {
+    double p1 = 0.0, p2 = 0.0;
+    for (int i = 0; i < 2 * d_[static_cast<size_t>(j)]; ++i) {
+      const auto [c, s] = impact::cone_edge(i, d_[static_cast<size_t>(j)]);
+      const double beta = zprev_(na_ + first_[static_cast<size_t>(j)] + i);
+      p1 += c * beta;
+      p2 += s * beta;
+    }
+    lam_(na_ + j) = p1;
+    lam_(na_ + nf_ + j) = p2;
+  }
   return true;
 }
 
@@ -183,9 +272,12 @@ bool MjFriction::step(MjIteration& f, const IndexSet& A, const std::vector<const
       failed.message = "a column W^{-1} t' is not finite";
       return false;
     }
-    if (na_ + nf_ <= pivot_max_active) Wd_ = MatrixXd(Wg_);
+    if (cone_)
+      assemble_cone();
+    else if (na_ + nf_ <= pivot_max_active)
+      Wd_ = MatrixXd(Wg_);
   }
-  const long ng = na_ + nf_;
+  const long ng = na_ + (cone_ ? 2 : 1) * nf_;
   // Rates G v_free, restitution on the normals, minus the surfaces' velocities.
   b_.resize(ng);
   auto row_times = [&](int i) {
@@ -199,13 +291,16 @@ bool MjFriction::step(MjIteration& f, const IndexSet& A, const std::vector<const
   }
   for (long j = 0; j < nf_; ++j)
     b_(na_ + j) = row_times(k + fric_[static_cast<size_t>(j)]) - belt_(j);
+  for (long j = 0; cone_ && j < nf_; ++j)
+    b_(na_ + nf_ + j) = row_times(t2_col_ + fric_[static_cast<size_t>(j)]);
   lam_.resize(ng);
   lam_.head(na_) = lambda_N;
   for (long j = 0; j < nf_; ++j)
     lam_(na_ + j) =
         lamT_prev_(m_.friction[static_cast<size_t>(fric_[static_cast<size_t>(j)])].contact);
-  const bool ok = ng <= pivot_max_active ? solve_dense(Wd_, solver, solves, failed)
-                                         : solve_sparse(solver, solves, failed, warning);
+  const bool ok = cone_                    ? solve_cone(solver, solves, failed)
+                  : ng <= pivot_max_active ? solve_dense(Wd_, solver, solves, failed)
+                                           : solve_sparse(solver, solves, failed, warning);
   if (!ok) return false;
   for (long g = 0; g < ng; ++g)
     if (const double x = lam_(g); x != 0.0)
@@ -216,6 +311,12 @@ bool MjFriction::step(MjIteration& f, const IndexSet& A, const std::vector<const
   for (long j = 0; j < nf_; ++j) {
     const int c = m_.friction[static_cast<size_t>(fric_[static_cast<size_t>(j)])].contact;
     lambda_T(c) = lamT_prev_(c) = lam_(na_ + j);
+  }
+  if (cone_) {
+    lamT2_.setZero();
+    for (long j = 0; j < nf_; ++j)
+      lamT2_(m_.friction[static_cast<size_t>(fric_[static_cast<size_t>(j)])].contact) =
+          lam_(na_ + nf_ + j);
   }
   return true;
 }

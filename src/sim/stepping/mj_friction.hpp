@@ -21,6 +21,18 @@
 //   the caller warns (as the frictionless step's PGS).
 // - Scratch is kept across steps: a step with an unchanged active set
 //   allocates nothing on the sparse path.
+//
+// 3-D friction (issue 27; models with mech::MechanicalModel::has_friction_3d,
+// planar models never take this path): G = [E_A; T_F; T2_F] (T2 the second
+// tangents, MjIteration's columns k + n_F + f; a planar contact of such a
+// model has an empty one) assembled as above, then Wb = P Wg P' over the
+// cone's edges D_i = cos(pi i/d) t + sin(pi i/d) t2 (P maps the tangent
+// rows to the 2d edge rows of each contact) and the step LCP in Stewart and
+// Trinkle's form (impact::friction_cone_lcp: lambda_N, 2d edge impulses, the
+// slack xi, the sliding speed in the polygon's dual norm), solved dense: on
+// the previous step's basis when A is unchanged (warm()), else by
+// impact::solve_friction_cone_lcp. No sparse solver for the cone yet: a step
+// whose LCP has more than kDenseFallbackMax unknowns fails with a message.
 #pragma once
 
 #include <lcsim/impact/impact.hpp>
@@ -50,6 +62,9 @@ class MjFriction {
   // step's start (restitution e_i E_i v on the normal rows). False on an LCP
   // failure (`failed` holds it); `warning` non-empty when the iterate of a
   // non-converged sweep was kept.
+  // 3-D friction: the impulses (N s) along the second tangents of the last
+  // step, per constraint (k; zero without 3-D friction).
+  const VectorXd& lambda_T2() const { return lamT2_; }
   bool step(MjIteration& f, const IndexSet& A, const std::vector<const SparseCol*>& cols,
             const VectorXd& Ev, const VectorXd& e, const lcp::Solver& solver, int pivot_max_active,
             VectorXd& v_next, VectorXd& lambda_N, VectorXd& lambda_T, long& solves,
@@ -59,7 +74,10 @@ class MjFriction {
   bool assemble(MjIteration& f, const IndexSet& A, const std::vector<const SparseCol*>& cols);
   bool solve_dense(const MatrixXd& Wg, const lcp::Solver& solver, long& solves,
                    lcp::Result& failed);
+  bool solve_kept(bool cone, const lcp::Solver& solver, long& solves, lcp::Result& failed);
   bool warm();
+  void assemble_cone();
+  bool solve_cone(const lcp::Solver& solver, long& solves, lcp::Result& failed);
   bool solve_sparse(const lcp::Solver& solver, long& solves, lcp::Result& failed,
                     std::string& warning);
 
@@ -89,6 +107,17 @@ class MjFriction {
   std::vector<int> J_, J_factored_;
   MatrixXd Mjj_;
   Eigen::PartialPivLU<MatrixXd> lu_;
+  // 3-D friction: whether the model has it, the columns' offset k + n_F of
+  // the second tangents, an empty column (a planar contact's second
+  // tangent), per F: edge pairs d and first edge row; the edges' Delassus
+  // matrix Wb, their rates and the impulses along t2 per constraint.
+  bool cone_ = false;
+  int t2_col_ = 0;
+  SparseCol empty_;
+  long ne_ = 0;
+  std::vector<int> d_, first_;
+  MatrixXd Wb_;
+  VectorXd rate_D_, lamT2_;
 };
 
 }  // namespace lcsim::sim::detail

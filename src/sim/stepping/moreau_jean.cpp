@@ -95,9 +95,18 @@ constexpr int kPivotFallbackMax = 2000;
 // when its sliding velocity is zero to rounding (a stuck velocity is a
 // cancellation of terms of the size of |t| |v|, exact to a few hundred eps
 // of it: 1e-12 of it), else slip along the sliding velocity's sign.
+// A 3-D contact: the same on the sliding speed |(t.v - velocity, t2.v)|
+// with the terms of both rows, kSlip when it slides.
 FrictionMode friction_mode_after_step(const mech::FrictionalContact& fc, const VectorXd& v) {
   const double s = fc.sliding(v);
-  const double scale = fc.tangent.cwiseAbs().dot(v.cwiseAbs()) + std::abs(fc.velocity);
+  double scale = fc.tangent.cwiseAbs().dot(v.cwiseAbs()) + std::abs(fc.velocity);
+  if (fc.is_3d()) {
+    const double s2 = fc.tangent2.dot(v);
+    scale += fc.tangent2.cwiseAbs().dot(v.cwiseAbs());
+    return std::hypot(s, s2) <= 1e-12 * scale + std::numeric_limits<double>::min()
+               ? FrictionMode::kStick
+               : FrictionMode::kSlip;
+  }
   if (std::abs(s) <= 1e-12 * scale + std::numeric_limits<double>::min())
     return FrictionMode::kStick;
   return s > 0.0 ? FrictionMode::kSlipPositive : FrictionMode::kSlipNegative;

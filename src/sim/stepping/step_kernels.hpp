@@ -71,14 +71,21 @@ class MjOperators {
   const SparseCol& E_by_columns() const { return Ec_; }
   // [E; T]' (N x (k + n_F)): column i < k is E_i', column k + f the tangent
   // row of m.friction[f] (the rows whose W^{-1} columns MjIteration caches).
+  // Models with 3-D friction: n_F more columns, k + n_F + f the second
+  // tangent of m.friction[f] (empty for a planar contact).
   const SparseCol& rows_transposed() const { return Gt_; }
   static SparseCol contact_rows_transposed(const mech::MechanicalModel& m) {
     SparseCol Gt = m.E.transpose();
-    Gt.conservativeResize(m.dofs(), m.num_constraints() + static_cast<int>(m.friction.size()));
-    for (size_t f = 0; f < m.friction.size(); ++f) {
-      const int col = m.num_constraints() + static_cast<int>(f);
-      for (Eigen::SparseVector<double>::InnerIterator it(m.friction[f].tangent); it; ++it)
+    const int k = m.num_constraints(), nf = static_cast<int>(m.friction.size());
+    Gt.conservativeResize(m.dofs(), k + (m.has_friction_3d() ? 2 : 1) * nf);
+    auto put = [&Gt](const Eigen::SparseVector<double>& t, int col) {
+      for (Eigen::SparseVector<double>::InnerIterator it(t); it; ++it)
         if (it.value() != 0.0) Gt.insert(it.index(), col) = it.value();
+    };
+    for (int f = 0; f < nf; ++f) {
+      put(m.friction[static_cast<size_t>(f)].tangent, k + f);
+      if (m.friction[static_cast<size_t>(f)].is_3d())
+        put(m.friction[static_cast<size_t>(f)].tangent2, k + nf + f);
     }
     Gt.makeCompressed();
     return Gt;
