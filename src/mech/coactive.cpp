@@ -29,38 +29,72 @@ VectorXd entries_of(const VectorXd& g, const std::vector<int>& J) {
 //    infeasible when its residual is not zero by gap_is_zero (the
 //    integrator's zero test for a gap, mech/tolerances.hpp).
 // 2. q = q_p + Z z with Z a basis of Ker E_J: the inequalities A z + b >= 0,
-//    A = E_K Z, b = E_K q_p + g_K, are feasible iff the convex QP
-//    min |z|^2/2 s.t. A z + b >= 0 has a solution, iff its KKT LCP
-//    0 <= A A' l + b ⟂ l >= 0 is solvable (z = A' l). A A' is PSD, so Lemke's
-//    method either solves it or ends on a ray, which for a PSD (copositive-
-//    plus) matrix proves the LCP infeasible (Cottle-Pang-Stone, Thm 4.4.13).
-bool feasible_exact(const MatrixXd& E, const VectorXd& g, const std::vector<int>& J) {
+//    A = E_K Z, b = E_K q_p + g_K. A row E_k in the row space of E_J (a
+//    corner above a closed one: equal rows of E) has A_k = 0: its gap is the
+//    constant b_k on the whole solution set, so it is judged alone (b_k >= 0
+//    or zero by gap_is_zero) and kept out of the LCP. Computed, A_k is the
+//    SVD's rounding (~eps |E_k|), not zero; handed to Lemke, whose row
+//    equilibration scales that row to 1 and its b_k to ~b_k / eps, it swamps
+//    the scale of every other basic value and Lemke stopped after 2 pivots on
+//    a wrong basis (numerical failure, read as "infeasible").
+// 3. The other rows are feasible iff the convex QP min |z|^2/2 s.t.
+//    A z + b >= 0 has a solution, iff its KKT LCP 0 <= A A' l + b ⟂ l >= 0 is
+//    solvable (z = A' l). A A' is PSD, so Lemke's method either solves it or
+//    ends on a ray, which for a PSD (copositive-plus) matrix proves the LCP
+//    infeasible (Cottle-Pang-Stone, Thm 4.4.13); any other end (a numerical
+//    failure) decides nothing: kUndecided.
+enum class Verdict { kFeasible, kInfeasible, kUndecided };
+
+// Whether row `row` of A is zero to the SVD's rounding: |A_k| <= 1e-12
+// max(rows, cols) |E_k| (the rank threshold of step 1, relative to the row's
+// own size; Z is orthonormal, so |A_k| <= |E_k| always).
+bool constant_on_solution_set(const MatrixXd& A, const MatrixXd& EK, Eigen::Index row,
+                              double rank_rel) {
+  return A.row(row).norm() <= rank_rel * EK.row(row).norm();
+}
+
+Verdict feasible_exact(const MatrixXd& E, const VectorXd& g, const std::vector<int>& J) {
   const int k = static_cast<int>(E.rows()), N = static_cast<int>(E.cols());
   std::vector<int> K;
   for (int i = 0; i < k; ++i)
     if (!std::binary_search(J.begin(), J.end(), i)) K.push_back(i);
   VectorXd qp = VectorXd::Zero(N);
   MatrixXd Z = MatrixXd::Identity(N, N);
+  const double rank_rel = 1e-12 * std::max<double>(static_cast<double>(J.size()), N);
   if (!J.empty()) {
     const MatrixXd EJ = rows_of(E, J);
     const VectorXd gJ = entries_of(g, J);
     Eigen::JacobiSVD<MatrixXd> svd(EJ, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    svd.setThreshold(1e-12 * std::max<double>(EJ.rows(), EJ.cols()));
+    svd.setThreshold(rank_rel);
     qp = svd.solve(-gJ);
     const VectorXd res = EJ * qp + gJ;
     const VectorXd scale = gap_scale(EJ, qp, gJ);
     for (Eigen::Index i = 0; i < res.size(); ++i)
-      if (!gap_is_zero(res(i), scale(i))) return false;
+      if (!gap_is_zero(res(i), scale(i))) return Verdict::kInfeasible;
     const int r = static_cast<int>(svd.rank());
     Z = svd.matrixV().rightCols(N - r);
   }
-  if (K.empty()) return true;
-  const MatrixXd A = rows_of(E, K) * Z;
-  const VectorXd b = rows_of(E, K) * qp + entries_of(g, K);
-  if (b.minCoeff() >= 0.0) return true;
+  if (K.empty()) return Verdict::kFeasible;
+  const MatrixXd EK = rows_of(E, K);
+  const VectorXd gK = entries_of(g, K);
+  const MatrixXd A = EK * Z;
+  const VectorXd b = EK * qp + gK;
+  const VectorXd scale = gap_scale(EK, qp, gK);
+  std::vector<int> live;  // rows of A that move on the solution set
+  for (Eigen::Index i = 0; i < A.rows(); ++i) {
+    if (!constant_on_solution_set(A, EK, i, rank_rel))
+      live.push_back(static_cast<int>(i));
+    else if (b(i) < 0.0 && !gap_is_zero(b(i), scale(i)))
+      return Verdict::kInfeasible;
+  }
+  if (live.empty()) return Verdict::kFeasible;
+  const MatrixXd AL = rows_of(A, live);
+  const VectorXd bL = entries_of(b, live);
+  if (bL.minCoeff() >= 0.0) return Verdict::kFeasible;
   const auto lemke = lcp::make_solver("lemke");
-  const lcp::Result sol = lemke->solve(A * A.transpose(), b, lcp::Options{});
-  return sol.ok();
+  const lcp::Result sol = lemke->solve(AL * AL.transpose(), bL, lcp::Options{});
+  if (sol.ok()) return Verdict::kFeasible;
+  return sol.status == lcp::Status::kRayTermination ? Verdict::kInfeasible : Verdict::kUndecided;
 }
 
 // At most this many feasibility tests (each a small SVD and LCP, ~0.1 ms at
@@ -75,13 +109,16 @@ struct Checker {
   const VectorXd& g;
   long left;
   bool exhausted = false;
+  bool undecided = false;  // some LCP ended neither solved nor on a ray
   bool operator()(const std::vector<int>& J) {
     if (left <= 0) {
       exhausted = true;
       return false;
     }
     --left;
-    return feasible_exact(E, g, J);
+    const Verdict v = feasible_exact(E, g, J);
+    if (v == Verdict::kUndecided) undecided = true;
+    return v == Verdict::kFeasible;
   }
 };
 
@@ -146,7 +183,7 @@ bool subset_of(const std::vector<int>& a, const std::vector<int>& b) {
 
 bool can_be_active_together(const MechanicalModel& m, std::vector<int> J) {
   std::sort(J.begin(), J.end());
-  return feasible_exact(MatrixXd(m.E), m.g, J);
+  return feasible_exact(MatrixXd(m.E), m.g, J) == Verdict::kFeasible;
 }
 
 CoactiveSets coactive_sets(const MechanicalModel& m, size_t max_sets) {
@@ -175,7 +212,7 @@ CoactiveSets coactive_sets(const MechanicalModel& m, size_t max_sets) {
   std::set<std::vector<int>> seen;
   std::vector<std::vector<int>> sets;
   for (const auto& C : cl) feasible_subsets(feasible, C, seen, sets, max_sets);
-  if (sets.size() >= max_sets || feasible.exhausted) out.complete = false;
+  if (sets.size() >= max_sets || feasible.exhausted || feasible.undecided) out.complete = false;
   // Keep the maximal ones (a dropped-index subset may lie in another clique).
   for (const auto& S : sets) {
     const bool dominated = std::any_of(sets.begin(), sets.end(), [&](const auto& T) {

@@ -390,6 +390,30 @@ TEST(ContactRuns, BoxDroppedFlatLandsOnFourCornersAtOnceAndRests) {
   EXPECT_GE(tr.max_violation, -1e-12);
 }
 
+// analyze's sets that can be active together on the shipped box: the four
+// bottom corners close together (flat on the floor: rank 3, a plane through
+// four points, so dependent, §4.6.1), and no top corner can ever close (its
+// gap is the one below it plus the height, 0.1 m, on every q: equal rows of
+// E). Before the fix in mech/coactive.cpp every corner read "never active".
+TEST(ContactRuns, BoxsBottomCornersCanCloseTogetherAndItsTopOnesNever) {
+  const mech::Model model = scene::load_model(kRobots + "box_drop_scene.yaml");
+  const mech::MechanicalModel& m = *model.mechanical;
+  std::vector<int> bottom = bottom_corners(m);
+  std::sort(bottom.begin(), bottom.end());
+  std::vector<int> top;
+  for (int i = 0; i < m.num_constraints(); ++i)
+    if (!std::binary_search(bottom.begin(), bottom.end(), i)) top.push_back(i);
+  ASSERT_EQ(top.size(), 4u);
+  const mech::CoactiveSets s = mech::coactive_sets(m);
+  EXPECT_TRUE(s.complete);
+  EXPECT_EQ(s.maximal, (std::vector<std::vector<int>>{bottom}));
+  EXPECT_EQ(s.never_active, top);
+  const mech::CoactiveWellPosedness w = mech::coactive_well_posedness(m, s);
+  ASSERT_EQ(w.sets.size(), 1u);
+  EXPECT_EQ(w.sets[0].rank, 3);
+  EXPECT_TRUE(w.dependent);
+}
+
 // The box tipped by th0 = 0.2 rad about x, on its bottom edge y = -b
 // (b = 0.1 m, half its width) with that edge's linear gap (z - z0) - b rx
 // at 0, released at rest. While it pivots that gap stays 0, z'' = b rx'',

@@ -266,7 +266,9 @@ bool can_be_active_together(const MechanicalModel& m, std::vector<int> J);
 // of the pairwise graph (Bron-Kerbosch), each verified as a whole and split
 // into its maximal feasible subsets if it fails. Pairs and singletons are
 // tested exactly. At most `max_sets` sets (complete = false beyond: the
-// verdicts below then do not cover every set). Exponential in the worst case
+// verdicts below then do not cover every set; complete is false too when a
+// feasibility LCP ends neither solved nor on a ray, undecided, counted as
+// "not together"). Exponential in the worst case
 // (2^j sets for j joints with two limits each; 128 for a 7-joint arm).
 struct CoactiveSets {
   std::vector<std::vector<int>> maximal;             // sorted, 0-based constraint indices
