@@ -22,6 +22,7 @@ packages=(
   clang libclang-rt-14-dev clang-format
   libsiconos-kernel-dev libsiconos-numerics-dev python3-siconos
   libopenmpi-dev openmpi-bin
+  libmujoco-dev ngspice
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -67,5 +67,8 @@ std::optional<Refined> refine_on_active_set(const Setup& s, const VectorXd& v,
 // surfaces (J; Kane's paradox, only restitution can cause it).
 double friction_mode_threshold(const Setup& s);
 void flag_friction_energy_gain(double surface_work, ImpactResult& out);
+// The message of a friction impact whose LCP no solver solved (`tried`: the
+// solvers, in the order tried).
+std::string friction_lcp_failure(const std::string& tried, const lcp::Result& res);
 
 }  // namespace lcsim::impact::detail

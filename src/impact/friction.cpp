@@ -253,9 +253,7 @@ ImpactResult moreau_friction(const ImpactInput& in, const lcp::Solver& solver) {
   const lcp::Result res = solve_friction_lcp(lcp, solver, &out.lcp_solves, &tried);
   out.lcp_status = res.status;
   if (!res.ok()) {
-    out.message = "friction impact LCP failed (" + tried +
-                  "): " + std::string(lcp::to_string(res.status, "solved")) +
-                  (res.message.empty() ? "" : " (" + res.message + ")");
+    out.message = detail::friction_lcp_failure(tried, res);
     return out;
   }
   const VectorXd* z = &res.z;
@@ -290,6 +288,12 @@ void flag_friction_energy_gain(double surface_work, ImpactResult& out) {
                        " J: Newton restitution with coupled normal and tangential "
                        "directions (W_NT != 0) can create energy (Kane's paradox)");
   }
+}
+
+std::string friction_lcp_failure(const std::string& tried, const lcp::Result& res) {
+  return "friction impact LCP failed (" + tried +
+         "): " + std::string(lcp::to_string(res.status, "solved")) +
+         (res.message.empty() ? "" : " (" + res.message + ")");
 }
 
 }  // namespace detail

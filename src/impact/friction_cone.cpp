@@ -303,9 +303,7 @@ ImpactResult moreau_friction_cone(const ImpactInput& in, const lcp::Solver& solv
   const lcp::Result res = solve_friction_cone_lcp(lcp, solver, &out.lcp_solves, &tried);
   out.lcp_status = res.status;
   if (!res.ok()) {
-    out.message = "friction impact LCP failed (" + tried +
-                  "): " + std::string(lcp::to_string(res.status, "solved")) +
-                  (res.message.empty() ? "" : " (" + res.message + ")");
+    out.message = detail::friction_lcp_failure(tried, res);
     return out;
   }
   const VectorXd lambda_N = res.z.head(nj), beta = res.z.segment(nj, ne);

@@ -91,11 +91,11 @@ bool has_attribute(const std::string& tag, const std::string& name, std::string*
   return true;
 }
 
-}  // namespace
-
-std::map<std::string, std::string> limits_without_bounds(const std::string& xml) {
-  std::map<std::string, std::string> out;
-  std::string joint;  // the <joint> element the scan is in ("" outside)
+// Calls visit(pos, tag) for every tag of the URDF text in order (start, end
+// or self-closing; `tag` its text from '<' to '>'), skipping comments, CDATA
+// and processing instructions; stops at an unclosed tag (urdfdom reports it).
+template <class Visit>
+void for_each_tag(const std::string& xml, Visit visit) {
   std::size_t pos = 0;
   while ((pos = xml.find('<', pos)) != std::string::npos) {
     if (const std::size_t v = verbatim_end(xml, pos); v != std::string::npos) {
@@ -103,8 +103,18 @@ std::map<std::string, std::string> limits_without_bounds(const std::string& xml)
       continue;
     }
     const std::size_t e = tag_end(xml, pos);
-    if (e == std::string::npos) break;  // unclosed: urdfdom reports it
-    const std::string tag = xml.substr(pos, e - pos);
+    if (e == std::string::npos) break;
+    visit(pos, xml.substr(pos, e - pos));
+    pos = e;
+  }
+}
+
+}  // namespace
+
+std::map<std::string, std::string> limits_without_bounds(const std::string& xml) {
+  std::map<std::string, std::string> out;
+  std::string joint;  // the <joint> element the scan is in ("" outside)
+  for_each_tag(xml, [&](std::size_t pos, const std::string& tag) {
     if (starts_tag(xml, pos, "joint")) {
       joint.clear();
       if (tag[tag.size() - 2] != '/') has_attribute(tag, "name", &joint);
@@ -115,8 +125,7 @@ std::map<std::string, std::string> limits_without_bounds(const std::string& xml)
       if (!lower || !upper)
         out[joint] = !lower && !upper ? "lower and upper" : !lower ? "lower" : "upper";
     }
-    pos = e;
-  }
+  });
   return out;
 }
 
@@ -177,17 +186,7 @@ struct CollisionScan {
 
 std::vector<CollisionElement> collision_elements(const std::string& xml) {
   CollisionScan scan;
-  std::size_t pos = 0;
-  while ((pos = xml.find('<', pos)) != std::string::npos) {
-    if (const std::size_t v = verbatim_end(xml, pos); v != std::string::npos) {
-      pos = v;
-      continue;
-    }
-    const std::size_t e = tag_end(xml, pos);
-    if (e == std::string::npos) break;  // unclosed: urdfdom reports it
-    scan.see(xml, pos, xml.substr(pos, e - pos));
-    pos = e;
-  }
+  for_each_tag(xml, [&](std::size_t pos, const std::string& tag) { scan.see(xml, pos, tag); });
   return std::move(scan.out);
 }
 
