@@ -99,7 +99,8 @@ VectorXd initial_state(const Circuit& c, std::string& note) {
                      "across a voltage that .ic holds): give .ic values or use `.tran ... uic`");
   }
   const VectorXd T = nr > 0 ? VectorXd(lu.solve(ARG * xG)) : VectorXd::Zero(0);
-  const MatrixXd U = nr > 0 ? MatrixXd(lu.solve(BR)) : MatrixXd::Zero(0, k);
+  // No solve with an empty right-hand side (Eigen offsets a null pointer).
+  const MatrixXd U = nr > 0 && k > 0 ? MatrixXd(lu.solve(BR)) : MatrixXd::Zero(nr, k);
   VectorXd u = VectorXd::Zero(k);
   if (k > 0) {
     const MatrixXd M = s.D - CR * U;

@@ -275,7 +275,7 @@ void name_and_output(Circuit& c, const Layout& L, const Quantities& q) {
   m.output_u.resize(no, L.k);
   for (Eigen::Index r = 0; r < no; ++r) {
     m.output_x.row(r) = rows[r].head(L.n());
-    m.output_u.row(r) = rows[r].tail(L.k);
+    if (L.k > 0) m.output_u.row(r) = rows[r].tail(L.k);  // no row view of an empty matrix
   }
 }
 

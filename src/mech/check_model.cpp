@@ -322,8 +322,9 @@ std::optional<ModelProblem> check_lcs_labels(const Model& model) {
   if (e < 0 || e > n || model.exo_initial.size() != e)
     return ModelProblem{"lcs.exosystem", "expected at most " + std::to_string(n) +
                                              " states with as many initial values"};
-  if (e > 0 && (model.lcs->A.bottomLeftCorner(e, n - e).cwiseAbs().sum() != 0.0 ||
-                model.lcs->B.bottomRows(e).cwiseAbs().sum() != 0.0))
+  // (No view of an empty block: Eigen's offsets a null pointer.)
+  if (e > 0 && ((n > e && model.lcs->A.bottomLeftCorner(e, n - e).cwiseAbs().sum() != 0.0) ||
+                (k > 0 && model.lcs->B.bottomRows(e).cwiseAbs().sum() != 0.0)))
     return ModelProblem{"lcs.exosystem", "its states must be driven by themselves only"};
   if (auto at = non_finite_vector(model.exo_initial))
     return ModelProblem{"lcs.exosystem" + *at, "not finite"};

@@ -50,6 +50,9 @@ enum class Verdict { kFeasible, kInfeasible, kUndecided };
 // own size; Z is orthonormal, so |A_k| <= |E_k| always).
 bool constant_on_solution_set(const MatrixXd& A, const MatrixXd& EK, Eigen::Index row,
                               double rank_rel) {
+  // A with no columns (J fixes every coordinate): each row is empty, so zero;
+  // no row view is taken (Eigen's view of an empty matrix offsets a null pointer).
+  if (A.cols() == 0) return true;
   return A.row(row).norm() <= rank_rel * EK.row(row).norm();
 }
 

@@ -66,7 +66,10 @@ int column(const mech::Model& m, const std::string& name) {
   return 0;
 }
 double output(const mech::Model& m, const sim::Sample& s, const std::string& name) {
-  return (m.output_x.row(column(m, name)) * s.x + m.output_u.row(column(m, name)) * s.u)(0);
+  const int r = column(m, name);
+  const double from_x = m.output_x.row(r).dot(s.x);
+  // No row view of an empty output_u (a circuit without diodes).
+  return m.output_u.cols() == 0 ? from_x : from_x + m.output_u.row(r).dot(s.u);
 }
 
 const char* kBridge = R"(diode bridge
