@@ -291,5 +291,18 @@ TEST(HalfWaveRectifier, TurnsOffAndOnWhereTheClosedFormSays) {
   EXPECT_NEAR(times[1], t_on, kEventTol);
 }
 
+// The run's worst complementarity violation is min(0, C x + D u) over the
+// samples, D u included: a diode in series with a resistor has C x < 0 while
+// it conducts (before the fix, the half-wave RLC circuit reported -10 V).
+// Rounding of a 10 V state: ~1e-14; 1e-9 V is the voltage tolerance above.
+TEST(ShippedCircuits, ReportNoComplementarityViolation) {
+  for (const char* name : {"diode_bridge", "half_wave_rlc", "half_wave_rectifier", "diode_clamp"}) {
+    const Circuit c =
+        circuit::load_circuit(std::string(LCSIM_SOURCE_DIR) + "/circuits/" + name + ".cir");
+    const sim::Trajectory tr = run(c, 20e-3, 1e-4);
+    EXPECT_GE(tr.max_violation, -kVoltTol) << name;
+  }
+}
+
 }  // namespace
 }  // namespace lcsim

@@ -97,7 +97,10 @@ void EventDriven::check_feasible(double t, const VectorXd& xa, const VectorXd& y
 
 void EventDriven::record(Trajectory& tr, double t, const VectorXd& xa, const Phase& ph) const {
   if (k_ > 0) {
-    const VectorXd gaps = sys_.C * xa;  // D u is zero for mechanical models
+    // y = C x + D u: an LCS with a feedthrough (a diode in series with a
+    // resistor) has C x < 0 where D u makes up the difference.
+    VectorXd gaps = sys_.C * xa;
+    if (!model_.is_mechanical()) gaps.noalias() += sys_.D * multipliers(ph, xa);
     tr.max_violation = std::min(tr.max_violation, std::min(0.0, gaps.minCoeff()));
     check_feasible(t, xa, gaps);
   }

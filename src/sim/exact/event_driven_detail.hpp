@@ -326,6 +326,10 @@ class EventDriven {
     std::vector<double> noise;
     std::vector<int> m0;
     std::vector<double> d0;
+    // A value above the noise band but within mode selection's zero test
+    // (LdcpOptions::tol_rel of its terms) whose next nonzero derivative is
+    // positive: the LDCP took it for zero and the monitor opens from it.
+    std::vector<char> small_opening;
     double h_first = 0.0;
   };
   MonitorStart monitor_start(const Phase& phase, const VectorXd& xstart, double t,

@@ -61,6 +61,8 @@ void EventDriven::first_derivatives(const Phase& phase, const VectorXd& xstart,
   const size_t nm = phase.monitors.size();
   m0.assign(nm, -1);
   d0.assign(nm, 0.0);
+  st.small_opening.assign(nm, 0);
+  std::vector<char> small(nm, 0);  // value within the LDCP's zero test
   std::vector<char> done(nm, 0);
   size_t remaining = nm;
   VectorXd Amx = xstart;
@@ -78,6 +80,8 @@ void EventDriven::first_derivatives(const Phase& phase, const VectorXd& xstart,
       const double dm = mon.w * Amx;
       const double zero =
           m == 0 ? noise[j] : ldcp_.tol_rel * mon.w.cwiseAbs().dot(Amx_abs) + ldcp_.tol_abs;
+      if (m == 0)
+        small[j] = std::abs(dm) <= ldcp_.tol_rel * mon.w.cwiseAbs().dot(Amx_abs) + ldcp_.tol_abs;
       if (std::abs(dm) <= zero) continue;
       if (m0[j] < 0) {
         m0[j] = m;
@@ -91,6 +95,7 @@ void EventDriven::first_derivatives(const Phase& phase, const VectorXd& xstart,
       for (int i = m0[j] + 1; i <= m; ++i) f *= i;
       const double tau = std::pow(ratio * f, 1.0 / (m - m0[j]));
       h_first = std::min(h_first, 0.25 * tau);
+      st.small_opening[j] = m0[j] == 0 && small[j] && d0[j] > 0.0 && dm > 0.0;
       done[j] = 1;
       --remaining;
     }
@@ -112,7 +117,16 @@ void EventDriven::arm_monitors(PhaseMarch& pm) const {
   pm.offset.assign(monitors.size(), 0.0);
   for (size_t j = 0; j < monitors.size(); ++j) {
     const double value = monitors[j].w.dot(pm.xstart);
-    if (pm.start.m0[j] == 0) {
+    if (pm.start.m0[j] == 0 && pm.start.small_opening[j]) {
+      // Rounding left a few 1e-14 of a held gap (a clamp's diode held over
+      // many periods) above the noise band, but mode selection took it for
+      // zero and opened it by its next derivative: followed from the start,
+      // as an opening at zero is, so the rounding of the states on the
+      // first, very short samples cannot read as its return.
+      pm.armed[j] = true;
+      pm.opening[j] = 1;
+      pm.offset[j] = value;
+    } else if (pm.start.m0[j] == 0) {
       pm.armed[j] = value > 0.0;
     } else if (pm.start.m0[j] > 0 && pm.start.d0[j] > 0.0) {
       pm.armed[j] = true;
