@@ -20,17 +20,6 @@ nlohmann::json row_or_nulls(const Eigen::Ref<const Eigen::RowVectorXd>& v,
 
 }  // namespace
 
-std::vector<std::string> state_names(const mech::Model& model) {
-  std::vector<std::string> out;
-  if (model.is_mechanical()) {
-    for (const auto& c : model.mechanical->coordinates) out.push_back(c);
-    for (const auto& c : model.mechanical->coordinates) out.push_back("v_" + c);
-  } else {
-    for (int i = 1; i <= model.state_size(); ++i) out.push_back("x" + std::to_string(i));
-  }
-  return out;
-}
-
 nlohmann::json sensitivity_json(const mech::Model& model, const sim::Trajectory& traj) {
   nlohmann::json j;
   j["columns"] = traj.sensitivity_columns;

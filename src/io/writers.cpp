@@ -184,6 +184,23 @@ int finish_temporary(TemporaryFile& t, const std::string& where, int err) {
   return err;
 }
 
+}  // namespace
+
+std::vector<std::string> state_names(const mech::Model& model) {
+  std::vector<std::string> out;
+  if (model.is_mechanical()) {
+    for (const auto& c : model.mechanical->coordinates) out.push_back(c);
+    for (const auto& c : model.mechanical->coordinates) out.push_back(prefixed("v_", c));
+  } else if (!model.state_names.empty()) {
+    out = model.state_names;
+  } else {
+    for (int i = 1; i <= model.state_size(); ++i) out.push_back(prefixed("x", std::to_string(i)));
+  }
+  return out;
+}
+
+namespace {
+
 std::vector<std::string> csv_header(const mech::Model& model) {
   const int n = model.state_size();
   const int k = model.num_constraints();

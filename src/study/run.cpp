@@ -94,16 +94,11 @@ std::string status_word(const sim::Trajectory& t) {
   return std::string(to_string(t.status, "completed"));
 }
 
-// Final-state column names: a single mechanical model's coordinate names,
-// else x1...
+// Final-state column names: a single model's state names as its trajectory
+// CSV has them (io::state_names), else x1...
 std::vector<std::string> state_names(const Study& s) {
+  if (s.models.size() == 1) return io::state_names(s.models.front());
   std::vector<std::string> names;
-  const mech::Model& m = s.models.front();
-  if (s.models.size() == 1 && m.is_mechanical()) {
-    for (const auto& c : m.mechanical->coordinates) names.push_back(c);
-    for (const auto& c : m.mechanical->coordinates) names.push_back("v_" + c);
-    return names;
-  }
   int n = 0;
   for (const auto& mm : s.models) n = std::max(n, mm.state_size());
   for (int i = 1; i <= n; ++i) names.push_back("x" + std::to_string(i));

@@ -150,6 +150,31 @@ TEST(StudyRuns, QuantitiesReachTheModel) {
   EXPECT_EQ(cell(s, r, "error_final"), "0");
 }
 
+// A circuit's final-state columns carry its state names, as its trajectory
+// CSV does (io::state_names): C1's voltage and L1's current, not x1, x2.
+TEST(StudyRuns, CircuitColumnsNameTheStates) {
+  const Study s =
+      parse_study("model: ../../circuits/half_wave_rlc.cir\naxes:\n  - t_end: [1e-3]\n", kSource);
+  const Row r = run_one(s, 0);
+  ASSERT_EQ(cell(s, r, "status"), "completed") << cell(s, r, "message");
+  EXPECT_EQ(cell(s, r, "final_x1"), "(no column final_x1)");
+  // The same run outside the study: each named column holds its own entry.
+  // The study may sample on another grid (the final state then comes from
+  // another product of exponentials): rounding of a 10 V state, ~1e-14;
+  // 1e-12 still tells C1.v (volts) from L1.i (tens of mA) apart.
+  sim::Options opt;
+  opt.t_end = 1e-3;
+  const sim::Trajectory tr = sim::simulate(s.models.front(), opt);
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  const std::vector<std::string> names = io::state_names(s.models.front());
+  for (std::size_t i = 0; i < names.size(); ++i)
+    EXPECT_NEAR(std::stod(cell(s, r, "final_" + names[i])), tr.final_state(static_cast<int>(i)),
+                1e-12)
+        << names[i];
+  EXPECT_EQ(names.at(0), "C1.v");
+  EXPECT_EQ(names.at(1), "L1.i");
+}
+
 TEST(StudyRuns, EventsAndEnergyOfTheThesisRun) {
   // The model's own x0 (thesis §3.7): cart 1 hits the stop at t = 1 with
   // velocity -1, the inelastic impact stops it (M = I: cart 2 keeps its

@@ -7,6 +7,7 @@
 #include <lcsim/mech/mech.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <string>
+#include <vector>
 
 namespace lcsim::io {
 
@@ -14,6 +15,12 @@ namespace lcsim::io {
 // or the model's state names otherwise), u1.. (u_<pair>), y1.. (y_<pair>),
 // the model's outputs, mode (active constraints joined by ';').
 std::string trajectory_csv(const mech::Model& model, const sim::Trajectory& traj);
+
+// The names of the state's entries as the trajectory CSV has them: the
+// coordinates then "v_<coordinate>" (mechanical); the model's state names
+// (a circuit's "C1.v", "L1.i"), else x1.. (LCS). The one list of them: the
+// sensitivity outputs and a study's final-state columns use it too.
+std::vector<std::string> state_names(const mech::Model& model);
 
 // The same CSV streamed to disk as a run goes (sim::Options::sample_sink), so
 // a long run's output never has to fit in memory: rows go to a temporary

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <lcsim/io/csv.hpp>
 #include <lcsim/mech/mech.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <nlohmann/json.hpp>
@@ -10,10 +11,6 @@
 #include <vector>
 
 namespace lcsim::io {
-
-// The names of the state's entries as the trajectory CSV has them: the
-// coordinates then "v_<coordinate>" (mechanical), x1.. (LCS).
-std::vector<std::string> state_names(const mech::Model& model);
 
 // {"columns": [...], "state": [...], "final": [[dx_i/dtheta_c per column c]
 // per state entry i, null where absent], "events": [{"t", "type", "dt": [...,
