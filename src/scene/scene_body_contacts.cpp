@@ -86,7 +86,11 @@ std::vector<ContactFrame> against_frames(const std::vector<ContactBody>& bodies,
       BodyShape s = shape;
       if (s.kind == "box") s.face = nearest_face(dyn, p, s, q0);
       if (shapes.size() > 1) p.name += suffix;
-      out.push_back(contact_frame(dyn, p, s, q0));
+      try {
+        out.push_back(contact_frame(dyn, p, s, q0));
+      } catch (const InputError& e) {  // a point at a sphere's centre: no normal
+        fail(source, key, e.what());
+      }
     }
   }
   return out;
