@@ -339,7 +339,9 @@ YAML::Node load_model_root(const std::string& yaml_text, const std::string& sour
   return root;
 }
 
-bool is_scene(const YAML::Node& root) { return root.IsMap() && root["urdf"]; }
+bool is_scene(const YAML::Node& root) {
+  return root.IsMap() && (root["urdf"] || root["bodies"]);  // one URDF, or several
+}
 
 mech::Model parse_matrix_model(const YAML::Node& root, const std::string& source) {
   const Keys keys = mapping(root, source, "", {"name", "mechanical", "lcs", "initial", "t_end"});

@@ -78,7 +78,7 @@ void add_points(const CollisionElement& c, const std::string& urdf, const std::s
                 Namer& name, std::vector<ContactPoint>& out) {
   const Eigen::Isometry3d X = origin(c, urdf);
   const auto add = [&](const std::string& kind, const Vector3d& p, double r) {
-    out.push_back({name(prefix, kind), c.link, X * p, r});
+    out.push_back({name(prefix, kind), c.link, X * p, r, 0});
   };
   if (c.shape == "box") {
     const auto it = c.attributes.find("size");
@@ -120,6 +120,35 @@ std::vector<ContactPoint> collision_points(const std::vector<CollisionElement>& 
   Namer name;
   for (const CollisionElement& c : elements)
     if (c.link == link) add_points(c, urdf, prefix, name, out);
+  return out;
+}
+
+std::vector<CollisionShape> collision_shapes(const std::vector<CollisionElement>& elements,
+                                             const std::string& link, const std::string& urdf) {
+  std::vector<CollisionShape> out;
+  std::map<std::string, int> count;
+  for (const CollisionElement& c : elements) {
+    if (c.link != link) continue;
+    CollisionShape s;
+    s.kind = c.shape;
+    s.origin = origin(c, urdf);
+    if (c.shape == "sphere") {
+      s.radius = length(c, "radius", urdf);
+    } else if (c.shape == "box") {
+      const auto it = c.attributes.find("size");
+      if (it == c.attributes.end()) refuse(urdf, c, "<box size>: missing");
+      const auto v = numbers(it->second, 3, urdf, c, "<box size>");
+      for (double x : v)
+        if (!(x > 0.0)) refuse(urdf, c, "<box size>: must be > 0 (got '" + it->second + "')");
+      s.half = 0.5 * Vector3d(v[0], v[1], v[2]);
+    } else {
+      refuse(urdf, c,
+             "<" + (c.shape.empty() ? std::string("geometry") : c.shape) +
+                 ">: another body's points can touch a sphere or a box only");
+    }
+    s.index = static_cast<std::size_t>(count[s.kind]++);
+    out.push_back(s);
+  }
   return out;
 }
 

@@ -40,11 +40,10 @@ struct Axis {
 
 // Coordinate i's unit and search extent: a floating base's position (m) or
 // rotation (rad); a joint's own, bounded by its limits where it has them.
-Axis axis_of(const Scene& s, std::size_t i, double q0) {
-  const std::size_t nb = base_coordinates(s.base).size();
+Axis axis_of(const Bodies& b, std::size_t i, double q0) {
   Axis a;
-  const auto j = i < nb ? nullptr : s.urdf->getJoint(s.lin.joints[i]);
-  const bool metres = i < nb ? i < 3 : j->type == urdf::Joint::PRISMATIC;
+  const auto j = b.joint_of(static_cast<Eigen::Index>(i));
+  const bool metres = b.in_metres(static_cast<Eigen::Index>(i));
   a.unit = metres ? "m" : "rad";
   a.lower = a.upper = metres ? 1.0 : M_PI;
   if (j && j->limits && j->type != urdf::Joint::CONTINUOUS &&
@@ -61,14 +60,14 @@ struct Reach {
   double distance = std::numeric_limits<double>::infinity();
   std::string end = "search";
 };
-Reach reach_along(const UrdfDynamics& dyn, const ContactFrame& c, const Plane& plane,
+Reach reach_along(const Bodies& dyn, const ContactFrame& c, const std::vector<Plane>& planes,
                   const VectorXd& q0, Eigen::Index i, const Axis& a, double threshold) {
   Reach r;
   for (const double dir : {-1.0, 1.0}) {
     const auto exceeds = [&](double step) {
       VectorXd q = q0;
       q(i) += dir * step;
-      const double exact = signed_distance(dyn, c.point, plane, q) - c.gap;
+      const double exact = signed_distance(dyn, c, planes, q) - c.gap;
       const double linear = c.normal_row(i) * dir * step;
       const double change = std::max(std::abs(exact), std::abs(linear));
       return change > 0.0 && std::abs(exact - linear) > threshold * change;
@@ -88,21 +87,16 @@ Reach reach_along(const UrdfDynamics& dyn, const ContactFrame& c, const Plane& p
 
 std::vector<ContactRange> contact_ranges(const Scene& s, double threshold) {
   check_linearisation_threshold(threshold);
-  const std::size_t nb = base_coordinates(s.base).size();
-  const std::vector<std::string> joints(s.lin.joints.begin() + static_cast<std::ptrdiff_t>(nb),
-                                        s.lin.joints.end());
-  const UrdfDynamics dyn(*s.urdf, joints, s.q0, s.gravity, s.urdf_source, s.base);
+  const Bodies dyn = scene_bodies(s);
   const VectorXd q0 = dyn.reference();
   const mech::MechanicalModel& m = *s.model.mechanical;
   const VectorXd gaps = m.E * q0 + m.g;
   const VectorXd scale = mech::gap_scale(m.E, q0, m.g);
   bool any_rad = false;
   for (std::size_t i = 0; i < s.lin.joints.size(); ++i)
-    any_rad |= axis_of(s, i, q0(static_cast<Eigen::Index>(i))).unit == "rad";
+    any_rad |= axis_of(dyn, i, q0(static_cast<Eigen::Index>(i))).unit == "rad";
   std::vector<ContactRange> out;
   for (const ContactFrame& c : s.contacts) {
-    const Plane& plane = *std::find_if(s.planes.begin(), s.planes.end(),
-                                       [&](const Plane& p) { return p.name == c.plane; });
     ContactRange r;
     r.contact = c.point.name;
     r.plane = c.plane;
@@ -111,9 +105,9 @@ std::vector<ContactRange> contact_ranges(const Scene& s, double threshold) {
     r.range = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < s.lin.joints.size(); ++i) {
       const auto ii = static_cast<Eigen::Index>(i);
-      const Axis a = axis_of(s, i, q0(ii));
+      const Axis a = axis_of(dyn, i, q0(ii));
       if (any_rad && a.unit != "rad") continue;  // rotations bend the gap; report theirs
-      const Reach got = reach_along(dyn, c, plane, q0, ii, a, threshold);
+      const Reach got = reach_along(dyn, c, s.planes, q0, ii, a, threshold);
       if (got.distance < r.range || r.coordinate.empty()) {
         r.coordinate = s.lin.joints[i];
         r.unit = a.unit;

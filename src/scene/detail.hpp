@@ -6,7 +6,9 @@
 #include <Eigen/Dense>
 #include <functional>
 #include <lcsim/io/yaml.hpp>
+#include <lcsim/scene/bodies.hpp>
 #include <lcsim/scene/contacts.hpp>
+#include <lcsim/scene/scene.hpp>
 #include <lcsim/scene/urdf.hpp>
 #include <map>
 #include <memory>
@@ -52,6 +54,18 @@ std::vector<CollisionElement> collision_elements(const std::string& xml);
 std::vector<ContactPoint> collision_points(const std::vector<CollisionElement>& elements,
                                            const std::string& link, const std::string& prefix,
                                            const std::string& urdf);
+// The sphere and box <collision> primitives of `link` as shapes (its frame
+// in the link's, a sphere's radius or a box's half sizes, m; index counted
+// per kind); InputError naming the link and the element for another shape.
+struct CollisionShape {
+  std::string kind;
+  std::size_t index = 0;
+  Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();
+  double radius = 0.0;
+  Eigen::Vector3d half = Eigen::Vector3d::Zero();
+};
+std::vector<CollisionShape> collision_shapes(const std::vector<CollisionElement>& elements,
+                                             const std::string& link, const std::string& urdf);
 
 // ---------------------------------------------------------------------------
 // Reading a scene file. read_scene (scene.cpp) is a driver that calls one
@@ -142,7 +156,9 @@ std::map<std::string, double> read_q0(const Keys& keys, const std::string& sourc
                                       const SceneUrdf& urdf, const SceneJoints& joints);
 // x = (q, v): q0 at rest, but for the positions and velocities `initial`
 // names.
-VectorXd read_initial(const Keys& keys, const std::string& source, const SceneUrdf& urdf,
+// `check` says which names may be given (simulated(joints, urdf) in a
+// one-URDF scene, the coordinates in a scene of bodies).
+VectorXd read_initial(const Keys& keys, const std::string& source, const NameCheck& check,
                       const SceneJoints& joints, const VectorXd& q0);
 
 // The dynamics being assembled, dense (scenes are small: one coordinate per
@@ -152,7 +168,8 @@ struct SceneDynamics {
   VectorXd f;     // constant generalised force
 };
 // `springs:` (scene_springs.cpp), added to K, D and f.
-void add_springs(const Keys& keys, const std::string& source, const SceneUrdf& urdf,
+// `check` as for read_initial.
+void add_springs(const Keys& keys, const std::string& source, const NameCheck& check,
                  const SceneJoints& joints, SceneDynamics& dyn);
 
 // The unilateral constraints E q + g >= 0 being assembled, one row each, in
@@ -171,7 +188,7 @@ SceneConstraints joint_stops(const std::string& source, const SceneUrdf& urdf,
                              const SceneJoints& joints);
 // `constraints:` (scene_constraints.cpp), in file order; then the check that
 // no two constraints share a name.
-void add_constraints(const Keys& keys, const std::string& source, const SceneUrdf& urdf,
+void add_constraints(const Keys& keys, const std::string& source, const NameCheck& check,
                      const SceneJoints& joints, SceneConstraints& out);
 void check_unique_names(const SceneConstraints& c, const std::string& source);
 // `planes:` (scene_contacts.cpp): the world planes contacts may touch.
@@ -183,9 +200,55 @@ struct SceneContacts {
   std::vector<ContactFrame> frames;
   std::vector<std::string> notes;
 };
-SceneContacts add_contacts(const Keys& keys, const std::string& source, const SceneUrdf& urdf,
-                           const std::vector<Plane>& planes, const UrdfDynamics& dyn,
-                           const VectorXd& q0, SceneConstraints& out);
+// A body as contacts name it: "" in a one-URDF scene (a link is named
+// alone), else its name (a link is named "<body>/<link>").
+struct ContactBody {
+  std::string name;
+  const SceneUrdf* urdf = nullptr;
+};
+SceneContacts add_contacts(const Keys& keys, const std::string& source,
+                           const std::vector<ContactBody>& bodies, const std::vector<Plane>& planes,
+                           const Bodies& dyn, const VectorXd& q0, SceneConstraints& out);
+
+// Body against body (scene_body_contacts.cpp). A link as a contact names it
+// at `key`: its body's index and the link's name in its URDF; InputError
+// naming the body, or the link and its body, when not found.
+struct LinkRef {
+  std::size_t body = 0;
+  std::string link;
+  std::string label;  // as written: "link" or "body/link"
+};
+LinkRef find_link(const std::vector<ContactBody>& bodies, const YAML::Node& n,
+                  const std::string& source, const std::string& key);
+// The sphere and box <collision> primitives of `ref`'s link, each a shape a
+// point may touch (its face chosen later); InputError naming the link and
+// the element for any other shape, or when it has none.
+std::vector<BodyShape> body_shapes(const std::vector<ContactBody>& bodies, const LinkRef& ref,
+                                   const std::string& source, const std::string& key);
+
+// The frames of `points` (on `ref`'s link) against each shape of the link
+// named at `key`.against: a point-against-shape contact each, named
+// <point> when the link has one shape, else <point>_<shape kind><k>; the
+// face of a box is the one nearest the point at q0 (nearest_face).
+// InputError when the two links are of one body.
+std::vector<ContactFrame> against_frames(const std::vector<ContactBody>& bodies, const LinkRef& ref,
+                                         const YAML::Node& against, const std::string& source,
+                                         const std::string& key,
+                                         const std::vector<ContactPoint>& points, const Bodies& dyn,
+                                         const VectorXd& q0);
+
+// A scene of several URDFs (`bodies:`, scene_bodies.cpp): read_scene's
+// counterpart when the file has that key instead of `urdf:`.
+Scene read_bodies_scene(const YAML::Node& root, const std::string& source);
+
+// The stages both kinds of scene share (scene.cpp).
+mech::Model named_model(const Keys& keys, const std::string& source);
+Eigen::Vector3d read_gravity(const Keys& keys, const std::string& source);
+SceneDynamics linear_dynamics(const UrdfLinearisation& lin, const VectorXd& q0);
+void check_mass_matrix(const MatrixXd& M, const SceneJoints& joints, const std::string& source);
+void read_t_end(const Keys& keys, const std::string& source, mech::Model& model);
+mech::MechanicalModel assemble(const UrdfLinearisation& lin, const SceneDynamics& dyn,
+                               const SceneConstraints& con, const SceneJoints& joints);
 // `restitution:` by constraint name (0 for those not named).
 VectorXd read_restitution(const Keys& keys, const std::string& source,
                           const std::vector<std::string>& constraints);

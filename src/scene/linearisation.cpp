@@ -23,12 +23,6 @@ using io::to_json;
 
 namespace {
 
-// The scene's simulated URDF joints: its coordinates after a floating base's.
-std::vector<std::string> urdf_joints(const Scene& s) {
-  const std::size_t nb = base_coordinates(s.base).size();
-  return {s.lin.joints.begin() + static_cast<std::ptrdiff_t>(nb), s.lin.joints.end()};
-}
-
 // e_M and e_F at q for the linear model (M0, f, K) and the exact dynamics.
 struct Errors {
   double mass = 0.0, force = 0.0;
@@ -37,13 +31,13 @@ struct Errors {
 
 struct Evaluator {
   const Scene& scene;
-  UrdfDynamics dyn;
+  Bodies dyn;
   MatrixXd M0, K;
   VectorXd f, q0;
 
   explicit Evaluator(const Scene& s)
       : scene(s),
-        dyn(*s.urdf, urdf_joints(s), s.q0, s.gravity, s.urdf_source, s.base),
+        dyn(scene_bodies(s)),
         M0(s.model.mechanical->M.toDense()),
         K(s.model.mechanical->K.toDense()),
         f(s.model.mechanical->f),
@@ -115,14 +109,13 @@ std::vector<LinearRange> linear_ranges(const Scene& scene, double threshold) {
   std::vector<LinearRange> out;
   for (std::size_t i = 0; i < scene.lin.joints.size(); ++i) {
     const auto ii = static_cast<Eigen::Index>(i);
-    // A floating base's coordinates (the first six) are no URDF joint: its
-    // position (m) and rotation vector (rad) have no limits.
-    const bool is_base = i < base_coordinates(scene.base).size();
-    const auto j = is_base ? nullptr : scene.urdf->getJoint(scene.lin.joints[i]);
+    // A floating base's coordinates are no URDF joint: its position (m)
+    // and rotation vector (rad) have no limits.
+    const auto j = ev.dyn.joint_of(ii);
     const double q0 = ev.q0(ii);
     LinearRange r;
     r.joint = scene.lin.joints[i];
-    const bool metres = is_base ? i < 3 : j->type == urdf::Joint::PRISMATIC;
+    const bool metres = ev.dyn.in_metres(ii);
     r.unit = metres ? "m" : "rad";
     r.q0 = q0;
     for (const double dir : {-1.0, 1.0}) {

@@ -44,8 +44,6 @@ using io::one_line;
 using io::read_file;
 namespace yaml = io::yaml;
 
-namespace {
-
 using yaml::describe;
 using yaml::fail;
 using yaml::join;
@@ -132,12 +130,11 @@ mech::MechanicalModel assemble(const UrdfLinearisation& lin, const SceneDynamics
   return m;
 }
 
-}  // namespace
-
 // One stage per key (scene/detail.hpp), in the order the file is checked:
 // a new key's stage goes after those whose results it needs.
 Scene read_scene(const std::string& yaml_text, const std::string& source) {
   const YAML::Node root = load(yaml_text, source);
+  if (root.IsMap() && root["bodies"]) return read_bodies_scene(root, source);
   const Keys keys = mapping(
       root, source, "",
       {"name", "urdf", "joints", "q0", "gravity", "springs", "constraints", "restitution",
@@ -156,27 +153,43 @@ Scene read_scene(const std::string& yaml_text, const std::string& source) {
       linearise_urdf(*urdf.model, joints.urdf_joints(), q0, gravity, urdf.path, base);
 
   SceneDynamics dyn = linear_dynamics(lin, q0v);
-  add_springs(keys, source, urdf, joints, dyn);
+  add_springs(keys, source, simulated(joints, urdf), joints, dyn);
   SceneConstraints constraints = joint_stops(source, urdf, joints);
-  add_constraints(keys, source, urdf, joints, constraints);
+  add_constraints(keys, source, simulated(joints, urdf), joints, constraints);
   const std::vector<Plane> planes = read_planes(keys, source);
-  SceneContacts contacts = add_contacts(keys, source, urdf, planes, exact, q0v, constraints);
+  const Bodies bodies({{"", urdf.model, urdf.path, q0, base, joints.urdf_joints(), 0}}, gravity);
+  SceneContacts contacts =
+      add_contacts(keys, source, {{"", &urdf}}, planes, bodies, q0v, constraints);
   check_unique_names(constraints, source);
   mech::MechanicalModel m = assemble(lin, dyn, constraints, joints);
   m.restitution = read_restitution(keys, source, m.constraints);
   check_mass_matrix(lin.M, joints, source);
-  model.initial = read_initial(keys, source, urdf, joints, q0v);
+  model.initial = read_initial(keys, source, simulated(joints, urdf), joints, q0v);
   read_t_end(keys, source, model);
 
   mech::fill_defaults(m);
   model.mechanical = m;
   std::vector<std::string> notes = std::move(urdf.repairs.notes);
   for (std::string& n : contacts.notes) notes.push_back(std::move(n));
-  return Scene{std::move(model), urdf.model,
-               urdf.path,        q0,
-               gravity,          lin,
-               std::move(notes), base,
-               planes,           std::move(contacts.frames)};
+  return Scene{std::move(model),
+               urdf.model,
+               urdf.path,
+               q0,
+               gravity,
+               lin,
+               std::move(notes),
+               base,
+               planes,
+               std::move(contacts.frames),
+               {}};
+}
+
+Bodies scene_bodies(const Scene& s) {
+  if (!s.bodies.empty()) return Bodies(s.bodies, s.gravity);
+  const std::size_t nb = base_coordinates(s.base).size();
+  const std::vector<std::string> joints(s.lin.joints.begin() + static_cast<std::ptrdiff_t>(nb),
+                                        s.lin.joints.end());
+  return Bodies({{"", s.urdf, s.urdf_source, s.q0, s.base, joints, 0}}, s.gravity);
 }
 
 mech::Model parse_scene(const std::string& yaml_text, const std::string& source) {
@@ -258,8 +271,8 @@ std::optional<Scene> scene_setup(const mech::Model& model) {
     // Bullet's multibody (src/bullet) is built with its root fixed at the
     // identity and no contacts: a scene with a floating or placed base, or
     // with contacts, is not one it can build (it runs the matrices).
-    if (scene->base.floating || scene->base.pose.matrix() != Eigen::Matrix4d::Identity() ||
-        !scene->contacts.empty())
+    if (!scene->bodies.empty() || scene->base.floating ||
+        scene->base.pose.matrix() != Eigen::Matrix4d::Identity() || !scene->contacts.empty())
       return std::nullopt;
     scene->model.mechanical->restitution = model.mechanical->restitution;  // the model's own
     return scene;

@@ -35,12 +35,11 @@ VectorXd SceneConstraints::g() const {
   return out;
 }
 
-void add_constraints(const Keys& keys, const std::string& source, const SceneUrdf& urdf,
+void add_constraints(const Keys& keys, const std::string& source, const NameCheck& check,
                      const SceneJoints& joints, SceneConstraints& out) {
   if (!keys.count("constraints")) return;
   const YAML::Node& cn = keys.at("constraints");
   if (!cn.IsSequence()) fail(source, "constraints", "expected a list (got " + describe(cn) + ")");
-  const NameCheck check = simulated(joints, urdf);
   for (std::size_t i = 0; i < cn.size(); ++i) {
     const std::string k = "constraints[" + std::to_string(i) + "]";
     const Keys ck = io::yaml::mapping(cn[i], source, k, {"name", "coefficients", "g"});

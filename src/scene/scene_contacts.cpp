@@ -62,7 +62,7 @@ std::vector<ContactPoint> given_points(const Keys& ck, const std::string& source
   if (!(r >= 0.0)) fail(source, k + ".radius", "must be >= 0 m (got " + format_number(r) + ")");
   std::vector<ContactPoint> out;
   for (Eigen::Index i = 0; i < P.rows(); ++i)
-    out.push_back({prefix + ".point" + std::to_string(i), link, P.row(i).transpose(), r});
+    out.push_back({prefix + ".point" + std::to_string(i), link, P.row(i).transpose(), r, 0});
   return out;
 }
 
@@ -94,6 +94,27 @@ const Plane& plane_named(const Keys& ck, const std::string& source, const std::s
        "no plane '" + name + "' (the planes are " + (names.empty() ? "none" : join(names)) + ")");
 }
 
+// The frames of entry `k`'s points: against its plane, or against each
+// sphere or box of the link its `against:` names (body_contacts.cpp).
+std::vector<ContactFrame> entry_frames(const Keys& ck, const std::string& source,
+                                       const std::string& k, const std::vector<ContactBody>& bodies,
+                                       const LinkRef& ref, const std::vector<ContactPoint>& points,
+                                       const std::vector<Plane>& planes, const Bodies& dyn,
+                                       const VectorXd& q0) {
+  std::vector<ContactFrame> out;
+  if (ck.count("against")) {
+    if (ck.count("plane"))
+      fail(source, k + ".against", "a contact has a plane or against, not both");
+    for (const ContactFrame& f :
+         against_frames(bodies, ref, ck.at("against"), source, k, points, dyn, q0))
+      out.push_back(f);
+    return out;
+  }
+  const Plane& plane = plane_named(ck, source, k, planes);
+  for (const ContactPoint& p : points) out.push_back(contact_frame(dyn, p, plane, q0));
+  return out;
+}
+
 }  // namespace
 
 std::vector<Plane> read_planes(const Keys& keys, const std::string& source) {
@@ -121,9 +142,9 @@ std::vector<Plane> read_planes(const Keys& keys, const std::string& source) {
   return out;
 }
 
-SceneContacts add_contacts(const Keys& keys, const std::string& source, const SceneUrdf& urdf,
-                           const std::vector<Plane>& planes, const UrdfDynamics& dyn,
-                           const VectorXd& q0, SceneConstraints& out) {
+SceneContacts add_contacts(const Keys& keys, const std::string& source,
+                           const std::vector<ContactBody>& bodies, const std::vector<Plane>& planes,
+                           const Bodies& dyn, const VectorXd& q0, SceneConstraints& out) {
   SceneContacts sc;
   const ContactOptions opt = read_options(keys, source);
   if (!keys.count("contacts")) return sc;
@@ -132,26 +153,27 @@ SceneContacts add_contacts(const Keys& keys, const std::string& source, const Sc
   std::size_t dropped = 0, total = 0;
   for (std::size_t i = 0; i < cn.size(); ++i) {
     const std::string k = "contacts[" + std::to_string(i) + "]";
-    const Keys ck =
-        io::yaml::mapping(cn[i], source, k, {"link", "plane", "points", "radius", "name"});
+    const Keys ck = io::yaml::mapping(cn[i], source, k,
+                                      {"link", "plane", "against", "points", "radius", "name"});
     if (!ck.count("link")) fail(source, k + ".link", "missing");
-    const std::string link = name_of(ck.at("link"), source, k + ".link");
-    if (!urdf.model->getLink(link))
-      fail(source, k + ".link", "no link '" + link + "' in " + urdf.path);
-    const Plane& plane = plane_named(ck, source, k, planes);
+    const LinkRef ref = find_link(bodies, ck.at("link"), source, k + ".link");
+    if (!ck.count("against")) plane_named(ck, source, k, planes);  // checked before the points
     const std::string prefix =
-        ck.count("name") ? name_of(ck.at("name"), source, k + ".name") : link;
-    for (const ContactPoint& p : entry_points(ck, source, k, urdf, link, prefix)) {
-      ContactFrame f = contact_frame(dyn, p, plane, q0);
+        ck.count("name") ? name_of(ck.at("name"), source, k + ".name")
+                         : (bodies.size() > 1 ? bodies[ref.body].name + "." : "") + ref.link;
+    std::vector<ContactPoint> points =
+        entry_points(ck, source, k, *bodies[ref.body].urdf, ref.link, prefix);
+    for (ContactPoint& p : points) p.body = ref.body;
+    for (ContactFrame& f : entry_frames(ck, source, k, bodies, ref, points, planes, dyn, q0)) {
       ++total;
+      const std::string other = f.against ? "'" + f.plane + "'" : "plane '" + f.plane + "'";
       if (f.normal_row.isZero())
         fail(source, k + ".link",
-             "contact '" + p.name + "' does not move toward or away from plane '" + plane.name +
-                 "' at q0 (no coordinate moves it along the normal: its row of E would be zero)");
+             "contact '" + f.point.name + "' does not move toward or away from " + other +
+                 " at q0 (no coordinate moves it along the normal: its row of E would be zero)");
       if (f.gap < -opt.penetration_tolerance)
         fail(source, k,
-             "contact '" + p.name + "' penetrates plane '" + plane.name + "' by " +
-                 format_number(-f.gap) +
+             "contact '" + f.point.name + "' penetrates " + other + " by " + format_number(-f.gap) +
                  " m at q0 (more than contact_options.penetration_tolerance = " +
                  format_number(opt.penetration_tolerance) + " m)");
       if (f.gap > opt.max_distance) {
@@ -159,7 +181,7 @@ SceneContacts add_contacts(const Keys& keys, const std::string& source, const Sc
         continue;
       }
       f.row = static_cast<Eigen::Index>(out.rows.size());
-      out.add(f.normal_row, f.gap - f.normal_row.dot(q0), p.name);
+      out.add(f.normal_row, f.gap - f.normal_row.dot(q0), f.point.name);
       sc.frames.push_back(std::move(f));
     }
   }

@@ -13,12 +13,11 @@ using io::yaml::describe;
 using io::yaml::fail;
 using io::yaml::number;
 
-void add_springs(const Keys& keys, const std::string& source, const SceneUrdf& urdf,
+void add_springs(const Keys& keys, const std::string& source, const NameCheck& check,
                  const SceneJoints& joints, SceneDynamics& dyn) {
   if (!keys.count("springs")) return;
   const YAML::Node& sn = keys.at("springs");
   if (!sn.IsSequence()) fail(source, "springs", "expected a list (got " + describe(sn) + ")");
-  const NameCheck check = simulated(joints, urdf);
   for (std::size_t i = 0; i < sn.size(); ++i) {
     const std::string k = "springs[" + std::to_string(i) + "]";
     const Keys sk = io::yaml::mapping(sn[i], source, k,

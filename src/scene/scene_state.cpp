@@ -63,7 +63,7 @@ std::map<std::string, double> read_q0(const Keys& keys, const std::string& sourc
   return q0;
 }
 
-VectorXd read_initial(const Keys& keys, const std::string& source, const SceneUrdf& urdf,
+VectorXd read_initial(const Keys& keys, const std::string& source, const NameCheck& check,
                       const SceneJoints& joints, const VectorXd& q0) {
   const Eigen::Index N = joints.size();
   VectorXd x(2 * N);
@@ -74,7 +74,7 @@ VectorXd read_initial(const Keys& keys, const std::string& source, const SceneUr
   for (const char* part : {"q", "v"}) {
     if (!ik.count(part)) continue;
     for (const auto& [jname, val] :
-         by_name(ik.at(part), source, std::string("initial.") + part, simulated(joints, urdf)))
+         by_name(ik.at(part), source, std::string("initial.") + part, check))
       x(joints.coord(jname) + (std::string(part) == "v" ? N : 0)) = val;
   }
   return x;

@@ -8,12 +8,14 @@
 
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace lcsim::scene {
 
 class UrdfDynamics;
+class Bodies;
 
 // A world plane: the points x with normal . (x - point) = 0; the free side
 // is where normal . (x - point) > 0. `normal` is a unit vector (the scene's
@@ -31,6 +33,7 @@ struct ContactPoint {
   std::string link;
   Eigen::Vector3d local = Eigen::Vector3d::Zero();  // m, link frame
   double radius = 0.0;                              // m, >= 0
+  std::size_t body = 0;  // its body in a scene of several (Bodies), 0 in a one-URDF scene
 };
 
 // The exact (nonlinear) signed distance of `p` to `plane` at coordinates q:
@@ -38,15 +41,44 @@ struct ContactPoint {
 double signed_distance(const UrdfDynamics& dyn, const ContactPoint& p, const Plane& plane,
                        const Eigen::VectorXd& q);
 
+// Another body's collision primitive that a contact point may touch
+// (docs/contacts.md, "Body against body"): a sphere, or a box of which one
+// face, the one nearest the point at q0 (nearest_face), is kept fixed in the
+// box's frame, so its signed distance is that of the face's plane.
+struct BodyShape {
+  std::string name;  // "<body>/<link>" (and ".<kind><k>" when the link has several)
+  std::size_t body = 0;
+  std::string link;
+  std::string kind;                                         // "sphere" or "box"
+  Eigen::Isometry3d local = Eigen::Isometry3d::Identity();  // its frame in the link's
+  double radius = 0.0;                                      // sphere: m
+  Eigen::Vector3d half = Eigen::Vector3d::Zero();           // box: half sizes (m)
+  int face = -1;  // box: axis face / 2 of its frame, outward along + (face odd) or - (even)
+};
+// The exact signed distances at the scene's coordinates q (m):
+//   plane:  phi = normal . (X_link(q) local - plane.point) - radius;
+//   sphere: phi = |w - c| - R - radius (w the point, c the sphere's centre, world);
+//   box:    phi = n_f . (w - X_box(q) (h_f n_f^box)) - radius, n_f = R_box(q) n_f^box,
+//           the face `face` (h_f its half size along its axis).
+double signed_distance(const Bodies& bodies, const ContactPoint& p, const Plane& plane,
+                       const Eigen::VectorXd& q);
+double signed_distance(const Bodies& bodies, const ContactPoint& p, const BodyShape& s,
+                       const Eigen::VectorXd& q);
+// The face of box `s` whose plane the point is farthest outside of at q
+// (the largest sign * y_axis - half_axis, y the point in the box's frame;
+// inside the box, the face it is least deep under); the first on a tie.
+int nearest_face(const Bodies& bodies, const ContactPoint& p, const BodyShape& s,
+                 const Eigen::VectorXd& q);
 // A contact point against a plane at q0: one row of the scene's E and g.
 // The tangents: t1 = normal x e / |normal x e| with e the world axis least
 // aligned with the normal (the first of x, y, z on a tie), t2 = normal x t1,
 // so (normal, t1, t2) is a right-handed orthonormal frame.
 struct ContactFrame {
   ContactPoint point;
-  std::string plane;
-  Eigen::Index row = -1;  // its row of E and g (and its constraint name is point.name)
-  double gap = 0.0;       // phi(q0) (m)
+  std::string plane;  // the plane's name, or the other body's shape's (BodyShape::name)
+  std::optional<BodyShape> against;  // set for a contact against another body
+  Eigen::Index row = -1;             // its row of E and g (and its constraint name is point.name)
+  double gap = 0.0;                  // phi(q0) (m)
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  // the point nearest the plane at q0 (m)
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ(), tangent1 = Eigen::Vector3d::UnitX(),
                   tangent2 = Eigen::Vector3d::UnitY();  // world frame, unit
@@ -60,5 +92,22 @@ struct ContactFrame {
 // derivatives (UrdfDynamics::point_jacobian), row left -1.
 ContactFrame contact_frame(const UrdfDynamics& dyn, const ContactPoint& p, const Plane& plane,
                            const Eigen::VectorXd& q);
+// The same on a scene's bodies (the rows over all its coordinates).
+ContactFrame contact_frame(const Bodies& bodies, const ContactPoint& p, const Plane& plane,
+                           const Eigen::VectorXd& q);
+// A point against another body's shape at q: the normal n points from the
+// shape to the point (sphere: along w - c; box: the face's outward normal),
+// the tangents as for a plane, and each row is d/dq of the relative
+// velocity along it of the two material points touching first, the
+// point's (w - radius n) and the shape's (c + R n, or w's projection on
+// the face): row = dir' (J_point - J_shape). The normal row is the exact
+// gradient of phi (the other terms of phi's derivative vanish along n).
+// InputError when the point is at the sphere's centre (no normal).
+ContactFrame contact_frame(const Bodies& bodies, const ContactPoint& p, const BodyShape& s,
+                           const Eigen::VectorXd& q);
+// The signed distance of the contact `c` describes (its plane among
+// `planes`, or its other body's shape) at q.
+double signed_distance(const Bodies& bodies, const ContactFrame& c,
+                       const std::vector<Plane>& planes, const Eigen::VectorXd& q);
 
 }  // namespace lcsim::scene

@@ -8,6 +8,7 @@
 #include <lcsim/circuit/circuit.hpp>
 #include <lcsim/io/input_error.hpp>
 #include <lcsim/mech/mech.hpp>
+#include <lcsim/scene/bodies.hpp>
 #include <lcsim/scene/contacts.hpp>
 #include <lcsim/scene/urdf.hpp>
 #include <map>
@@ -51,7 +52,16 @@ struct Scene {
   BasePose base;                     // where the URDF's root sits (fixed or floating)
   std::vector<Plane> planes;         // the world planes of `planes:`
   std::vector<ContactFrame> contacts;  // one per contact row of E (ContactFrame::row)
+  // A scene of several URDFs (`bodies:`, docs/contacts.md): each body, its
+  // coordinates at its offset. Then `urdf` is null, `q0` and `lin.joints`
+  // name the coordinates (`<body>.<joint>`, `<body>.x`, ...), `lin` is the
+  // bodies' block-diagonal whole and `base` is unused. Empty in a one-URDF
+  // scene.
+  std::vector<SceneBody> bodies;
 };
+// The exact dynamics of the scene's bodies (its one URDF as body "" when
+// `bodies` is empty): what its linear model is checked against.
+Bodies scene_bodies(const Scene& scene);
 Scene read_scene(const std::string& yaml_text, const std::string& source);
 // The scene in `path`, or nullopt when the file is a model, not a scene (no
 // top-level `urdf:` key). Errors as load_model.

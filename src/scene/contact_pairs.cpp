@@ -1,0 +1,148 @@
+// Contact points on a scene's bodies: against a world plane, and against
+// another body's sphere or box (docs/contacts.md, "Body against body"):
+// exact signed distances and, at a configuration, the contact frame with
+// the exact derivatives of the relative motion along its directions.
+#include <cmath>
+#include <lcsim/io/input_error.hpp>
+#include <lcsim/scene/bodies.hpp>
+#include <lcsim/scene/contacts.hpp>
+#include <limits>
+
+namespace lcsim::scene {
+
+using Eigen::Vector3d;
+
+namespace {
+
+// t1 = n x e / |n x e|, e the world axis least aligned with n (first on a
+// tie), as for a plane (contacts.cpp).
+Vector3d first_tangent(const Vector3d& n) {
+  Eigen::Index k = 0;
+  n.cwiseAbs().minCoeff(&k);
+  const Vector3d t = n.cross(Vector3d::Unit(k));
+  return t / t.norm();
+}
+
+void set_directions(ContactFrame& c, const Vector3d& n) {
+  c.normal = n;
+  c.tangent1 = first_tangent(n);
+  c.tangent2 = n.cross(c.tangent1);
+}
+
+// The box face's outward unit normal in the box's frame.
+Vector3d face_normal(int face) { return (face % 2 ? 1.0 : -1.0) * Vector3d::Unit(face / 2); }
+
+// The shape's frame in the world at q.
+Eigen::Isometry3d shape_pose(const Bodies& b, const BodyShape& s, const Eigen::VectorXd& q) {
+  return b.link_pose(s.body, s.link, q) * s.local;
+}
+
+// The point's centre in the world at q.
+Vector3d point_at(const Bodies& b, const ContactPoint& p, const Eigen::VectorXd& q) {
+  return b.link_pose(p.body, p.link, q) * p.local;
+}
+
+// The unit normal (shape to point), the distance of the point's centre from
+// the shape's surface along it, and the shape's material point there.
+struct Separation {
+  Vector3d normal, surface;
+  double distance = 0.0;  // m, before the point's radius
+};
+Separation separation(const Bodies& b, const ContactPoint& p, const BodyShape& s,
+                      const Eigen::VectorXd& q) {
+  const Vector3d w = point_at(b, p, q);
+  const Eigen::Isometry3d X = shape_pose(b, s, q);
+  Separation out;
+  if (s.kind == "sphere") {
+    const Vector3d d = w - X.translation();
+    if (!(d.norm() > 0.0))
+      throw InputError("contact '" + p.name + "' is at the centre of sphere '" + s.name +
+                       "': no normal");
+    out.normal = d / d.norm();
+    out.distance = d.norm() - s.radius;
+    out.surface = X.translation() + s.radius * out.normal;
+  } else {
+    out.normal = X.linear() * face_normal(s.face);
+    out.distance = out.normal.dot(w - X.translation()) - s.half(s.face / 2);
+    out.surface = w - out.distance * out.normal;
+  }
+  return out;
+}
+
+}  // namespace
+
+double signed_distance(const Bodies& bodies, const ContactPoint& p, const Plane& plane,
+                       const Eigen::VectorXd& q) {
+  return plane.normal.dot(point_at(bodies, p, q) - plane.point) - p.radius;
+}
+
+double signed_distance(const Bodies& bodies, const ContactPoint& p, const BodyShape& s,
+                       const Eigen::VectorXd& q) {
+  return separation(bodies, p, s, q).distance - p.radius;
+}
+
+int nearest_face(const Bodies& bodies, const ContactPoint& p, const BodyShape& s,
+                 const Eigen::VectorXd& q) {
+  const Vector3d y = shape_pose(bodies, s, q).inverse() * point_at(bodies, p, q);
+  int best = 0;
+  double most = -std::numeric_limits<double>::infinity();
+  for (int f = 0; f < 6; ++f) {
+    const double d = face_normal(f).dot(y) - s.half(f / 2);
+    if (d > most) most = d, best = f;
+  }
+  return best;
+}
+
+ContactFrame contact_frame(const Bodies& bodies, const ContactPoint& p, const Plane& plane,
+                           const Eigen::VectorXd& q) {
+  ContactFrame c;
+  c.point = p;
+  c.plane = plane.name;
+  set_directions(c, plane.normal);
+  const Eigen::Isometry3d X = bodies.link_pose(p.body, p.link, q);
+  const Vector3d w = X * p.local;
+  c.gap = plane.normal.dot(w - plane.point) - p.radius;
+  c.position = w - p.radius * plane.normal;
+  // As contacts.cpp: the rows of the link's material point at `position`.
+  const Eigen::Matrix3Xd J = bodies.point_jacobian(p.body, p.link, X.inverse() * c.position, q);
+  c.normal_row = (c.normal.transpose() * J).transpose();
+  c.tangent1_row = (c.tangent1.transpose() * J).transpose();
+  c.tangent2_row = (c.tangent2.transpose() * J).transpose();
+  return c;
+}
+
+ContactFrame contact_frame(const Bodies& bodies, const ContactPoint& p, const BodyShape& s,
+                           const Eigen::VectorXd& q) {
+  ContactFrame c;
+  c.point = p;
+  c.plane = s.name;
+  c.against = s;
+  const Separation sep = separation(bodies, p, s, q);
+  set_directions(c, sep.normal);
+  c.gap = sep.distance - p.radius;
+  c.position = point_at(bodies, p, q) - p.radius * sep.normal;
+  // The relative velocity of the point's material point at `position` and
+  // the shape's at `surface`. Along n it is d phi/dt: a sphere's centre
+  // moves its surface point by omega x R n, normal to n; a box face's
+  // normal turns with omega, and (omega x n) . (w - o) = -n . (omega x
+  // (w - o)), the box's material point at w, which moves along n as the
+  // one at `surface` (they differ by a multiple of n).
+  const Eigen::Isometry3d Xp = bodies.link_pose(p.body, p.link, q);
+  const Eigen::Isometry3d Xs = bodies.link_pose(s.body, s.link, q);
+  const Eigen::Matrix3Xd J = bodies.point_jacobian(p.body, p.link, Xp.inverse() * c.position, q) -
+                             bodies.point_jacobian(s.body, s.link, Xs.inverse() * sep.surface, q);
+  c.normal_row = (c.normal.transpose() * J).transpose();
+  c.tangent1_row = (c.tangent1.transpose() * J).transpose();
+  c.tangent2_row = (c.tangent2.transpose() * J).transpose();
+  return c;
+}
+
+double signed_distance(const Bodies& bodies, const ContactFrame& c,
+                       const std::vector<Plane>& planes, const Eigen::VectorXd& q) {
+  if (c.against) return signed_distance(bodies, c.point, *c.against, q);
+  for (const Plane& p : planes)
+    if (p.name == c.plane) return signed_distance(bodies, c.point, p, q);
+  throw InputError("contact '" + c.point.name + "': no plane '" + c.plane + "'");
+}
+
+}  // namespace lcsim::scene
