@@ -5,8 +5,11 @@ q = -0.5 (q + 0.5 >= 0) with restitution e. A trajectory recorded with the true 
 its position sampled every 0.1 s to t = 8 s with seeded Gaussian noise, is fitted by
 Gauss-Newton on the least squares of the positions, once with the exact Jacobian of the
 run (simulate(..., sensitivity=["e[stop]", "K[0][0]"]), docs/sensitivities.md) and once
-with central finite differences of the run (two extra runs per parameter). Prints the
-iterations, the runs, the wall time and the error of the recovered values.
+with central finite differences of the run (two extra runs per parameter), and once as a
+differentiable time-stepping simulator does it: the run and its Jacobian both from
+Moreau-Jean (h = 1e-3, the derivative of its discrete map, docs/sensitivities.md "The
+time-stepping derivative"). Prints the iterations, the runs, the wall time and the error
+of the recovered values.
 
     PYTHONPATH=build/python /usr/bin/python3 examples/python/system_identification.py
 """
@@ -24,6 +27,7 @@ NAMES = ["e[stop]", "K[0][0]"]
 X0 = [0.0, -2.0]  # (q, v): moving towards the stop
 T_END, DT = 8.0, 0.1
 SIGMA = 0.01  # noise on the recorded positions (m)
+MJ_H = 1e-3  # Moreau-Jean's step in the third fit (s)
 
 
 def model(theta):
@@ -46,10 +50,12 @@ def grid_samples(run):
     return np.array(idx)
 
 
-def positions(theta, jacobian=False):
-    """q at the grid times, and with jacobian=True dq/d(e, k) from the run (exact)."""
-    run = lcsim.simulate(model(theta), x0=X0, t_end=T_END, dt_out=DT,
-                         sensitivity=NAMES if jacobian else ())
+def positions(theta, jacobian=False, method="event"):
+    """q at the grid times, and with jacobian=True dq/d(e, k) from the run (exact for the
+    method 'event'; for 'moreau-jean' the derivative of its discrete map at step MJ_H)."""
+    step = dict(h=MJ_H) if method == "moreau-jean" else {}
+    run = lcsim.simulate(model(theta), x0=X0, t_end=T_END, dt_out=DT, method=method,
+                         sensitivity=NAMES if jacobian else (), **step)
     if not run.ok:
         raise RuntimeError(f"run failed at theta = {theta}: {run.message}")
     idx = grid_samples(run)
@@ -80,12 +86,12 @@ def record(seed=1):
     return q + np.random.default_rng(seed).normal(0.0, SIGMA, q.shape)
 
 
-def gauss_newton(data, exact, theta0=GUESS, tol=1e-10, max_iter=30):
+def gauss_newton(data, exact, theta0=GUESS, tol=1e-10, max_iter=30, method="event"):
     """Gauss-Newton with step halving on the cost. Converged when the step is below tol
     relative to theta. Returns (theta, iterations, runs, converged, J at theta)."""
     theta, runs = np.array(theta0, float), 0
     for it in range(1, max_iter + 1):
-        q, J = positions(theta, jacobian=exact)
+        q, J = positions(theta, jacobian=exact, method=method)
         runs += 1
         if not exact:
             J = fd_jacobian(theta)
@@ -95,11 +101,13 @@ def gauss_newton(data, exact, theta0=GUESS, tol=1e-10, max_iter=30):
         cost, lam = r @ r, 1.0
         while True:  # halve the step until the cost does not rise
             trial = theta + lam * step
-            rt = positions(trial)[0] - data
+            rt = positions(trial, method=method)[0] - data
             runs += 1
             if rt @ rt <= cost or lam < 1e-6:
                 break
             lam /= 2
+        if rt @ rt > cost:  # no step along -J^+ r lowers the cost: J is not its gradient
+            return theta, it, runs, False, J
         theta = trial
         if np.linalg.norm(lam * step) <= tol * np.linalg.norm(theta):
             return theta, it, runs, True, J
@@ -109,11 +117,16 @@ def gauss_newton(data, exact, theta0=GUESS, tol=1e-10, max_iter=30):
 def fit_both(seed=1):
     data = record(seed)
     out = {}
-    for label, exact in (("exact Jacobian", True), ("central differences", False)):
+    for label, exact, method, tol in (("exact Jacobian", True, "event", 1e-10),
+                                      ("central differences", False, "event", 1e-10),
+                                      ("Moreau-Jean", True, "moreau-jean", 1e-6)):
         t0 = time.perf_counter()
-        theta, it, runs, ok, J = gauss_newton(data, exact)
-        out[label] = dict(theta=theta, iterations=it, runs=runs, converged=ok,
-                          wall=time.perf_counter() - t0, J=J)
+        theta, it, runs, ok, J = gauss_newton(data, exact, tol=tol, method=method)
+        wall = time.perf_counter() - t0
+        # The fit's residual with its own model: ~SIGMA where it fits the data.
+        rms = np.sqrt(np.mean((positions(theta, method=method)[0] - data) ** 2))
+        out[label] = dict(theta=theta, iterations=it, runs=runs, converged=ok, wall=wall, J=J,
+                          rms=rms)
     return data, out
 
 
@@ -122,14 +135,19 @@ def main():
     print(f"true (e, k) = {tuple(TRUE)}, guess {tuple(GUESS)}, noise sigma = {SIGMA} m, "
           f"{round(T_END / DT) + 1} samples")
     print(f"{'Jacobian':22} {'iters':>5} {'runs':>5} {'wall s':>8} {'e':>10} {'k':>10} "
-          f"{'|de|':>9} {'|dk|':>9} {'sd e':>9} {'sd k':>9}")
+          f"{'|de|':>9} {'|dk|':>9} {'sd e':>9} {'sd k':>9} {'rms m':>9}")
     for label, f in fits.items():
         sd = SIGMA * np.sqrt(np.diag(np.linalg.inv(f["J"].T @ f["J"])))
         err = np.abs(f["theta"] - TRUE)
         print(f"{label:22} {f['iterations']:5d} {f['runs']:5d} {f['wall']:8.3f} "
               f"{f['theta'][0]:10.6f} {f['theta'][1]:10.6f} {err[0]:9.2e} {err[1]:9.2e} "
-              f"{sd[0]:9.2e} {sd[1]:9.2e}{'' if f['converged'] else '  NOT CONVERGED'}")
-    return 0 if all(f["converged"] for f in fits.values()) else 3
+              f"{sd[0]:9.2e} {sd[1]:9.2e} {f['rms']:9.2e}"
+              f"{'' if f['converged'] else '  NOT CONVERGED'}"
+              f"{'  (stopped where its model does not fit: rms >> sigma)' if f['rms'] > 3 * SIGMA else ''}")
+    # The Moreau-Jean fit is reported, not required: its model has discontinuities of
+    # O(h) where an impact changes step (docs/sensitivities.md).
+    return 0 if fits["exact Jacobian"]["converged"] and fits["central differences"]["converged"] \
+        else 3
 
 
 if __name__ == "__main__":

@@ -177,6 +177,17 @@ class StreamComparison {
   double at_events_ = 0.0;
 };
 
+// Max-abs difference of the run's dx(T)/dtheta to the reference's: +inf
+// when a column is absent in either (or the run computed none).
+double gradient_error(const sim::Trajectory& run, const sim::Trajectory& ref) {
+  if (run.dx_final.size() == 0 || run.dx_final.rows() != ref.dx_final.rows() ||
+      run.dx_final.cols() != ref.dx_final.cols())
+    return kInf;
+  for (size_t c = 0; c < run.dx_final_exists.size(); ++c)
+    if (!run.dx_final_exists[c] || !ref.dx_final_exists[c]) return kInf;
+  return (run.dx_final - ref.dx_final).cwiseAbs().maxCoeff();
+}
+
 void fill_reference(SweepRow& row, const ReferenceRun& ref) {
   row.reference = ref.law;
   row.reference_warnings = ref.warnings;
@@ -195,10 +206,11 @@ SweepRow event_row(const sim::Integrator& integ, const mech::Model& model,
   r.max_violation = ref.run.max_violation;
   r.steps = ref.run.steps;
   r.lcp_solves = ref.run.lcp_solves;
+  if (!o.base.sensitivity.empty()) r.error_gradient = gradient_error(ref.run, ref.run);  // 0 or inf
   if (ref.status == "completed")
     r.wall_time_s = timed(integ, model, x0, timing, o.repeat);
   else
-    r.error_final = r.error_max = r.error_events = kInf;
+    r.error_final = r.error_max = r.error_events = r.error_gradient = kInf;
   return r;
 }
 
@@ -236,7 +248,7 @@ SweepRow stepping_row(const std::string& method, const sim::Integrator& integ,
   r.steps = tr.steps;
   r.lcp_solves = tr.lcp_solves;
   r.error_floor = error_floor(tr);
-  r.error_final = r.error_max = r.error_events = kInf;
+  r.error_final = r.error_max = r.error_events = r.error_gradient = kInf;
   if (tr.status != sim::RunStatus::kCompleted) return r;
   if (ref.status != "completed") {
     r.status = "failed: the exact reference (" + law.label() + ") failed: " + ref.run.message;
@@ -249,6 +261,7 @@ SweepRow stepping_row(const std::string& method, const sim::Integrator& integ,
                     ? max_sample_error(cmp.grid(), grid, timing.h)
                     : kInf;
   r.error_max = std::max({r.error_max, r.error_final, r.error_events});
+  if (!o.base.sensitivity.empty()) r.error_gradient = gradient_error(tr, ref.run);
   r.energy_drift =
       (tr.energy_final - tr.energy_initial) - (ref.run.energy_final - ref.run.energy_initial);
   r.wall_time_s = timed(integ, model, x0, timing, o.repeat);
@@ -263,7 +276,7 @@ SweepRow refused_row(const std::string& method, double h, const sim::Trajectory&
   r.h = h;
   r.reference = reference_law(method, o.base.impact, model);
   r.status = status_of(why);
-  r.error_final = r.error_max = r.error_events = kInf;
+  r.error_final = r.error_max = r.error_events = r.error_gradient = kInf;
   return r;
 }
 
@@ -323,6 +336,7 @@ SweepResult run_sweep(const mech::Model& model, const Eigen::VectorXd& x0, const
   out.model = model.name;
   out.t_end = o.base.t_end.value_or(model.t_end);
   out.impact = o.base.impact;
+  out.sensitivity = o.base.sensitivity;
   const std::vector<PlannedRow> plan = plan_rows(model, x0, o, out.t_end);
   // Nothing to measure: the first refusal is the sweep's input error.
   if (std::all_of(plan.begin(), plan.end(), [](const PlannedRow& p) { return p.refused; }))
@@ -355,6 +369,7 @@ nlohmann::json sweep_json(const SweepResult& r) {
   j["t_end"] = r.t_end;
   j["impact"] = r.impact;
   j["error_measures"] = kErrorMeasures;
+  if (!r.sensitivity.empty()) j["sensitivity"] = r.sensitivity;
   j["references"] = nlohmann::json::array();
   for (const auto& ref : r.references)
     j["references"].push_back({{"law", ref.law.law},
@@ -375,6 +390,7 @@ nlohmann::json sweep_json(const SweepResult& r) {
     o["error_final"] = io::finite_or_null(row.error_final);
     o["error_max"] = io::finite_or_null(row.error_max);
     o["error_events"] = io::finite_or_null(row.error_events);
+    if (!r.sensitivity.empty()) o["error_gradient"] = io::finite_or_null(row.error_gradient);
     o["error_floor"] = text_or_null(row.error_floor);
     o["max_violation"] = io::finite_or_null(row.max_violation);
     o["energy_drift"] = io::finite_or_null(row.energy_drift);

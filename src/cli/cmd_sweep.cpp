@@ -41,6 +41,7 @@ struct SweepArgs {
   std::string plot;
   std::string lcp = "pivot";
   std::string impact = sim::Options{}.impact;
+  std::string sensitivity;  // "x0,f[1]": the err_grad column (docs/sensitivities.md)
 };
 
 std::vector<std::string> split_list(const std::string& s) {
@@ -60,18 +61,21 @@ std::string warning_text(long count, const std::string& first) {
 void print_text(const app::SweepResult& s, const std::string& x0_from) {
   std::printf("model %s, t_end %g, --impact %s, x0 from %s\n", s.model.c_str(), s.t_end,
               s.impact.c_str(), x0_from.c_str());
-  std::printf("%-12s %-8s %-24s %-11s %-11s %-11s %-11s %-9s %-9s %-10s\n", "method", "h",
+  const bool grad = !s.sensitivity.empty();  // the column only when asked
+  std::printf("%-12s %-8s %-24s %-11s %-11s %-11s %-11s %-9s %-9s %-10s%s\n", "method", "h",
               "reference law", "err_final", "err_max", "violation", "E_drift", "steps", "lcp",
-              "wall_s");
+              "wall_s", grad ? " err_grad" : "");
   for (const auto& r : s.rows) {
     char hbuf[32];
     if (r.method == "event")
       std::snprintf(hbuf, sizeof hbuf, "-");
     else
       std::snprintf(hbuf, sizeof hbuf, "%g", r.h);
-    std::printf("%-12s %-8s %-24s %-11.3e %-11.3e %-11.3e %-11.3e %-9ld %-9ld %-10.3e%s\n",
+    char gbuf[32] = "";
+    if (grad) std::snprintf(gbuf, sizeof gbuf, " %-10.3e", r.error_gradient);
+    std::printf("%-12s %-8s %-24s %-11.3e %-11.3e %-11.3e %-11.3e %-9ld %-9ld %-10.3e%s%s\n",
                 r.method.c_str(), hbuf, r.reference.label().c_str(), r.error_final, r.error_max,
-                r.max_violation, r.energy_drift, r.steps, r.lcp_solves, r.wall_time_s,
+                r.max_violation, r.energy_drift, r.steps, r.lcp_solves, r.wall_time_s, gbuf,
                 r.status == "completed" ? "" : ("  " + r.status).c_str());
     if (!r.error_floor.empty()) std::printf("    error floor: %s\n", r.error_floor.c_str());
     if (r.warnings > 0)
@@ -103,6 +107,7 @@ void run_sweep(const SweepArgs& a) {
   o.base.force = a.force;
   o.base.lcp_solver = a.lcp;
   o.base.impact = a.impact;
+  o.base.sensitivity = split_list(a.sensitivity);
   o.progress = [](const std::string& line) { std::cerr << "sweep: " << line << "\n"; };
   // The plot's path and script are checked before the runs, not after.
   PlotScript script;
@@ -145,6 +150,10 @@ void setup(CLI::App& app) {
                       sim::Options{}.impact + ": " + name_list(impact::impact_law_names()));
   cmd->add_flag("--force", a->force, "Run backward Euler even where it is not consistent");
   cmd->add_option("--lcp", a->lcp, "LCP solver: " + name_list(lcp::solver_names()));
+  cmd->add_option("--sensitivity", a->sensitivity,
+                  "Comma-separated columns (x0, f[i], g[c], e[c], K[i][j], D[i][j], M[i][j]): "
+                  "each row also gives err_grad, the error of its dx(T)/dtheta against the "
+                  "exact one");
   cmd->add_flag("--json", a->json, "Print {\"rows\": [...]} as JSON");
   cmd->add_option("--plot", a->plot, "Draw the work-precision diagram (PNG) here");
   cmd->callback([a, t_end] {

@@ -315,3 +315,57 @@ TEST(Sweep, ErrorAtTheExactEventsIsPartOfTheErrorOverTheRun) {
 
 }  // namespace
 }  // namespace lcsim::app
+
+namespace lcsim::app {
+namespace {
+
+// Asked for sensitivities, each row also measures error_gradient: the
+// max-abs difference of its dx(T)/dtheta to the exact run's, which is what
+// the two runs give directly (the same runs: equal to rounding, 0 here since
+// the sweep runs them with the same options), falling at first order for
+// Moreau-Jean with theta = 1 on the two carts before their impact (t = 1;
+// tests/sim/test_sensitivity_stepping.cpp measures ratio 2.000). Not asked,
+// the JSON has no such field (today's outputs unchanged). A method that
+// refuses a column (Moreau-Jean, g[c]) is a refused row.
+TEST(Sweep, GradientErrorOnlyWhenAsked) {
+  const mech::Model m = load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/two_carts.yaml");
+  SweepOptions o;
+  o.methods = {"event", "moreau-jean"};
+  o.hs = {1e-2, 5e-3};
+  o.repeat = 1;
+  o.base.t_end = 0.9;
+  o.base.theta = 1.0;
+  const nlohmann::json plain = sweep_json(run_sweep(m, m.initial, o));
+  EXPECT_FALSE(plain.contains("sensitivity"));
+  for (const auto& row : plain["rows"]) EXPECT_FALSE(row.contains("error_gradient"));
+  o.base.sensitivity = {"x0", "f[1]"};
+  const SweepResult s = run_sweep(m, m.initial, o);
+  ASSERT_EQ(s.rows.size(), 3u);
+  EXPECT_EQ(s.rows[0].error_gradient, 0.0);  // the event row is the reference
+  sim::Options so;
+  so.t_end = 0.9;
+  so.sensitivity = o.base.sensitivity;
+  const sim::Trajectory exact = sim::simulate(m, m.initial, so, "event");
+  for (int r = 1; r <= 2; ++r) {
+    so.h = s.rows[static_cast<size_t>(r)].h;
+    so.theta = 1.0;
+    const sim::Trajectory mj = sim::simulate(m, m.initial, so, "moreau-jean");
+    so.theta = 0.5;
+    ASSERT_TRUE(mj.ok()) << mj.message;
+    EXPECT_EQ(s.rows[static_cast<size_t>(r)].error_gradient,
+              (mj.dx_final - exact.dx_final).cwiseAbs().maxCoeff());
+  }
+  const double ratio = s.rows[1].error_gradient / s.rows[2].error_gradient;
+  EXPECT_GT(ratio, 1.8);  // first order: 2 within 10%
+  EXPECT_LT(ratio, 2.2);
+  const nlohmann::json j = sweep_json(s);
+  EXPECT_EQ(j["sensitivity"], nlohmann::json({"x0", "f[1]"}));
+  EXPECT_EQ(j["rows"][1]["error_gradient"].get<double>(), s.rows[1].error_gradient);
+  o.base.sensitivity = {"g[stop]"};
+  const SweepResult g = run_sweep(m, m.initial, o);
+  EXPECT_EQ(g.rows[1].status.rfind("refused: ", 0), 0u) << g.rows[1].status;
+  EXPECT_TRUE(std::isinf(g.rows[1].error_gradient));
+}
+
+}  // namespace
+}  // namespace lcsim::app

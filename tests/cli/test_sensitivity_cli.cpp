@@ -57,12 +57,13 @@ TEST(SimulateSensitivity, LossInSummaryAndEmptyFields) {
 
 TEST(SimulateSensitivity, RefusalNamesTheFlag) {
   const CliRun r =
-      run_lcsim("simulate '" + kRobots + "two_carts.yaml' --method euler " + "--sensitivity x0",
+      run_lcsim("simulate '" + kRobots + "two_carts.yaml' --method euler " +
+                    "--sensitivity 'x0,e[stop]'",  // euler computes x0, not e (no restitution)
                 private_temp("refuse", ".err"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(r.err,
-            "lcsim: error: method 'euler' does not compute --sensitivity (the exact method "
-            "'event' does)\n");
+            "lcsim: error: --sensitivity 'e[stop]': method 'euler' does not compute it "
+            "(backward Euler ignores restitution; the method 'event' computes it)\n");
 }
 
 }  // namespace

@@ -65,4 +65,4 @@ def test_refusals_are_input_errors(robots):
     with pytest.raises(lcsim.InputError, match="no coordinate 'x9'"):
         lcsim.simulate(model, sensitivity=["f[x9]"])
     with pytest.raises(lcsim.InputError, match="does not compute"):
-        lcsim.simulate(model, method="moreau-jean", sensitivity=["x0"])
+        lcsim.simulate(model, method="moreau-jean", sensitivity=["g[stop]"])

@@ -345,8 +345,10 @@ TEST(Sensitivity, RefusesWhatItDoesNotCover) {
   const mech::Model m = load("two_carts.yaml");
   sim::Options opt;
   opt.t_end = 1.0;
-  opt.sensitivity = {"x0"};
+  opt.sensitivity = {"e[stop]"};  // backward Euler ignores restitution (x0 it computes)
   EXPECT_EQ(sim::simulate(m, m.initial, opt, "euler").status, Status::kInvalidInput);
+  opt.sensitivity = {"g[stop]"};  // Moreau-Jean's map depends on g only through its active set
+  EXPECT_EQ(sim::simulate(m, m.initial, opt, "moreau-jean").status, Status::kInvalidInput);
   for (const std::string bad : {"f[9]", "K[0]", "e[nope]", "z[0]", "x0,x0"}) {
     opt.sensitivity = {bad};
     if (bad == "x0,x0") opt.sensitivity = {"x0", "x0"};

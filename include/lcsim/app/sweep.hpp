@@ -22,6 +22,9 @@ struct SweepOptions {
   std::vector<double> hs;            // step sizes (s), each in (0, t_end]
   int repeat = 3;                    // timing runs per point (median), >= 1
   sim::Options base;                 // t_end, impact, theta, force, lcp_solver, ...
+  // base.sensitivity non-empty: each row also measures error_gradient, its
+  // derivative dx(T)/dtheta against the exact one (docs/sensitivities.md);
+  // empty (the default): no such column, the outputs as before.
   // Called after each row with "[i/n] method h = ..." (progress for a log).
   std::function<void(const std::string&)> progress;
 };
@@ -53,7 +56,11 @@ struct ReferenceRun {
 //                  URDF's nonlinear dynamics, the exact run the model's
 //                  linearisation: "the linearisation gap: ..."),
 //   max_violation  the run's most negative gap,
-//   energy_drift   (E_final - E_initial) of the run minus the reference's (J).
+//   energy_drift   (E_final - E_initial) of the run minus the reference's (J),
+//   error_gradient only when base.sensitivity is asked: the max-abs
+//                  difference of dx(T)/dtheta (every column) to the exact
+//                  run's; +inf when either has no derivative there (a loss)
+//                  or the method does not compute it.
 // Errors are +inf when the run or its reference failed or was refused.
 // kErrorMeasures says the same in one sentence (the JSON's "error_measures").
 inline constexpr const char* kErrorMeasures =
@@ -67,6 +74,7 @@ struct SweepRow {
   std::string status = "completed";  // "completed", "failed: ..." or "refused: ..."
   double error_final = 0.0, error_max = 0.0, max_violation = 0.0, energy_drift = 0.0;
   double error_events = 0.0;
+  double error_gradient = 0.0;  // when SweepOptions::base.sensitivity is asked
   std::string error_floor;
   long steps = 0, lcp_solves = 0;
   // Median of `repeat` runs with their output (samples on the comparison
@@ -81,7 +89,8 @@ struct SweepRow {
 struct SweepResult {
   std::string model;
   double t_end = 0.0;
-  std::string impact;  // Options::impact of the sweep
+  std::string impact;                    // Options::impact of the sweep
+  std::vector<std::string> sensitivity;  // the columns asked (empty: no error_gradient)
   std::vector<ReferenceRun> references;
   std::vector<SweepRow> rows;
   // True if some reference run failed (its rows carry the failure): the

@@ -239,7 +239,8 @@ struct OptionsUsed {
   // The method handles mechanical.friction (planar Coulomb, issue 17); a
   // method without it refuses a model with friction (check_run).
   bool friction = false;
-  // The method computes Options::sensitivity (the exact method).
+  // The method computes Options::sensitivity (the exact method; the
+  // derivative of the discrete map for backward Euler and Moreau–Jean).
   bool sensitivity = false;
   // The method also handles 3-D contacts (two tangents, a polyhedral cone:
   // mech::FrictionalContact::is_3d, issue 27); a method with friction but

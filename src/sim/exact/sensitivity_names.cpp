@@ -94,21 +94,45 @@ SensColumns parse_sensitivity(const mech::Model& model, const std::vector<std::s
 
 }  // namespace detail
 
+namespace {
+
+// What a time-stepping scheme's step map cannot differentiate: "" or why.
+std::string refuse_for_scheme(const detail::SensColumns& c, std::string_view method) {
+  for (const detail::SensParam& p : c.params) {
+    if (method == "moreau-jean" && p.kind == 'g')
+      return "Options::sensitivity '" + p.name +
+             "': method 'moreau-jean' does not compute it (its step map depends on the gap "
+             "offsets only through the active set, so its derivative there is zero or absent; "
+             "the method 'event' computes it)";
+    if (method == "euler" && p.kind == 'e')
+      return "Options::sensitivity '" + p.name +
+             "': method 'euler' does not compute it (backward Euler ignores restitution; the "
+             "method 'event' computes it)";
+  }
+  return "";
+}
+
+}  // namespace
+
 std::string check_sensitivity(const mech::Model& model, const Options& opt, std::string_view method,
                               const OptionsUsed& used) {
   if (opt.sensitivity.empty()) return "";
   if (!used.sensitivity)
     return "method '" + std::string(method) +
-           "' does not compute Options::sensitivity (the exact method 'event' does)";
+           "' does not compute Options::sensitivity (the methods 'event', 'euler' and "
+           "'moreau-jean' do)";
   if (model.is_mechanical() && model.mechanical->has_friction())
     return "Options::sensitivity: model '" + model.name +
            "' has mechanical.friction; sensitivities through stick / slip are not computed";
-  const std::string law = impact::make_impact_law(opt.impact)->name();
-  if (model.is_mechanical() && law != "moreau-restitution" && law != "newton" && law != "inelastic")
+  const std::string law = used.impact ? impact::make_impact_law(opt.impact)->name() : "";
+  if (used.impact && model.is_mechanical() && law != "moreau-restitution" && law != "newton" &&
+      law != "inelastic")
     return "Options::sensitivity: impact law '" + opt.impact +
            "' has no derivative computed (moreau-restitution, newton and inelastic are linear "
            "at a fixed active set)";
-  return detail::parse_sensitivity(model, opt.sensitivity).error;
+  const detail::SensColumns c = detail::parse_sensitivity(model, opt.sensitivity);
+  if (!c.error.empty()) return c.error;
+  return refuse_for_scheme(c, method);
 }
 
 }  // namespace lcsim::sim

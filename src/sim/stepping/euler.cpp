@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "sim/stepping/step_sensitivity.hpp"
 #include "sim/stepping/time_stepping_detail.hpp"
 
 namespace lcsim::sim::detail {
@@ -136,6 +137,9 @@ class EulerRun {
     OutputSampler sampler(opt_.dt_out);
     DivergenceGuard guard(model_, x0_user, *opt_.t_end);
     u_ = VectorXd::Zero(k_);
+    if (!opt_.sensitivity.empty())  // the discrete map's derivative (step_sensitivity.hpp)
+      sens_ = std::make_unique<EulerStepSensitivity>(
+          model_, parse_sensitivity(model_, opt_.sensitivity), sys_);
     record(0.0, x, u_);
     xb_.resize(n_);
     q_.resize(k_);
@@ -145,6 +149,8 @@ class EulerRun {
       if (opt_.progress && j % Options::kProgressSteps == 0) opt_.progress(j * grid.h);
       const EulerFactors& f = (last && grid.h_last != grid.h) ? F_last_ : F_;
       if (!step(f, x, (j - 1) * grid.h)) return fail(failure_, x);
+      if (sens_)
+        sens_->step((j - 1) * grid.h, last ? grid.h_last : grid.h, f.Phi, f.PhiB, f.G, x_next_, u_);
       if (std::string why = guard.check(last ? *opt_.t_end : j * grid.h, x_next_, last);
           !why.empty()) {
         tr_.t_end = (j - 1) * grid.h;  // the time reached: the last sane state's
@@ -172,6 +178,7 @@ class EulerRun {
   Trajectory finish(const VectorXd& xa) {
     tr_.final_state = user(xa);
     tr_.energy_final = energy(xa);
+    if (sens_) sens_->finish(tr_);
     return std::move(tr_);  // only ever returned from the run: no copy of the samples
   }
 
@@ -219,6 +226,7 @@ class EulerRun {
     s.y = y;
     for (int i = 0; i < k_; ++i)
       if (uu(i) > 0.0) s.mode.push_back(i);
+    if (sens_) sens_->fill(s.dx, s.dx_exists);
     tr_.record_sample(std::move(s), opt_);
   }
 
@@ -233,7 +241,8 @@ class EulerRun {
   EulerFactors F_, F_last_;
   lcp::Options lopt_;
   VectorXd u_, xb_, q_, x_next_;
-  std::string failure_;  // why step() failed
+  std::string failure_;                         // why step() failed
+  std::unique_ptr<EulerStepSensitivity> sens_;  // Options::sensitivity asked, else null
 };
 
 }  // namespace

@@ -80,6 +80,7 @@
 
 #include "sim/stepping/mj_friction.hpp"
 #include "sim/stepping/step_kernels.hpp"
+#include "sim/stepping/step_sensitivity.hpp"
 #include "sim/stepping/time_stepping_detail.hpp"
 
 namespace lcsim::sim::detail {
@@ -118,7 +119,8 @@ FrictionMode friction_mode_after_step(const mech::FrictionalContact& fc, const V
 class MjRun {
  public:
   MjRun(const mech::Model& model, const VectorXd& x0, const Options& opt)
-      : opt_(opt),
+      : model_(model),
+        opt_(opt),
         m_(*model.mechanical),
         N_(m_.dofs()),
         k_(m_.num_constraints()),
@@ -171,6 +173,9 @@ class MjRun {
     y_ += m_.g;
     if (k_ > 0) tr_.max_violation = std::min(0.0, y_.minCoeff());
     u_ = VectorXd::Zero(k_);
+    if (!opt_.sensitivity.empty())  // the discrete map's derivative (step_sensitivity.hpp)
+      sens_ = std::make_unique<MjStepSensitivity>(
+          model_, parse_sensitivity(model_, opt_.sensitivity), theta_);
     record(0.0);
     pgs_opt_.tolerance = kPgsTolerance;
     pgs_opt_.max_iterations = kPgsMaxSweeps;
@@ -205,6 +210,7 @@ class MjRun {
     tr_.final_state.resize(2 * N_);
     tr_.final_state << q_, v_;
     tr_.energy_final = ops_.energy(q_, v_);
+    if (sens_) sens_->finish(tr_);
     return std::move(tr_);  // only ever returned from the run: no copy of the samples
   }
 
@@ -223,6 +229,7 @@ class MjRun {
     } else if (!A_.empty()) {
       if (!contact_step(f, h, t0)) return false;
     }
+    if (sens_) sens_->step(t0, h, q_, v_, v_next_, A_, z_);
     return advance(j, last, h);
   }
 
@@ -440,9 +447,11 @@ class MjRun {
       s.u_t = u_t_;
       s.friction_mode = fmode_;
     }
+    if (sens_) sens_->fill(s.dx, s.dx_exists);
     tr_.record_sample(std::move(s), opt_);
   }
 
+  const mech::Model& model_;
   const Options& opt_;
   const mech::MechanicalModel& m_;
   const int N_, k_;
@@ -488,8 +497,9 @@ class MjRun {
   long Gd_version_ = 0;
   // v_next_ holds the free velocity v + h W^{-1} rhs until the impulses are added.
   VectorXd rhs_, dv_, v_next_, q_next_, Ev_, Evf_, b_, z_;
-  lcp::Result failed_;   // the failed LCP
-  std::string failure_;  // why the run ends
+  lcp::Result failed_;                       // the failed LCP
+  std::string failure_;                      // why the run ends
+  std::unique_ptr<MjStepSensitivity> sens_;  // Options::sensitivity asked, else null
 };
 
 }  // namespace

@@ -1,0 +1,284 @@
+// The derivative of the time-stepping schemes' discrete map
+// (step_sensitivity.hpp, docs/sensitivities.md "The time-stepping
+// derivative"). Dense linear algebra: the schemes' models here are the small
+// ones (backward Euler is dense already; a Moreau–Jean run asking for it pays
+// one dense factorisation of W per step length and O(N^2 (N + columns)) per
+// step).
+#include "sim/stepping/step_sensitivity.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace lcsim::sim::detail {
+
+namespace {
+
+MatrixXd dense(const Eigen::SparseMatrix<double>& A) { return MatrixXd(A); }
+
+// A row within this fraction of the step's scale in both its multiplier (as
+// a residual: z_a times the Delassus diagonal) and its residual is
+// degenerate: as the exact method's sqrt(eps) test of a degenerate impact.
+const double kDegenerate = std::sqrt(std::numeric_limits<double>::epsilon());
+
+// dM of M[i][j]: the entries (i, j) and (j, i) together (M stays symmetric).
+MatrixXd unit_mass(int N, int i, int j) {
+  MatrixXd dM = MatrixXd::Zero(N, N);
+  dM(i, j) = 1.0;
+  dM(j, i) = 1.0;
+  return dM;
+}
+
+}  // namespace
+
+StepSensitivity::StepSensitivity(const mech::Model& model, const SensColumns& cols)
+    : model_(model), cols_(cols) {
+  nx0_ = cols.x0 ? static_cast<int>(model.state_size()) : 0;
+  m_ = nx0_ + static_cast<int>(cols.params.size());
+  exists_.assign(static_cast<size_t>(m_), 1);
+}
+
+std::vector<std::string> StepSensitivity::column_names() const {
+  std::vector<std::string> out;
+  for (int i = 0; i < nx0_; ++i) out.push_back("x0[" + std::to_string(i) + "]");
+  for (const SensParam& p : cols_.params) out.push_back(p.name);
+  return out;
+}
+
+void StepSensitivity::fill(MatrixXd& dx, std::vector<char>& exists) const {
+  dx = S_.topRows(model_.state_size());
+  for (int c = 0; c < m_; ++c)
+    if (!exists_[static_cast<size_t>(c)]) dx.col(c).setZero();
+  exists = exists_;
+}
+
+void StepSensitivity::finish(Trajectory& tr) const {
+  tr.sensitivity_columns = column_names();
+  fill(tr.dx_final, tr.dx_final_exists);
+  tr.sensitivity_losses = losses_;
+}
+
+bool StepSensitivity::any_exists() const {
+  for (char e : exists_)
+    if (e) return true;
+  return false;
+}
+
+void StepSensitivity::lose_all(double t, int row, const std::string& reason) {
+  if (!any_exists()) return;
+  SensitivityLoss l;
+  l.t = t;
+  l.contact = model_.is_mechanical() ? model_.mechanical->constraints[static_cast<size_t>(row)]
+                                     : "y" + std::to_string(row);
+  l.reason = reason;
+  for (int c = 0; c < m_; ++c)
+    if (exists_[static_cast<size_t>(c)]) {
+      exists_[static_cast<size_t>(c)] = 0;
+      l.columns.push_back(c);
+    }
+  losses_.push_back(std::move(l));
+}
+
+int StepSensitivity::classify(const VectorXd& z, const VectorXd& w, const VectorXd& diag,
+                              double scale, std::vector<int>& active) {
+  active.clear();
+  const double tol = kDegenerate * scale + std::numeric_limits<double>::min();
+  for (int a = 0; a < z.size(); ++a) {
+    if (z(a) * diag(a) > tol)
+      active.push_back(a);
+    else if (w(a) <= tol)
+      return a;
+  }
+  return -1;
+}
+
+// ---- Moreau–Jean ----
+
+MjStepSensitivity::MjStepSensitivity(const mech::Model& model, const SensColumns& cols,
+                                     double theta)
+    : StepSensitivity(model, cols), theta_(theta) {
+  const mech::MechanicalModel& m = *model.mechanical;
+  N_ = m.dofs();
+  M_ = dense(m.M);
+  D_ = dense(m.D);
+  K_ = dense(m.K);
+  E_ = dense(m.E);
+  e_ = m.restitution.size() == m.num_constraints() ? m.restitution
+                                                   : VectorXd::Zero(m.num_constraints());
+  S_ = MatrixXd::Zero(2 * N_, m_);
+  S_.topLeftCorner(nx0_, nx0_).setIdentity();
+}
+
+const Eigen::LLT<MatrixXd>& MjStepSensitivity::factor(double h) {
+  for (int s = 0; s < 2; ++s)
+    if (h_[s] == h) return llt_[s];
+  const int s = h_[0] < 0.0 ? 0 : 1;  // the grid's step, then its last one
+  h_[s] = h;
+  llt_[s].compute(M_ + h * theta_ * D_ + h * h * theta_ * theta_ * K_);
+  return llt_[s];
+}
+
+void MjStepSensitivity::parameter_terms(double h, const VectorXd& q, const VectorXd& v,
+                                        const VectorXd& v_next, MatrixXd& R) const {
+  const VectorXd qt = q + h * theta_ * v, dv = v_next - v;
+  const double ht = h * theta_;
+  for (size_t p = 0; p < cols_.params.size(); ++p) {
+    const SensParam& sp = cols_.params[p];
+    auto col = R.col(nx0_ + static_cast<int>(p));
+    switch (sp.kind) {
+      case 'f':
+        col(sp.i) += h;
+        break;
+      case 'K':
+        col(sp.i) -= h * qt(sp.j) + ht * ht * dv(sp.j);
+        break;
+      case 'D':
+        col(sp.i) -= h * v(sp.j) + ht * dv(sp.j);
+        break;
+      case 'M':
+        col -= unit_mass(N_, sp.i, sp.j) * dv;
+        break;
+      default:
+        break;  // 'e' enters the active rows' equation
+    }
+  }
+}
+
+void MjStepSensitivity::step(double t0, double h, const VectorXd& q, const VectorXd& v,
+                             const VectorXd& v_next, const IndexSet& A, const VectorXd& z) {
+  if (!any_exists()) return;
+  const Eigen::LLT<MatrixXd>& W = factor(h);
+  const auto dQ = S_.topRows(N_);
+  const auto dV = S_.bottomRows(N_);
+  // W dv+ = W dv + h drhs - dW (v+ - v) + E_S' dz_S.
+  MatrixXd R = M_ * dV - h * (D_ * dV + K_ * (dQ + h * theta_ * dV)) + h * theta_ * D_ * dV +
+               h * h * theta_ * theta_ * K_ * dV;
+  parameter_terms(h, q, v, v_next, R);
+  MatrixXd dVn = W.solve(R);
+  if (!A.empty()) {
+    const int na = static_cast<int>(A.size());
+    MatrixXd EA(na, N_);
+    for (int a = 0; a < na; ++a) EA.row(a) = E_.row(A[static_cast<size_t>(a)]);
+    const MatrixXd Y = W.solve(EA.transpose());
+    const MatrixXd G = EA * Y;
+    const VectorXd Ev = EA * v, Evn = EA * v_next;
+    VectorXd w(na);
+    for (int a = 0; a < na; ++a) w(a) = Evn(a) + e_(A[static_cast<size_t>(a)]) * Ev(a);
+    const double scale = std::max({Ev.cwiseAbs().maxCoeff(), Evn.cwiseAbs().maxCoeff(),
+                                   (G.diagonal().cwiseProduct(z)).cwiseAbs().maxCoeff()});
+    std::vector<int> act;
+    if (const int bad = classify(z, w, G.diagonal(), scale, act); bad >= 0) {
+      lose_all(t0, A[static_cast<size_t>(bad)],
+               "degenerate step LCP (moreau-jean): zero impulse and zero velocity");
+      return;
+    }
+    if (!act.empty()) {
+      const int ns = static_cast<int>(act.size());
+      MatrixXd GS(ns, ns), rhs(ns, m_);
+      MatrixXd YS(N_, ns);
+      for (int a = 0; a < ns; ++a) {
+        const int r = A[static_cast<size_t>(act[a])];
+        YS.col(a) = Y.col(act[a]);
+        for (int b = 0; b < ns; ++b) GS(a, b) = G(act[a], act[b]);
+        // E_S dv+ = -e_S (E_S dv) - de_S (E_S v)
+        rhs.row(a) = -e_(r) * (E_.row(r) * dV) - E_.row(r) * dVn;
+        for (size_t p = 0; p < cols_.params.size(); ++p)
+          if (cols_.params[p].kind == 'e' && cols_.params[p].i == r)
+            rhs(a, nx0_ + static_cast<int>(p)) -= Ev(act[a]);
+      }
+      dVn += YS * GS.ldlt().solve(rhs);
+    }
+  }
+  const MatrixXd dQn = dQ + h * ((1.0 - theta_) * dV + theta_ * dVn);
+  S_.topRows(N_) = dQn;
+  S_.bottomRows(N_) = dVn;
+}
+
+// ---- backward Euler ----
+
+EulerStepSensitivity::EulerStepSensitivity(const mech::Model& model, const SensColumns& cols,
+                                           const lcs::Lcs& sys)
+    : StepSensitivity(model, cols), sys_(sys), n_(sys.n()), nu_(sys.k()) {
+  Sa_ = MatrixXd::Zero(n_, m_);
+  Sa_.topLeftCorner(nx0_, nx0_).setIdentity();
+  S_ = Sa_;
+  const size_t P = cols_.params.size();
+  dA_.assign(P, MatrixXd());
+  dB_.assign(P, MatrixXd());
+  dC_.assign(P, MatrixXd());
+  if (!model.is_mechanical()) return;
+  const mech::MechanicalModel& m = *model.mechanical;
+  const int N = m.dofs();
+  const MatrixXd G = dense(m.M).inverse();
+  for (size_t p = 0; p < P; ++p) {
+    const SensParam& sp = cols_.params[p];
+    MatrixXd dA = MatrixXd::Zero(n_, n_), dB = MatrixXd::Zero(n_, nu_),
+             dC = MatrixXd::Zero(nu_, n_);
+    switch (sp.kind) {  // A = [0 I 0; -GK -GD Gf; 0 0 0], B = [0; GE'; 0], C = [E 0 g]
+      case 'f':
+        dA.block(N, 2 * N, N, 1) = G.col(sp.i);
+        break;
+      case 'K':
+        dA.block(N, sp.j, N, 1) = -G.col(sp.i);
+        break;
+      case 'D':
+        dA.block(N, N + sp.j, N, 1) = -G.col(sp.i);
+        break;
+      case 'g':
+        dC(sp.i, 2 * N) = 1.0;
+        break;
+      case 'M': {
+        const MatrixXd dG = -G * unit_mass(N, sp.i, sp.j) * G;
+        dA.block(N, 0, N, N) = -dG * dense(m.K);
+        dA.block(N, N, N, N) = -dG * dense(m.D);
+        dA.block(N, 2 * N, N, 1) = dG * m.f;
+        dB.block(N, 0, N, nu_) = dG * dense(m.E).transpose();
+        break;
+      }
+      default:
+        break;  // 'e' is refused (check_sensitivity)
+    }
+    dA_[p] = dA;
+    dB_[p] = dB;
+    dC_[p] = dC;
+  }
+}
+
+void EulerStepSensitivity::step(double t0, double h, const MatrixXd& Phi, const MatrixXd& PhiB,
+                                const MatrixXd& G, const VectorXd& x_next, const VectorXd& u) {
+  if (!any_exists()) return;
+  // (I - hA) dx+ = dx + h dA x+ + h dB u + h B du.
+  MatrixXd R = Sa_;
+  for (size_t p = 0; p < dA_.size(); ++p) {
+    if (dA_[p].size() == 0) continue;
+    R.col(nx0_ + static_cast<int>(p)) += h * (dA_[p] * x_next + dB_[p] * u);
+  }
+  Sa_ = Phi * R;
+  if (nu_ > 0) {
+    const VectorXd w = sys_.C * x_next + sys_.D * u;
+    const VectorXd q = w - G * u;  // the step's LCP vector C (I - hA)^{-1} x
+    const double scale =
+        std::max(q.cwiseAbs().maxCoeff(), (G.diagonal().cwiseProduct(u)).cwiseAbs().maxCoeff());
+    std::vector<int> act;
+    if (const int bad = classify(u, w, G.diagonal(), scale, act); bad >= 0) {
+      lose_all(t0, bad, "degenerate step LCP (euler): zero multiplier and zero output");
+      S_ = Sa_;
+      return;
+    }
+    if (!act.empty()) {  // G_SS du_S = -(C_S dx+ + dC_S x+) with dx+ before du
+      const int ns = static_cast<int>(act.size());
+      MatrixXd GS(ns, ns), rhs(ns, m_), PS(n_, ns);
+      for (int a = 0; a < ns; ++a) {
+        PS.col(a) = PhiB.col(act[a]);
+        for (int b = 0; b < ns; ++b) GS(a, b) = G(act[a], act[b]);
+        rhs.row(a) = -sys_.C.row(act[a]) * Sa_;
+        for (size_t p = 0; p < dC_.size(); ++p)
+          if (dC_[p].size() > 0)
+            rhs(a, nx0_ + static_cast<int>(p)) -= dC_[p].row(act[a]).dot(x_next);
+      }
+      Sa_ += PS * GS.fullPivLu().solve(rhs);
+    }
+  }
+  S_ = Sa_;
+}
+
+}  // namespace lcsim::sim::detail

@@ -1,0 +1,97 @@
+// Private to src/sim: the derivative of the time-stepping schemes' discrete
+// map (docs/sensitivities.md, "The time-stepping derivative"): for
+// Moreau–Jean and backward Euler, dx_j/dtheta carried from step to step by
+// the implicit function theorem on each step's LCP at its active set, as a
+// differentiable time-stepping simulator computes it. Strictly active rows
+// (positive multiplier) are equalities, inactive rows (positive gap or
+// velocity) are dropped; a degenerate row (both zero) ends every column: the
+// step map has no derivative there.
+#pragma once
+
+#include <Eigen/Dense>
+#include <lcsim/sim/sim.hpp>
+#include <string>
+#include <vector>
+
+#include "sim/exact/sensitivity.hpp"
+
+namespace lcsim::sim::detail {
+
+// The columns, S = dx/dtheta on the user's state (rows as x) and the losses,
+// shared by both schemes.
+class StepSensitivity {
+ public:
+  StepSensitivity(const mech::Model& model, const SensColumns& cols);
+  std::vector<std::string> column_names() const;
+  // A sample's or the final dx and its flags.
+  void fill(MatrixXd& dx, std::vector<char>& exists) const;
+  const std::vector<SensitivityLoss>& losses() const { return losses_; }
+  // Writes the columns, the final derivative and the losses into tr.
+  void finish(Trajectory& tr) const;
+
+ protected:
+  // The rows of a step's LCP: -1 when row r is degenerate (multiplier and
+  // residual both within sqrt(eps) of `scale`), else the strictly active
+  // positions (z_a * diag_a > the threshold) in `active`.
+  static int classify(const VectorXd& z, const VectorXd& w, const VectorXd& diag, double scale,
+                      std::vector<int>& active);
+  // Every column absent from t on (once), naming constraint `row`.
+  void lose_all(double t, int row, const std::string& reason);
+  bool any_exists() const;
+
+  const mech::Model& model_;
+  SensColumns cols_;
+  int nx0_ = 0, m_ = 0;
+  MatrixXd S_;  // dx/dtheta: state rows (the scheme's), m_ columns
+  std::vector<char> exists_;
+  std::vector<SensitivityLoss> losses_;
+};
+
+// Moreau–Jean: W (v+ - v) = h (f - D v - K (q + h theta v)) + E_A' z,
+// q+ = q + h ((1 - theta) v + theta v+), E_S v+ + e_S . E_S v = 0 on the
+// strictly active rows S. Columns x0, f, K, D, M, e (g is refused: the map
+// depends on it only through the active set).
+class MjStepSensitivity : public StepSensitivity {
+ public:
+  MjStepSensitivity(const mech::Model& model, const SensColumns& cols, double theta);
+  // The step of length h starting at t0 from (q, v) to v_next with the
+  // impulses z on the active set A.
+  void step(double t0, double h, const VectorXd& q, const VectorXd& v, const VectorXd& v_next,
+            const IndexSet& A, const VectorXd& z);
+
+ private:
+  const Eigen::LLT<MatrixXd>& factor(double h);
+  // The parameters' part of W dv+ (before the impulses): h (df - dD v -
+  // dK (q + h theta v)) - dW (v+ - v) for each parameter column.
+  void parameter_terms(double h, const VectorXd& q, const VectorXd& v, const VectorXd& v_next,
+                       MatrixXd& R) const;
+
+  double theta_;
+  int N_ = 0;
+  MatrixXd M_, D_, K_, E_;
+  VectorXd e_;
+  double h_[2] = {-1.0, -1.0};
+  Eigen::LLT<MatrixXd> llt_[2];
+};
+
+// Backward Euler on the LCS (A, B, C, D) (augmented for a mechanical model):
+// (I - hA) x+ = x + h B u, w = C x+ + D u, w_S = 0 on the strictly active
+// rows. Columns x0, and for a mechanical model f, g, K, D, M (e is refused:
+// the scheme ignores restitution).
+class EulerStepSensitivity : public StepSensitivity {
+ public:
+  EulerStepSensitivity(const mech::Model& model, const SensColumns& cols, const lcs::Lcs& sys);
+  // The step of length h starting at t0 to x_next (augmented) with the
+  // multipliers u; Phi = (I - hA)^{-1}, PhiB = h Phi B, G = D + C PhiB.
+  void step(double t0, double h, const MatrixXd& Phi, const MatrixXd& PhiB, const MatrixXd& G,
+            const VectorXd& x_next, const VectorXd& u);
+
+ private:
+  const lcs::Lcs& sys_;
+  int n_ = 0, nu_ = 0;
+  MatrixXd Sa_;  // S on the augmented state (its last row zero)
+  // dA, dB, dC of each parameter column (mechanical models).
+  std::vector<MatrixXd> dA_, dB_, dC_;
+};
+
+}  // namespace lcsim::sim::detail
