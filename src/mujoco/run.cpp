@@ -285,7 +285,7 @@ struct Recorder {
 
 }  // namespace
 
-// One piece: the step loop's stages (forces, mj_step, read back, record,
+// It is one piece: the step loop's stages (forces, mj_step, read back, record,
 // divergence) share the run's state and read in order.
 sim::Trajectory simulate_mujoco(const mech::Model& model, const VectorXd& x0,
                                 const sim::Options& options, const Settings& s) {
