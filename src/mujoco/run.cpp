@@ -283,7 +283,33 @@ struct Recorder {
   }
 };
 
+// check_expressible (throws), then the scene's MuJoCo model set up and
+// mapped; std::invalid_argument when MuJoCo cannot load it.
+void prepare(Run& r, const mech::Model& model, const Settings& s, double h) {
+  check_expressible(model);
+  const std::optional<scene::Scene> setup = scene::load_scene_details(model.source);
+  r.m = load_scene_model(*setup);
+  configure(r, *setup, s, h);
+  map_coordinates(r, *setup, *model.mechanical);
+}
+
 }  // namespace
+
+double mj_step_time(const mech::Model& model, const VectorXd& x0, double h, long steps,
+                    const Settings& s) {
+  mju_user_warning = [](const char*) {};
+  Run r;
+  prepare(r, model, s, h);
+  r.d = MjDataPtr(mj_makeData(r.m.get()));
+  const int N = model.mechanical->dofs();
+  const VectorXd q = x0.head(N), v = x0.tail(N);
+  set_state(r, q, v);
+  apply_forces(r, q, r.f_s - r.K_s * q - r.D * v);
+  const auto t0 = std::chrono::steady_clock::now();
+  for (long j = 0; j < steps; ++j) mj_step(r.m.get(), r.d.get());
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return wall / static_cast<double>(std::max(1L, steps));
+}
 
 // It is one piece: the step loop's stages (forces, mj_step, read back, record,
 // divergence) share the run's state and read in order.
@@ -308,14 +334,10 @@ sim::Trajectory simulate_mujoco(const mech::Model& model, const VectorXd& x0,
   // mjData::warning (a bad acceleration ends it as a numerical failure).
   mju_user_warning = [](const char*) {};
   const auto wall0 = std::chrono::steady_clock::now();
-  check_expressible(model);  // std::invalid_argument: the caller's input
-  const std::optional<scene::Scene> setup = scene::load_scene_details(model.source);
   const mech::MechanicalModel& mm = *model.mechanical;
   Run r;
   try {
-    r.m = load_scene_model(*setup);
-    configure(r, *setup, s, opt.h);
-    map_coordinates(r, *setup, mm);
+    prepare(r, model, s, opt.h);
   } catch (const std::invalid_argument& e) {
     tr.status = sim::RunStatus::kInvalidInput;
     tr.message = e.what();

@@ -61,6 +61,13 @@ void check_expressible(const mech::Model& model);
 sim::Trajectory simulate_mujoco(const mech::Model& model, const Eigen::VectorXd& x0,
                                 const sim::Options& opt, const Settings& s = {});
 
+// For bench/: the wall time of one mj_step (s), the mean over `steps` steps
+// of the scene's MuJoCo model (as simulate_mujoco sets it up) from x0 at
+// step h, the scene's forces at x0 applied throughout; nothing else timed.
+// Throws as check_expressible.
+double mj_step_time(const mech::Model& model, const Eigen::VectorXd& x0, double h, long steps,
+                    const Settings& s = {});
+
 // Adds the "mujoco" integrator to sim::integrators(). Called by the
 // registration source compiled into every program linking lcsim::mujoco.
 void register_backends();
