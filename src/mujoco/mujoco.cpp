@@ -33,6 +33,7 @@
 #include <lcsim/mujoco/mujoco.hpp>
 #include <lcsim/scene/scene.hpp>
 #include <optional>
+#include <regex>
 #include <stdexcept>
 
 #include "mujoco/detail.hpp"
@@ -112,7 +113,7 @@ std::string refusal(const mech::Model& model, std::optional<scene::Scene>& sc) {
       return where + "constraint '" + m.constraints[static_cast<std::size_t>(i)] +
              "' is not a contact against a plane: MuJoCo runs contacts only";
   for (const auto& cf : sc->contacts)
-    if (cf.point.name.find(".point") != std::string::npos)
+    if (std::regex_search(cf.point.name, std::regex("\\.point[0-9]+$")))
       return where + "contact '" + cf.point.name +
              "' has explicit points: MuJoCo collides the URDF's <collision> geometry only";
   if (!sc->base.floating && !sc->base.pose.isApprox(Eigen::Isometry3d::Identity(), 0.0))
