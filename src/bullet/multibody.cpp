@@ -107,6 +107,10 @@ struct Tree {
   std::map<std::string, btTransform> X;
   std::map<std::string, int> owner;  // link -> Bullet link index (-1: base)
   std::vector<Body> bodies;
+  // The root link and every link frozen to it: Bullet's base. Its mass and
+  // frame matter only for a floating base (merge_base); a fixed base's frame
+  // is the root link's (com_frame stays the identity).
+  Body base;
 };
 
 Tree cut_into_bodies(const urdf::ModelInterface& model, const std::vector<std::string>& joints,
@@ -132,6 +136,7 @@ Tree cut_into_bodies(const urdf::ModelInterface& model, const std::vector<std::s
   };
   t.X[model.getRoot()->name] = btTransform::getIdentity();
   walk(*model.getRoot(), -1);
+  t.base.com_frame = btTransform::getIdentity();
   if (t.bodies.size() != joints.size())
     throw std::invalid_argument("bullet: a simulated joint is not in the URDF tree");
   return t;
@@ -150,6 +155,27 @@ void merge_masses(const urdf::ModelInterface& model, Tree& t) {
   give_massless_bodies_a_speck(model, t.X, t.bodies);
 }
 
+// Adds a link's inertia (its <inertial> at world pose Xi) to body b, about
+// b's centre of mass (parallel-axis theorem).
+void add_inertia(Body& b, const btTransform& Xi, const urdf::Inertial& in) {
+  const btMatrix3x3 I(in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz);
+  const btMatrix3x3& R = Xi.getBasis();
+  const btVector3 d = Xi.getOrigin() - b.com;
+  const btMatrix3x3 parallel(d.dot(d) - d.x() * d.x(), -d.x() * d.y(), -d.x() * d.z(),
+                             -d.y() * d.x(), d.dot(d) - d.y() * d.y(), -d.y() * d.z(),
+                             -d.z() * d.x(), -d.z() * d.y(), d.dot(d) - d.z() * d.z());
+  b.inertia = b.inertia + R * I * R.transpose() + parallel * in.mass;
+}
+
+// b's principal moments and its frame at the centre of mass in principal axes.
+void principal_frame(Body& b) {
+  btMatrix3x3 rot;
+  btMatrix3x3 diag = b.inertia;
+  diag.diagonalize(rot, 1e-15, 200);  // inertia = rot * diag * rot^T
+  b.principal = btVector3(diag[0][0], diag[1][1], diag[2][2]);
+  b.com_frame = btTransform(rot, b.com);
+}
+
 // Each body's inertia about its centre of mass (parallel-axis theorem), then
 // its principal axes.
 void merge_inertias(const urdf::ModelInterface& model, Tree& t) {
@@ -158,25 +184,35 @@ void merge_inertias(const urdf::ModelInterface& model, Tree& t) {
     const auto link = model.getLink(name);
     if (own < 0 || !link->inertial) continue;
     Body& b = t.bodies[static_cast<std::size_t>(own)];
-    const urdf::Inertial& in = *link->inertial;
-    const btTransform Xi = t.X[name] * to_bt(in.origin);
-    const btMatrix3x3 I(in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz);
-    const btMatrix3x3& R = Xi.getBasis();
-    const btVector3 d = Xi.getOrigin() - b.com;
-    const btMatrix3x3 parallel(d.dot(d) - d.x() * d.x(), -d.x() * d.y(), -d.x() * d.z(),
-                               -d.y() * d.x(), d.dot(d) - d.y() * d.y(), -d.y() * d.z(),
-                               -d.z() * d.x(), -d.z() * d.y(), d.dot(d) - d.z() * d.z());
-    b.inertia = b.inertia + R * I * R.transpose() + parallel * in.mass;
+    add_inertia(b, t.X[name] * to_bt(link->inertial->origin), *link->inertial);
   }
   for (auto& b : t.bodies)
     if (b.speck > 0.0) b.inertia = b.inertia + btMatrix3x3::getIdentity() * b.speck;
-  for (auto& b : t.bodies) {
-    btMatrix3x3 rot;
-    btMatrix3x3 diag = b.inertia;
-    diag.diagonalize(rot, 1e-15, 200);  // inertia = rot * diag * rot^T
-    b.principal = btVector3(diag[0][0], diag[1][1], diag[2][2]);
-    b.com_frame = btTransform(rot, b.com);
+  for (auto& b : t.bodies) principal_frame(b);
+}
+
+// A floating base: the root link and every link frozen to it, one rigid
+// body at its centre of mass in principal axes (Bullet's base frame).
+// std::invalid_argument when it has no mass.
+void merge_base(const urdf::ModelInterface& model, Tree& t) {
+  Body& b = t.base;
+  b.inertia.setValue(0, 0, 0, 0, 0, 0, 0, 0, 0);
+  for (const auto& [name, own] : t.owner) {
+    const auto link = model.getLink(name);
+    if (own >= 0 || !link->inertial) continue;
+    b.com += link->inertial->mass * (t.X[name] * to_bt(link->inertial->origin)).getOrigin();
+    b.mass += link->inertial->mass;
   }
+  if (!(b.mass > 0.0))
+    throw std::invalid_argument("bullet: the floating base's root link '" + model.getRoot()->name +
+                                "' (with every link fixed or frozen to it) has no mass");
+  b.com /= b.mass;
+  for (const auto& [name, own] : t.owner) {
+    const auto link = model.getLink(name);
+    if (own >= 0 || !link->inertial) continue;
+    add_inertia(b, t.X[name] * to_bt(link->inertial->origin), *link->inertial);
+  }
+  principal_frame(b);
 }
 
 // Bullet link i: body i on its joint (prismatic, else revolute), in its
@@ -184,9 +220,8 @@ void merge_inertias(const urdf::ModelInterface& model, Tree& t) {
 void set_up_link(const urdf::ModelInterface& model, Tree& t, int i, btMultiBody& mb) {
   const Body& b = t.bodies[static_cast<std::size_t>(i)];
   const auto j = model.getJoint(b.joint);
-  const btTransform parent_frame = b.parent < 0
-                                       ? btTransform::getIdentity()
-                                       : t.bodies[static_cast<std::size_t>(b.parent)].com_frame;
+  const btTransform parent_frame =
+      b.parent < 0 ? t.base.com_frame : t.bodies[static_cast<std::size_t>(b.parent)].com_frame;
   const btMatrix3x3& Rp = parent_frame.getBasis();
   const btMatrix3x3& Rc = b.com_frame.getBasis();
   const btTransform& Xj = t.X[j->child_link_name];  // joint frame at q = 0
@@ -206,19 +241,48 @@ void set_up_link(const urdf::ModelInterface& model, Tree& t, int i, btMultiBody&
 
 }  // namespace
 
+namespace {
+
+btTransform to_bt(const Eigen::Isometry3d& X) {
+  const Eigen::Matrix3d R = X.linear();
+  return btTransform(
+      btMatrix3x3(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2)),
+      btVector3(X.translation().x(), X.translation().y(), X.translation().z()));
+}
+
+// Where each URDF link sits in its Bullet body's frame.
+void record_links(const Tree& t, UrdfMultiBody& out) {
+  for (const auto& [name, own] : t.owner) {
+    const btTransform& body =
+        own < 0 ? t.base.com_frame : t.bodies[static_cast<std::size_t>(own)].com_frame;
+    out.owner[name] = own;
+    out.link_in_body[name] = body.inverse() * t.X.at(name);
+  }
+}
+
+}  // namespace
+
 UrdfMultiBody build_urdf_multibody(const urdf::ModelInterface& model,
                                    const std::vector<std::string>& joints,
-                                   const std::map<std::string, double>& q0) {
+                                   const std::map<std::string, double>& q0,
+                                   const scene::BasePose& base) {
   Tree t = cut_into_bodies(model, joints, q0);
   merge_masses(model, t);
   merge_inertias(model, t);
+  if (base.floating) merge_base(model, t);
 
   const int n = static_cast<int>(t.bodies.size());
   UrdfMultiBody out;
-  out.body = std::make_unique<btMultiBody>(n, 1.0, btVector3(1, 1, 1), /*fixedBase=*/true,
-                                           /*canSleep=*/false);
+  if (base.floating)
+    out.body = std::make_unique<btMultiBody>(n, t.base.mass, t.base.principal, /*fixedBase=*/false,
+                                             /*canSleep=*/false);
+  else
+    out.body = std::make_unique<btMultiBody>(n, 1.0, btVector3(1, 1, 1), /*fixedBase=*/true,
+                                             /*canSleep=*/false);
   btMultiBody& mb = *out.body;
-  mb.setBaseWorldTransform(btTransform::getIdentity());
+  out.root_to_base = t.base.com_frame;
+  mb.setBaseWorldTransform(to_bt(base.pose) * out.root_to_base);
+  record_links(t, out);
   for (int i = 0; i < n; ++i) set_up_link(model, t, i, mb);
   mb.finalizeMultiDof();
   // Pitfall (shared/notes/bullet.md): default damping 0.04.

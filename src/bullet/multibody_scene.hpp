@@ -6,6 +6,8 @@
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
 #include <lcsim/scene/scene.hpp>
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -21,18 +23,79 @@ struct JointLimit {
   bool lower = true;
 };
 
-// One JointLimit per row of E; std::invalid_argument naming the file
-// `source` (the scene's path; omitted when empty) and the first row that
-// involves more or fewer than one coordinate (0-based).
-std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m, const std::string& source);
+// One JointLimit per row of E that is not one of setup's contacts;
+// std::invalid_argument naming the file `source` (the scene's path; omitted
+// when empty) and the first row that involves more or fewer than one
+// coordinate (0-based), or a floating base's coordinate.
+std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m, const std::string& source,
+                                        const scene::Scene* setup = nullptr);
 
 // "btMultiBody from the URDF, btMultiBodyConstraintSolver (100 iterations), ..."
-std::string multibody_description(const WorldSettings& s);
+// With `contacts`, the contact settings too.
+std::string multibody_description(const WorldSettings& s, bool contacts = false);
 
 // The scene run as a btMultiBody (multibody_world.cpp); `limits` from
 // joint_limits_of. Never throws.
 sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene& setup,
                                    const std::vector<JointLimit>& limits, const Eigen::VectorXd& x0,
                                    const sim::Options& opt, const WorldSettings& s);
+
+}  // namespace lcsim::bullet
+
+// ---- Floating bases and contacts (multibody_contacts.cpp) ----
+
+#include <BulletCollision/CollisionDispatch/btCollisionDispatcher.h>
+#include <BulletCollision/CollisionDispatch/btCollisionObject.h>
+#include <BulletCollision/CollisionShapes/btCollisionShape.h>
+
+#include "bullet/urdf_multibody.hpp"
+
+namespace lcsim::bullet {
+
+// A floating base's six coordinates (docs/contacts.md: the root origin p and
+// a rotation vector r, orientation exp([r]x) R0) and their rates, set on and
+// read from Bullet's base (its centre of mass, world-frame velocity and
+// angular velocity omega = J_l(r) r').
+void set_floating_base(btMultiBody& b, const UrdfMultiBody& mb, const scene::BasePose& base,
+                       const Eigen::Matrix<double, 6, 1>& q, const Eigen::Matrix<double, 6, 1>& v);
+void get_floating_base(const btMultiBody& b, const UrdfMultiBody& mb, const scene::BasePose& base,
+                       Eigen::Ref<Eigen::VectorXd> q, Eigen::Ref<Eigen::VectorXd> v);
+// The generalised force Q on the six coordinates applied to Bullet's base:
+// the force Q_p at the root origin and the torque J_l(r)^-T Q_r (so that
+// their virtual work is Q . dq).
+void add_floating_base_force(btMultiBody& b, const UrdfMultiBody& mb, const scene::BasePose& base,
+                             const Eigen::Matrix<double, 6, 1>& q,
+                             const Eigen::Matrix<double, 6, 1>& Q);
+
+// The scene's contact points as Bullet colliders: per Bullet link (the base
+// is -1) one btCompoundShape of spheres, one per contact point at its place
+// in that link's frame with the point's radius (a box corner: radius 0, a
+// point), and one btStaticPlaneShape object per plane. Links collide only
+// with planes (and not with each other).
+struct ContactColliders {
+  std::vector<std::unique_ptr<btCollisionShape>> shapes;
+  std::map<int, btCollisionShape*> shape_of;  // Bullet link -> its compound
+  std::vector<std::unique_ptr<btCollisionObject>> planes;
+  std::map<std::pair<int, int>, int> row_of;  // (Bullet link, compound child) -> row of E
+  std::map<int, double> restitution_of;       // Bullet link -> the largest e of its points
+  int rows = 0;                               // contact rows
+};
+// Collision filter groups of links with contacts and of planes.
+constexpr int kContactLinkGroup = 1 << 6, kPlaneGroup = 1 << 7;
+// The colliders of setup.contacts (restitution: the largest of a link's
+// points, Bullet's product with the planes' 1; friction 0). Throws
+// std::invalid_argument naming the contact whose link Bullet does not hold.
+ContactColliders make_contact_colliders(const scene::Scene& setup, const UrdfMultiBody& mb,
+                                        const mech::MechanicalModel& m);
+// Adds the step's normal impulses of every contact point (N s) to `impulse`
+// (size k, by row of E), from the dispatcher's manifolds.
+void contact_impulses(btCollisionDispatcher& d, const ContactColliders& c,
+                      Eigen::VectorXd& impulse);
+
+// A btCollisionDispatcher whose manifolds keep points up to `threshold` (m)
+// apart (Bullet's default is 0.02 times the shapes' bounding radius): a
+// point within it is a speculative contact row of the solver.
+std::unique_ptr<btCollisionDispatcher> make_dispatcher(btCollisionConfiguration* config,
+                                                       double threshold);
 
 }  // namespace lcsim::bullet

@@ -92,13 +92,17 @@ std::vector<FollowingMimic> following_mimics(const scene::Scene& setup,
 // colliders -> multibody -> world -> solvers.
 struct MbWorld {
   std::unique_ptr<btDefaultCollisionConfiguration> config;
-  std::unique_ptr<btCollisionDispatcher> dispatcher;
+  std::unique_ptr<btCollisionDispatcher> dispatcher;  // make_dispatcher's with contacts
   std::unique_ptr<btDbvtBroadphase> broadphase;
   std::unique_ptr<btDantzigSolver> dantzig;
   std::unique_ptr<btMultiBodyConstraintSolver> solver;
   std::unique_ptr<btMultiBodyDynamicsWorld> world;
   std::unique_ptr<btSphereShape> shape;
   UrdfMultiBody mb;
+  int nb = 0;                 // the floating base's coordinates (6), first in q; else 0
+  scene::BasePose base;       // the scene's
+  ContactColliders contacts;  // shapes outlive the colliders below
+  std::unique_ptr<btMultiBodyLinkCollider> base_collider;
   std::vector<std::unique_ptr<btMultiBodyLinkCollider>> colliders;
   std::vector<std::unique_ptr<btMultiBodyJointLimitConstraint>> limits;
   std::vector<FollowingMimic> mimics;
@@ -107,19 +111,25 @@ struct MbWorld {
     for (auto& c : gears) world->removeMultiBodyConstraint(c.get());
     for (auto& c : limits) world->removeMultiBodyConstraint(c.get());
     for (auto& c : colliders) world->removeCollisionObject(c.get());
+    if (base_collider) world->removeCollisionObject(base_collider.get());
+    for (auto& p : contacts.planes) world->removeCollisionObject(p.get());
     if (mb.body) world->removeMultiBody(mb.body.get());
   }
 };
 
-void set_state(btMultiBody& b, const UrdfMultiBody& mb, const std::vector<FollowingMimic>& mimics,
-               const VectorXd& q, const VectorXd& v) {
-  for (int c = 0; c < q.size(); ++c) {
-    b.setJointPos(mb.link[static_cast<std::size_t>(c)], q(c));
-    b.setJointVel(mb.link[static_cast<std::size_t>(c)], v(c));
+// The Bullet link of coordinate c (a joint: c >= w.nb).
+int link_of(const MbWorld& w, int c) { return w.mb.link[static_cast<std::size_t>(c - w.nb)]; }
+
+void set_state(MbWorld& w, const VectorXd& q, const VectorXd& v) {
+  btMultiBody& b = *w.mb.body;
+  if (w.nb > 0) set_floating_base(b, w.mb, w.base, q.head<6>(), v.head<6>());
+  for (int c = w.nb; c < q.size(); ++c) {
+    b.setJointPos(link_of(w, c), q(c));
+    b.setJointVel(link_of(w, c), v(c));
   }
-  for (const FollowingMimic& f : mimics) {
-    b.setJointPos(f.link, f.a * q(f.leader) + f.b);
-    b.setJointVel(f.link, f.a * v(f.leader));
+  for (const FollowingMimic& f : w.mimics) {
+    b.setJointPos(f.link, f.a * q(w.nb + f.leader) + f.b);
+    b.setJointVel(f.link, f.a * v(w.nb + f.leader));
   }
   btAlignedObjectArray<btQuaternion> world_to_local;
   btAlignedObjectArray<btVector3> local_origin;
@@ -134,7 +144,10 @@ void set_state(btMultiBody& b, const UrdfMultiBody& mb, const std::vector<Follow
 std::unique_ptr<MbWorld> make_world(const scene::Scene& setup, const WorldSettings& s) {
   auto w = std::make_unique<MbWorld>();
   w->config = std::make_unique<btDefaultCollisionConfiguration>();
-  w->dispatcher = std::make_unique<btCollisionDispatcher>(w->config.get());
+  if (setup.contacts.empty())
+    w->dispatcher = std::make_unique<btCollisionDispatcher>(w->config.get());
+  else
+    w->dispatcher = make_dispatcher(w->config.get(), s.contact_threshold);
   w->broadphase = std::make_unique<btDbvtBroadphase>();
   if (s.multibody_mlcp) {
     w->dantzig = std::make_unique<btDantzigSolver>();
@@ -153,19 +166,48 @@ std::unique_ptr<MbWorld> make_world(const scene::Scene& setup, const WorldSettin
   info.m_sor = 1.0;
   info.m_splitImpulse = 0;
   info.m_leastSquaresResidualThreshold = 0.0;
+  info.m_linearSlop = 0.0;  // Bullet's default; contacts: penetration = distance + slop
   info.m_solverMode = SOLVER_USE_WARMSTARTING | SOLVER_SIMD;  // no articulated warm start
   return w;
 }
 
+// The collider of Bullet link `link` (-1: the base): its contact points'
+// compound colliding with the planes, or (a link without contacts) a sphere
+// that collides with nothing, there only because a joint limit on a link
+// without a collider is ignored.
+std::unique_ptr<btMultiBodyLinkCollider> make_collider(MbWorld& w, int link) {
+  btMultiBody& b = *w.mb.body;
+  auto col = std::make_unique<btMultiBodyLinkCollider>(&b, link);
+  col->setActivationState(DISABLE_DEACTIVATION);
+  const auto contact = w.contacts.shape_of.find(link);
+  if (contact == w.contacts.shape_of.end()) {
+    col->setCollisionShape(w.shape.get());
+    // Mask 0: the broadphase pairs this collider with nothing.
+    w.world->addCollisionObject(col.get(), btBroadphaseProxy::DefaultFilter, 0);
+    return col;
+  }
+  col->setCollisionShape(contact->second);
+  col->setRestitution(w.contacts.restitution_of.at(link));
+  col->setFriction(0.0);
+  col->setRollingFriction(0.0);
+  col->setSpinningFriction(0.0);
+  w.world->addCollisionObject(col.get(), kContactLinkGroup, kPlaneGroup);
+  return col;
+}
+
 // The multibody of the scene's URDF (the coordinates' joints, then their
-// mimics), each link with a collider that collides with nothing.
+// mimics; a floating base's six coordinates are Bullet's base), each link
+// with a collider, the planes.
 void add_multibody(MbWorld& w, const scene::Scene& setup, const mech::MechanicalModel& m) {
-  w.mimics = following_mimics(setup, m.coordinates);
-  std::vector<std::string> moving = m.coordinates;
+  w.base = setup.base;
+  w.nb = setup.base.floating ? 6 : 0;
+  const std::vector<std::string> joints(m.coordinates.begin() + w.nb, m.coordinates.end());
+  w.mimics = following_mimics(setup, joints);
+  std::vector<std::string> moving = joints;
   for (const FollowingMimic& f : w.mimics) moving.push_back(f.joint);
-  w.mb = build_urdf_multibody(*setup.urdf, moving, setup.q0);
-  for (std::size_t i = 0; i < w.mimics.size(); ++i)
-    w.mimics[i].link = w.mb.link[m.coordinates.size() + i];
+  w.mb = build_urdf_multibody(*setup.urdf, moving, setup.q0, setup.base);
+  for (std::size_t i = 0; i < w.mimics.size(); ++i) w.mimics[i].link = w.mb.link[joints.size() + i];
+  w.contacts = make_contact_colliders(setup, w.mb, m);
   btMultiBody& b = *w.mb.body;
   b.setLinearDamping(0);
   b.setAngularDamping(0);
@@ -177,15 +219,16 @@ void add_multibody(MbWorld& w, const scene::Scene& setup, const mech::Mechanical
   w.world->addMultiBody(&b, btBroadphaseProxy::DefaultFilter, 0);
   w.shape = std::make_unique<btSphereShape>(0.01);
   w.shape->setMargin(0.0);
-  for (int i = 0; i < b.getNumLinks(); ++i) {
-    auto col = std::make_unique<btMultiBodyLinkCollider>(&b, i);
-    col->setCollisionShape(w.shape.get());
-    col->setActivationState(DISABLE_DEACTIVATION);
-    // Mask 0: the broadphase pairs this collider with nothing.
-    w.world->addCollisionObject(col.get(), btBroadphaseProxy::DefaultFilter, 0);
-    b.getLink(i).m_collider = col.get();
-    w.colliders.push_back(std::move(col));
+  if (w.contacts.shape_of.count(-1) > 0) {
+    w.base_collider = make_collider(w, -1);
+    b.setBaseCollider(w.base_collider.get());
   }
+  for (int i = 0; i < b.getNumLinks(); ++i) {
+    w.colliders.push_back(make_collider(w, i));
+    b.getLink(i).m_collider = w.colliders.back().get();
+  }
+  for (auto& p : w.contacts.planes)
+    w.world->addCollisionObject(p.get(), kPlaneGroup, kContactLinkGroup);
 }
 
 // The gear's row is v_m + r v_J = 0 (Jacobian 1 on link A, r on link B):
@@ -213,8 +256,8 @@ void add_limits(MbWorld& w, const std::vector<JointLimit>& limits, const WorldSe
   for (const JointLimit& L : limits) {
     const double lo = L.lower ? L.bound : L.bound - s.limit_range;
     const double hi = L.lower ? L.bound + s.limit_range : L.bound;
-    auto c = std::make_unique<btMultiBodyJointLimitConstraint>(
-        w.mb.body.get(), w.mb.link[static_cast<std::size_t>(L.coordinate)], lo, hi);
+    auto c = std::make_unique<btMultiBodyJointLimitConstraint>(w.mb.body.get(),
+                                                               link_of(w, L.coordinate), lo, hi);
     // Allocates the rows' storage (else done lazily in the first step, after
     // simulate_multibody has reset the applied impulses).
     c->finalizeMultiDof();
@@ -229,7 +272,7 @@ std::unique_ptr<MbWorld> build(const scene::Scene& setup, const mech::Mechanical
                                const VectorXd& v0, const WorldSettings& s) {
   std::unique_ptr<MbWorld> w = make_world(setup, s);
   add_multibody(*w, setup, m);
-  set_state(*w->mb.body, w->mb, w->mimics, q0, v0);
+  set_state(*w, q0, v0);
   add_gears(*w);
   add_limits(*w, limits, s);
   return w;
@@ -238,7 +281,7 @@ std::unique_ptr<MbWorld> build(const scene::Scene& setup, const mech::Mechanical
 // The scene's warnings: what Bullet does differently from lcsim's model
 // beyond the step error.
 void warn(sim::Trajectory& tr, const mech::MechanicalModel& m, const MatrixXd& K_s,
-          const sim::Options& opt) {
+          const sim::Options& opt, const std::vector<JointLimit>& limits) {
   warn_explicit_damping(tr, m, opt.h, "joint torques");
   // Springs are explicit torques (symplectic Euler): stable for omega h <= 2,
   // omega^2 the largest eigenvalue of K_s x = omega^2 M(q0) x.
@@ -252,8 +295,8 @@ void warn(sim::Trajectory& tr, const mech::MechanicalModel& m, const MatrixXd& K
                   short_number(w) + " rad/s gives omega h = " + short_number(w * opt.h) +
                   " at h = " + short_number(opt.h) + "; expect growth, or reduce h");
   }
-  for (int i = 0; i < m.num_constraints(); ++i)
-    if (m.restitution(i) > 0.0) {
+  for (const JointLimit& L : limits)
+    if (const int i = L.row; m.restitution(i) > 0.0) {
       tr.warn("bullet-restitution-lost", 0.0,
               "bullet: restitution is lost: Bullet's multibody joint limits are inelastic "
               "(btMultiBodyJointLimitConstraint has no bounce); constraint '" +
@@ -285,12 +328,15 @@ SceneForces scene_forces(const scene::Scene& setup, const mech::MechanicalModel&
   return out;
 }
 
-// One Bullet step of length h under the joint torques tau; the state it
-// reached.
-void step(MbWorld& w, const VectorXd& tau, double h, VectorXd& q_next, VectorXd& v_next) {
+// One Bullet step of length h under the generalised forces tau (joint
+// torques; a floating base's six as its force and torque) from the state q;
+// the state it reached.
+void step(MbWorld& w, const VectorXd& q, const VectorXd& tau, double h, VectorXd& q_next,
+          VectorXd& v_next) {
   btMultiBody& b = *w.mb.body;
   const auto N = static_cast<int>(tau.size());
-  for (int c = 0; c < N; ++c) b.addJointTorque(w.mb.link[static_cast<std::size_t>(c)], tau(c));
+  if (w.nb > 0) add_floating_base_force(b, w.mb, w.base, q.head<6>(), tau.head<6>());
+  for (int c = w.nb; c < N; ++c) b.addJointTorque(link_of(w, c), tau(c));
   // A limit row exists only in steps that start at or past its bound;
   // its impulse from an earlier step would otherwise be read again.
   for (auto& c : w.limits) {
@@ -299,16 +345,21 @@ void step(MbWorld& w, const VectorXd& tau, double h, VectorXd& q_next, VectorXd&
   }
   // maxSubSteps = 0: exactly one step of length h (no interpolation).
   w.world->stepSimulation(h, 0, h);
-  for (int c = 0; c < N; ++c) {
-    q_next(c) = b.getJointPos(w.mb.link[static_cast<std::size_t>(c)]);
-    v_next(c) = b.getJointVel(w.mb.link[static_cast<std::size_t>(c)]);
+  if (w.nb > 0) get_floating_base(b, w.mb, w.base, q_next.head<6>(), v_next.head<6>());
+  for (int c = w.nb; c < N; ++c) {
+    q_next(c) = b.getJointPos(link_of(w, c));
+    v_next(c) = b.getJointVel(link_of(w, c));
   }
 }
 
 // The step's impulses by row of E. Row 0 of a limit pushes +q (the lower
 // bound), row 1 -q; lcsim's row is c e_j, so the impulse P on the joint is
 // |c| h u.
-void limit_impulses(const MbWorld& w, const std::vector<JointLimit>& limits, VectorXd& impulse) {
+void limit_impulses(MbWorld& w, const std::vector<JointLimit>& limits, VectorXd& impulse) {
+  if (w.contacts.rows > 0) {
+    impulse.setZero();
+    contact_impulses(*w.dispatcher, w.contacts, impulse);
+  }
   for (std::size_t i = 0; i < limits.size(); ++i)
     impulse(limits[i].row) =
         w.limits[i]->getAppliedImpulse(limits[i].lower ? 0 : 1) / std::abs(limits[i].c);
@@ -316,9 +367,16 @@ void limit_impulses(const MbWorld& w, const std::vector<JointLimit>& limits, Vec
 
 }  // namespace
 
-std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m, const std::string& source) {
+std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m, const std::string& source,
+                                        const scene::Scene* setup) {
   std::vector<JointLimit> out;
+  std::vector<bool> contact(static_cast<std::size_t>(m.num_constraints()), false);
+  const int nb = setup && setup->base.floating ? 6 : 0;
+  if (setup)
+    for (const scene::ContactFrame& cf : setup->contacts)
+      contact[static_cast<std::size_t>(cf.row)] = true;
   for (int i = 0; i < m.num_constraints(); ++i) {
+    if (contact[static_cast<std::size_t>(i)]) continue;
     std::vector<int> nz;
     for (int j = 0; j < m.dofs(); ++j)
       if (m.E.coeff(i, j) != 0.0) nz.push_back(j);
@@ -328,6 +386,13 @@ std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m, const st
           m.constraints[static_cast<std::size_t>(i)] + "' (row " + std::to_string(i) +
           " of E) involves " + std::to_string(nz.size()) +
           " joints: Bullet's multibody expresses only joint limits (one joint each)");
+    if (nz[0] < nb)
+      throw std::invalid_argument("bullet: " + (source.empty() ? std::string() : source + ": ") +
+                                  "constraint '" + m.constraints[static_cast<std::size_t>(i)] +
+                                  "' (row " + std::to_string(i) + " of E) is a stop on the " +
+                                  "floating base's coordinate '" +
+                                  m.coordinates[static_cast<std::size_t>(nz[0])] +
+                                  "': Bullet's multibody has limits on joints only");
     JointLimit L;
     L.row = i;
     L.coordinate = nz[0];
@@ -339,20 +404,26 @@ std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m, const st
   return out;
 }
 
-std::string multibody_description(const WorldSettings& s) {
+std::string multibody_description(const WorldSettings& s, bool contacts) {
+  const std::string planes =
+      contacts ? ", contact points as btSphereShape (radius 0 at a corner) against "
+                 "btStaticPlaneShape planes (friction 0, contact ERP " +
+                     short_number(s.limit_erp) + ", slop 0, speculative within " +
+                     short_number(s.contact_threshold) + " m)"
+               : std::string();
   return std::string("btMultiBody from the URDF, ") +
          (s.multibody_mlcp ? "btMultiBodyMLCPConstraintSolver (btDantzigSolver)"
                            : "btMultiBodyConstraintSolver (" + std::to_string(s.solver_iterations) +
                                  " iterations)") +
          ", btMultiBodyJointLimitConstraint limits (ERP " + short_number(s.limit_erp) +
-         ", max impulse " + short_number(s.limit_max_impulse) + ")";
+         ", max impulse " + short_number(s.limit_max_impulse) + ")" + planes;
 }
 
 sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene& setup,
                                    const std::vector<JointLimit>& limits, const VectorXd& x0,
                                    const sim::Options& opt, const WorldSettings& s) {
   sim::Trajectory tr;
-  tr.method = "bullet " + multibody_description(s);
+  tr.method = "bullet " + multibody_description(s, !setup.contacts.empty());
   tr.dynamics = "the URDF's nonlinear multibody (Bullet)";
   tr.t_end = *opt.t_end;
   tr.final_state = x0;
@@ -367,7 +438,7 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene&
   const SceneForces forces = scene_forces(setup, m);
   const MatrixXd &K_s = forces.K_s, &D = forces.D;
   const VectorXd& f_s = forces.f_s;
-  warn(tr, m, K_s, opt);
+  warn(tr, m, K_s, opt, limits);
 
   VectorXd q = x0.head(N), v = x0.tail(N);
   std::unique_ptr<MbWorld> w;
@@ -384,7 +455,7 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene&
     if (opt.progress && j % sim::Options::kProgressSteps == 0) opt.progress(j * opt.h);
     const double h = last ? grid.h_last : grid.h;
     tau = f_s - K_s * q - D * v;
-    step(*w, tau, h, q_next, v_next);
+    step(*w, q, tau, h, q_next, v_next);
     limit_impulses(*w, limits, impulse);
     // Round-off in an impulse is ~1e-16 of the momentum; real ones are O(h).
     const double tiny =

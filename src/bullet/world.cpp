@@ -251,6 +251,30 @@ std::unique_ptr<World> build(const mech::MechanicalModel& m, const std::vector<L
   return w;
 }
 
+// The scene `model` was loaded from when it has a floating or placed base or
+// contacts (which scene::scene_setup leaves out) and `model` is still what
+// that file gives (M, D, K, E, g, f and the names; the restitution is the
+// model's own); else nullopt.
+std::optional<scene::Scene> contact_scene_of(const mech::Model& model) {
+  try {
+    std::optional<scene::Scene> sc = scene::load_scene_details(model.source);
+    if (!sc) return std::nullopt;
+    if (!sc->base.floating && sc->base.pose.matrix() == Eigen::Matrix4d::Identity() &&
+        sc->contacts.empty())
+      return std::nullopt;
+    const mech::MechanicalModel &a = *sc->model.mechanical, &b = *model.mechanical;
+    if (a.coordinates != b.coordinates || a.constraints != b.constraints ||
+        MatrixXd(a.M) != MatrixXd(b.M) || MatrixXd(a.D) != MatrixXd(b.D) ||
+        MatrixXd(a.K) != MatrixXd(b.K) || MatrixXd(a.E) != MatrixXd(b.E) || a.g != b.g ||
+        a.f != b.f)
+      return std::nullopt;
+    sc->model.mechanical->restitution = b.restitution;
+    return sc;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
 // Which scene runs a model: the multibody for a URDF scene whose rows are
 // all joint limits; else rb6 (a scene's matrices included, with a warning);
 // std::invalid_argument when neither can express it.
@@ -265,6 +289,19 @@ Plan plan_of(const mech::Model& model, const WorldSettings& s) {
   Plan p;
   std::optional<scene::Scene> setup =
       model.is_mechanical() ? scene::scene_setup(model) : std::nullopt;
+  if (!setup && model.is_mechanical()) {
+    // scene::scene_setup hands over scenes with a fixed root at the identity
+    // and no contacts only; the multibody builds the others too.
+    if (std::optional<scene::Scene> c = contact_scene_of(model)) {
+      if (model.mechanical->has_friction())
+        throw std::invalid_argument(
+            "bullet: " + model.source +
+            ": a contact scene with friction: Bullet runs contact scenes frictionless only");
+      p.joint_limits = joint_limits_of(*model.mechanical, model.source, &*c);
+      p.scene = std::move(c);
+      return p;
+    }
+  }
   if (!setup) {
     p.rb6_limits = limits_of(model, s.limit_range);
     return p;
@@ -295,7 +332,8 @@ std::string rb6_description(const WorldSettings& s) {
 }  // namespace
 
 std::string solver_description(const mech::Model& model, const WorldSettings& s) {
-  return plan_of(model, s).scene ? multibody_description(s) : rb6_description(s);
+  const Plan p = plan_of(model, s);
+  return p.scene ? multibody_description(s, !p.scene->contacts.empty()) : rb6_description(s);
 }
 
 void check_expressible(const mech::Model& model) { (void)plan_of(model, WorldSettings{}); }
@@ -435,6 +473,8 @@ std::string settings_error(const WorldSettings& s) {
     return bad("limit_range", s.limit_range, "finite and > 0");
   if (!(std::isfinite(s.limit_max_impulse) && s.limit_max_impulse > 0.0))
     return bad("limit_max_impulse", s.limit_max_impulse, "finite and > 0");
+  if (!(std::isfinite(s.contact_threshold) && s.contact_threshold > 0.0))
+    return bad("contact_threshold", s.contact_threshold, "finite and > 0");
   return "";
 }
 

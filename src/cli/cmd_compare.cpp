@@ -12,6 +12,8 @@
 //   energy_drift   Bullet's (E_final - E_initial) minus the exact run's (J),
 //   max_violation  Bullet's most negative gap,
 //   bullet_solver  which Bullet constraint solver ran.
+// `--peer mujoco` runs a contact scene in MuJoCo instead (mujoco::simulate_mujoco),
+// compared the same way.
 // A model with friction must be a block on a floor (bullet::friction_block_of):
 // Bullet's box on a plane runs beside the exact run, and the stick times and
 // slide distances of the closed form, the exact run and Bullet are printed.
@@ -27,6 +29,9 @@
 #include <lcsim/sim/sim.hpp>
 #include <memory>
 #include <nlohmann/json.hpp>
+#ifdef LCSIM_HAS_MUJOCO
+#include <lcsim/mujoco/mujoco.hpp>
+#endif
 
 #include "cli/command.hpp"
 #include "cli/flag_names.hpp"
@@ -45,6 +50,7 @@ struct CompareArgs {
   bool json = false;
   double stop_erp = bullet::WorldSettings{}.stop_erp;
   int iterations = bullet::WorldSettings{}.solver_iterations;
+  std::string peer = "bullet";  // or "mujoco"
 };
 
 // A block on a floor with friction: Bullet's box beside the exact run
@@ -88,7 +94,9 @@ void print_friction(const mech::Model& model, const CompareArgs& a,
 // What is printed of Bullet's run beside the comparison.
 struct BulletRun {
   const sim::Trajectory& trajectory;
-  std::string solver;  // bullet::solver_description
+  std::string peer;  // "Bullet 3.24 (double precision)", "MuJoCo 2.2.2"
+  std::string name() const { return peer.substr(0, peer.find(' ')); }  // "Bullet", "MuJoCo"
+  std::string solver;                                                  // bullet::solver_description
   double stop_erp = 0.0;
   double t_end = 0.0;  // the horizon (s)
   double per_step() const {
@@ -118,9 +126,10 @@ void print_comparison_json(const mech::Model& model, const CompareArgs& a, const
   j["max_violation"] = c.max_violation;
   j["reference_law"] = law.label();
   j["reference_reason"] = law.reason;
-  j["bullet_solver"] = bt.solver;
+  j["peer"] = a.peer;
+  j["bullet_solver"] = bt.solver;  // the peer's settings (kept under this key for Bullet's)
   j["stop_erp"] = bt.stop_erp;
-  j["bullet_version"] = bullet::version_string();
+  j["bullet_version"] = bt.peer;
   j["steps"] = bt.trajectory.steps;
   j["wall_time_per_step_s"] = bt.per_step();
   std::printf("%s\n", j.dump(2).c_str());
@@ -131,25 +140,27 @@ void print_comparison_text(const mech::Model& model, const CompareArgs& a, const
   // The scene's own ERP (rb6's stop ERP, the multibody's limit ERP) is in
   // bullet_solver.
   std::printf("model %s, t_end %g, h %g: %s, %s\n", model.name.c_str(), bt.t_end, a.h,
-              bullet::version_string().c_str(), bt.solver.c_str());
+              bt.peer.c_str(), bt.solver.c_str());
   std::printf("reference      exact run, %s (%s)\n", law.label().c_str(), law.reason.c_str());
   std::printf("deviation max  %.3e (at t = %.6g)\n", c.deviation_max, c.deviation_t);
   std::printf("error final    %.3e\n", c.error_final);
-  std::printf("energy drift   %.3e J (Bullet's change minus the exact change)\n", c.energy_drift);
+  const std::string who = bt.name();
+  std::printf("energy drift   %.3e J (%s's change minus the exact change)\n", c.energy_drift,
+              who.c_str());
   std::printf("max violation  %.3e\n", c.max_violation);
   std::printf("time per step  %.3g s (%ld steps)\n", bt.per_step(), bt.trajectory.steps);
-  std::printf("event shifts (t_bullet - t_exact):\n");
+  std::printf("event shifts (t_%s - t_exact):\n", a.peer.c_str());
   for (const auto& s : c.event_shifts) {
     std::printf("  %-10s %-10s t_exact %-14.9g ",
                 model.mechanical->constraints[s.constraint].c_str(),
                 s.activation ? "activation" : "release", s.t_exact);
     if (std::isfinite(s.t_other))
-      std::printf("t_bullet %-14.9g shift %.3e\n", s.t_other, s.shift);
+      std::printf("t_%s %-14.9g shift %.3e\n", a.peer.c_str(), s.t_other, s.shift);
     else
-      std::printf("no Bullet switch\n");
+      std::printf("no %s switch\n", who.c_str());
   }
   if (c.unmatched_other)
-    std::printf("  (%d Bullet switches match no exact switch)\n", c.unmatched_other);
+    std::printf("  (%d %s switches match no exact switch)\n", c.unmatched_other, who.c_str());
 }
 
 // The runs' options: the horizon, Bullet's h, and the comparison grid (left
@@ -195,15 +206,62 @@ void compare_bullet(const scene::LoadedModel& loaded, const CompareArgs& a, app:
   // What the Bullet scene does differently (lost restitution, explicit
   // springs, a scene run as rb6), as `simulate` prints it.
   print_warnings(bt);
-  const BulletRun run{bt, bullet_solver, ws.stop_erp, *req.options.t_end};
+  const BulletRun run{bt, bullet::version_string(), bullet_solver, ws.stop_erp, *req.options.t_end};
   if (a.json)
     print_comparison_json(model, a, run, law, c);
   else
     print_comparison_text(model, a, run, law, c);
 }
 
+#ifdef LCSIM_HAS_MUJOCO
+// MuJoCo's run on the comparison grid, paired with the exact run (the
+// pairing of bullet::compare_trajectories; MuJoCo's switches are its
+// contact points' first and last steps with a force).
+void compare_mujoco(const scene::LoadedModel& loaded, const CompareArgs& a, app::RunRequest req,
+                    const sim::Trajectory& exact) {
+  const mech::Model& model = loaded.model;
+  req.runner = [](const mech::Model& m, const Eigen::VectorXd& x0, const sim::Options& opt) {
+    return mujoco::simulate_mujoco(m, x0, opt);
+  };
+  req.check_linearisation = false;  // the exact run's states are checked
+  const sim::Trajectory mj = compare_run(loaded, req, "MuJoCo");
+  const bullet::Comparison c = bullet::compare_trajectories(exact, mj, 1e-9 * a.h);
+  print_warnings(mj);
+  const sim::ReferenceLaw law = sim::reference_law("mujoco", req.options.impact, model);
+  const BulletRun run{mj, mujoco::version_string(), mujoco::settings_description({}, a.h), 0.0,
+                      *req.options.t_end};
+  if (a.json)
+    print_comparison_json(model, a, run, law, c);
+  else
+    print_comparison_text(model, a, run, law, c);
+}
+#endif
+
+// `--peer mujoco`: the exact run beside MuJoCo's.
+void run_compare_mujoco(const scene::LoadedModel& loaded, const CompareArgs& a) {
+#ifdef LCSIM_HAS_MUJOCO
+  const mech::Model& model = loaded.model;
+  mujoco::check_expressible(model);  // invalid_argument naming it: exit 2
+  app::RunRequest req;
+  req.x0 = resolve_initial_state(model, a.model, a.x0);
+  req.options = compare_options(a, model);
+  const sim::ReferenceLaw law = sim::reference_law("mujoco", req.options.impact, model);
+  app::RunRequest exact_req = req;
+  exact_req.runner = app::reference_runner(law);
+  const sim::Trajectory exact = compare_run(loaded, exact_req, "exact event-driven");
+  compare_mujoco(loaded, a, req, exact);
+#else
+  (void)loaded;
+  (void)a;
+  throw io::InputError("peer: this lcsim was built without MuJoCo (libmujoco-dev not found)");
+#endif
+}
+
 void run_compare(const CompareArgs& a) {
+  if (a.peer != "bullet" && a.peer != "mujoco")
+    throw io::InputError("peer: unknown peer '" + a.peer + "' (bullet, mujoco)");
   const scene::LoadedModel loaded = scene::load_model_and_scene(a.model);
+  if (a.peer == "mujoco") return run_compare_mujoco(loaded, a);
   const mech::Model& model = loaded.model;
   const bool friction = model.is_mechanical() && !model.mechanical->friction.empty();
   if (!friction) bullet::check_expressible(model);  // invalid_argument naming it: exit 2
@@ -237,6 +295,8 @@ void setup(CLI::App& app) {
   cmd->add_option("--stop-erp", a->stop_erp,
                   "ERP of Bullet's 6DOF2 limits in (0, 1] (rb6 scenes only); default 0.2");
   cmd->add_option("--iterations", a->iterations, "Bullet solver iterations; default 100");
+  cmd->add_option("--peer", a->peer,
+                  "The peer: bullet (default) or mujoco (contact scenes; MuJoCo's soft contacts)");
   cmd->add_flag("--json", a->json, "Print the comparison as JSON");
   cmd->callback([a, t_end] {
     a->t_end_given = t_end->count() > 0;

@@ -53,6 +53,13 @@ ReferenceLaw reference_law(const std::string& method, const std::string& impact,
         "Bullet 3.24's limits do not bounce (rigid-body limits at stop ERP 0.2, multibody "
         "joint limits at all; docs/bullet-comparison.md): nearest exact law is inelastic" +
         inelastic_note;
+  } else if (method == "mujoco") {
+    r.law = "inelastic";
+    r.inelastic = e;
+    r.reason =
+        "MuJoCo's contacts are critically damped springs (solref damping ratio 1): nearest "
+        "exact law is inelastic" +
+        inelastic_note;
   } else {
     r.law = impact;
     r.reason = "assumed: the run's impact law";

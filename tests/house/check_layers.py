@@ -30,12 +30,13 @@ LAYERS = {
     "circuit": {"core", "lcp", "lcs", "mech", "impact", "sim", "io"},
     "scene": {"core", "lcp", "lcs", "mech", "impact", "sim", "io", "circuit"},
     "bullet": {"core", "lcp", "lcs", "mech", "impact", "sim", "io", "circuit", "scene"},
+    "mujoco": {"core", "lcp", "lcs", "mech", "impact", "sim", "io", "circuit", "scene"},
     "study": {"core", "lcp", "lcs", "mech", "impact", "sim", "io", "circuit", "scene"},
     "app": {"core", "lcp", "lcs", "mech", "impact", "sim", "io", "circuit", "scene", "study"},
     "cli": {"core", "lcp", "lcs", "mech", "impact", "ipopt", "sim", "io", "circuit", "scene",
-            "bullet", "study", "app"},
+            "bullet", "mujoco", "study", "app"},
     "python": {"core", "lcp", "lcs", "mech", "impact", "ipopt", "sim", "io", "circuit", "scene",
-               "bullet", "study", "app"},
+               "bullet", "mujoco", "study", "app"},
 }
 
 # (includer, private header's layer): why it is tolerated.

@@ -68,6 +68,17 @@ struct WorldSettings {
   // (../shared/notes/bullet.md, measured in docs/bullet-comparison.md); kept
   // only to measure that.
   bool multibody_mlcp = false;
+  // ---- contact scenes (docs/contacts.md, "Peers on contact scenes") ----
+  // The contact points are spheres (radius 0 for a corner) on their links'
+  // colliders against btStaticPlaneShape planes; restitution the scene's
+  // (0 by default), friction 0. Contact rows use limit_erp too
+  // (btContactSolverInfo::m_erp2) and a linear slop of 0. A manifold keeps a
+  // point while it is closer than contact_threshold (m; Bullet's default is
+  // 0.02 times the shape's bounding radius, 4 mm for the box): such a point
+  // is a speculative row of the solver (target velocity -distance / h), so
+  // a point approaching at up to contact_threshold / h stops at the plane
+  // without crossing it (50 m/s at h = 1e-3).
+  double contact_threshold = 0.05;
 };
 
 // "" when every setting is usable, else one line naming the first bad one

@@ -19,6 +19,8 @@ namespace lcsim::sim {
 //   bullet       the same inelastic law: Bullet 3.24 applies a limit's bounce
 //                only near stop ERP 1 and lcsim's scene uses 0.2, where nothing
 //                rebounds (docs/bullet-comparison.md);
+//   mujoco       inelastic too: its soft contacts are critically damped
+//                springs that do not bounce (docs/contacts.md);
 //   other names  Options::impact, said to be assumed.
 // On a model without restitution (every e = 0) the inelastic flag is dropped:
 // the laws coincide. LCS models have no impact law; the reference is the

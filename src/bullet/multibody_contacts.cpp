@@ -1,0 +1,204 @@
+// A scene's floating base and its contacts against world planes in Bullet's
+// btMultiBody (multibody_world.cpp builds the world; this file maps the
+// floating base's coordinates and makes the contact colliders).
+//
+// The floating base. lcsim's six coordinates are the root link origin p
+// (m, world) and a rotation vector r (rad, world axes) with orientation
+// exp([r]x) R0; the angular velocity is omega = J_l(r) r', J_l the left
+// Jacobian of SO(3) (docs/contacts.md). Bullet's base is the root body at its
+// centre of mass c in principal axes (UrdfMultiBody::root_to_base), with the
+// world-frame velocity of c and omega. So v_c = p' + omega x (c - p).
+//
+// The contacts. Each contact point of the scene (scene::ContactFrame: a point
+// in its link's frame with a radius) is a sphere of that radius in a
+// btCompoundShape on the Bullet link that carries the URDF link: a box's
+// corners are spheres of radius 0 (points), a sphere primitive its sphere, a
+// capsule its two cap spheres, a cylinder its 16 rim points, explicit points
+// as given. Against a plane these are exactly the geometry lcsim's rows
+// describe (a convex box touches a plane first at a corner; docs/contacts.md
+// states the cylinder's rim approximation), so Bullet and lcsim model the
+// same contacts and differ only in the dynamics (nonlinear rigid bodies,
+// Bullet's step) and in Bullet's contact solver.
+#include <BulletCollision/CollisionDispatch/btCollisionDispatcher.h>
+#include <BulletCollision/CollisionShapes/btCompoundShape.h>
+#include <BulletCollision/CollisionShapes/btSphereShape.h>
+#include <BulletCollision/CollisionShapes/btStaticPlaneShape.h>
+#include <BulletDynamics/Featherstone/btMultiBody.h>
+#include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
+
+#include <algorithm>
+#include <cmath>
+#include <lcsim/core/format.hpp>
+#include <stdexcept>
+
+#include "bullet/multibody_scene.hpp"
+#include "bullet/urdf_multibody.hpp"
+
+namespace lcsim::bullet {
+
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+btVector3 bt(const Vector3d& v) { return btVector3(v.x(), v.y(), v.z()); }
+Vector3d eig(const btVector3& v) { return Vector3d(v.x(), v.y(), v.z()); }
+
+btMatrix3x3 bt(const Matrix3d& R) {
+  return btMatrix3x3(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1),
+                     R(2, 2));
+}
+Matrix3d eig(const btMatrix3x3& R) {
+  Matrix3d out;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) out(i, j) = R[i][j];
+  return out;
+}
+
+Matrix3d skew(const Vector3d& r) {
+  Matrix3d K;
+  K << 0, -r.z(), r.y(), r.z(), 0, -r.x(), -r.y(), r.x(), 0;
+  return K;
+}
+
+Matrix3d exp_so3(const Vector3d& r) {
+  const double th = r.norm();
+  return th > 0.0 ? Eigen::AngleAxisd(th, r / th).toRotationMatrix() : Matrix3d::Identity();
+}
+
+Vector3d log_so3(const Matrix3d& R) {
+  const Eigen::AngleAxisd aa(R);
+  return aa.angle() * aa.axis();
+}
+
+// The left Jacobian of SO(3): omega = J_l(r) r' for the orientation exp([r]x).
+// Its coefficients (1 - cos t) / t^2 and (t - sin t) / t^3 by their series
+// below t = 1e-4 (the closed forms lose digits there; the series' next terms
+// are below 1e-17).
+Matrix3d left_jacobian(const Vector3d& r) {
+  const double t = r.norm();
+  const double a = t < 1e-4 ? 0.5 - t * t / 24.0 : (1.0 - std::cos(t)) / (t * t);
+  const double b = t < 1e-4 ? 1.0 / 6.0 - t * t / 120.0 : (t - std::sin(t)) / (t * t * t);
+  const Matrix3d K = skew(r);
+  return Matrix3d::Identity() + a * K + b * K * K;
+}
+
+// A dispatcher whose manifolds keep their points up to `threshold` apart.
+class ThresholdDispatcher : public btCollisionDispatcher {
+ public:
+  ThresholdDispatcher(btCollisionConfiguration* config, double threshold)
+      : btCollisionDispatcher(config), threshold_(threshold) {}
+  btPersistentManifold* getNewManifold(const btCollisionObject* b0,
+                                       const btCollisionObject* b1) override {
+    btPersistentManifold* m = btCollisionDispatcher::getNewManifold(b0, b1);
+    m->setContactBreakingThreshold(threshold_);
+    return m;
+  }
+
+ private:
+  double threshold_;
+};
+
+}  // namespace
+
+void set_floating_base(btMultiBody& b, const UrdfMultiBody& mb, const scene::BasePose& base,
+                       const Vector6d& q, const Vector6d& v) {
+  const Vector3d p = q.head<3>(), r = q.tail<3>();
+  const Matrix3d R = exp_so3(r) * base.pose.linear();
+  const btTransform Tb = btTransform(bt(R), bt(p)) * mb.root_to_base;
+  const Vector3d omega = left_jacobian(r) * v.tail<3>();
+  const Vector3d c = eig(Tb.getOrigin());
+  b.setBaseWorldTransform(Tb);
+  b.setBaseVel(bt(Vector3d(v.head<3>() + omega.cross(c - p))));
+  b.setBaseOmega(bt(omega));
+}
+
+void get_floating_base(const btMultiBody& b, const UrdfMultiBody& mb, const scene::BasePose& base,
+                       Eigen::Ref<Eigen::VectorXd> q, Eigen::Ref<Eigen::VectorXd> v) {
+  const btTransform Tb = b.getBaseWorldTransform();
+  const btTransform Troot = Tb * mb.root_to_base.inverse();
+  const Vector3d p = eig(Troot.getOrigin()), c = eig(Tb.getOrigin());
+  const Vector3d r = log_so3(eig(Troot.getBasis()) * base.pose.linear().transpose());
+  const Vector3d omega = eig(b.getBaseOmega());
+  q.head<3>() = p;
+  q.tail<3>() = r;
+  v.head<3>() = eig(b.getBaseVel()) + omega.cross(p - c);
+  v.tail<3>() = left_jacobian(r).lu().solve(omega);
+}
+
+void add_floating_base_force(btMultiBody& b, const UrdfMultiBody& mb, const scene::BasePose& base,
+                             const Vector6d& q, const Vector6d& Q) {
+  (void)base;
+  const Vector3d p = q.head<3>();
+  const Vector3d F = Q.head<3>();
+  const Vector3d tau = left_jacobian(q.tail<3>()).transpose().lu().solve(Q.tail<3>());
+  const Vector3d c = eig(b.getBaseWorldTransform().getOrigin());
+  (void)mb;
+  b.addBaseForce(bt(F));
+  b.addBaseTorque(bt(Vector3d(tau + (p - c).cross(F))));
+}
+
+ContactColliders make_contact_colliders(const scene::Scene& setup, const UrdfMultiBody& mb,
+                                        const mech::MechanicalModel& m) {
+  ContactColliders out;
+  for (const scene::ContactFrame& cf : setup.contacts) {
+    const auto own = mb.owner.find(cf.point.link);
+    if (own == mb.owner.end())
+      throw std::invalid_argument("bullet: contact '" + cf.point.name + "': link '" +
+                                  cf.point.link + "' is not in Bullet's multibody");
+    auto& shape = out.shape_of[own->second];
+    if (!shape) {
+      auto compound = std::make_unique<btCompoundShape>(/*enableDynamicAabbTree=*/false);
+      compound->setMargin(0.0);
+      shape = compound.get();
+      out.shapes.push_back(std::move(compound));
+    }
+    auto sphere = std::make_unique<btSphereShape>(cf.point.radius);
+    const btTransform at = mb.link_in_body.at(cf.point.link) *
+                           btTransform(btMatrix3x3::getIdentity(), bt(Vector3d(cf.point.local)));
+    auto& compound = static_cast<btCompoundShape&>(*shape);
+    out.row_of[{own->second, compound.getNumChildShapes()}] = static_cast<int>(cf.row);
+    compound.addChildShape(at, sphere.get());
+    out.shapes.push_back(std::move(sphere));
+    double& e = out.restitution_of[own->second];
+    e = std::max(e, m.restitution(static_cast<int>(cf.row)));
+    ++out.rows;
+  }
+  for (const scene::Plane& pl : setup.planes) {
+    auto shape = std::make_unique<btStaticPlaneShape>(bt(pl.normal), pl.normal.dot(pl.point));
+    auto obj = std::make_unique<btCollisionObject>();
+    obj->setCollisionShape(shape.get());
+    obj->setRestitution(1.0);  // Bullet multiplies it with the link's
+    obj->setFriction(0.0);
+    obj->setRollingFriction(0.0);
+    obj->setSpinningFriction(0.0);
+    out.shapes.push_back(std::move(shape));
+    out.planes.push_back(std::move(obj));
+  }
+  return out;
+}
+
+void contact_impulses(btCollisionDispatcher& d, const ContactColliders& c,
+                      Eigen::VectorXd& impulse) {
+  for (int i = 0; i < d.getNumManifolds(); ++i) {
+    const btPersistentManifold* pm = d.getManifoldByIndexInternal(i);
+    const auto* l0 = btMultiBodyLinkCollider::upcast(pm->getBody0());
+    const auto* l1 = btMultiBodyLinkCollider::upcast(pm->getBody1());
+    const btMultiBodyLinkCollider* link = l0 ? l0 : l1;
+    if (!link || (l0 && l1)) continue;
+    for (int j = 0; j < pm->getNumContacts(); ++j) {
+      const btManifoldPoint& pt = pm->getContactPoint(j);
+      const int child = l0 ? pt.m_index0 : pt.m_index1;
+      const auto row = c.row_of.find({link->m_link, child});
+      if (row != c.row_of.end()) impulse(row->second) += pt.m_appliedImpulse;
+    }
+  }
+}
+
+std::unique_ptr<btCollisionDispatcher> make_dispatcher(btCollisionConfiguration* config,
+                                                       double threshold) {
+  return std::make_unique<ThresholdDispatcher>(config, threshold);
+}
+
+}  // namespace lcsim::bullet

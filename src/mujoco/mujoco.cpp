@@ -1,0 +1,140 @@
+// A URDF scene with contacts run in MuJoCo (mj_step), beside lcsim.
+//
+// What MuJoCo integrates: the URDF's nonlinear multibody (MuJoCo's own URDF
+// reader) with a free joint at the root for a floating base; the scene's
+// springs and dampers as applied generalised forces (qfrc_applied) before
+// every step, tau = f_s - K_s q - D v with K_s = K - K_g and
+// f_s = f - tau_g(q0) - K_g q0 (the linearised gravity removed: MuJoCo has
+// the nonlinear one), as Bullet's multibody does (src/bullet). MuJoCo's own
+// joint damping, armature, friction loss, stiffness and joint ranges are set
+// to 0 / off: the scene states its own.
+//
+// Contacts: the geoms of the links the scene's contacts name (the URDF's
+// <collision> primitives: a box collides as a box, up to 4 contacts on a
+// plane) collide with the scene's planes and nothing else (contype 1 /
+// conaffinity 0 against 0 / 1), condim 1 (frictionless), solref
+// (time constant, damping ratio) and solimp from Settings. MuJoCo's contacts
+// are soft by design: a contact force exists only with penetration (or
+// within solimp's width), set by a spring-damper reference acceleration
+// -b v - k r that the solver tracks with impedance d < 1. So a resting body
+// sinks by a small steady depth instead of lcsim's zero gap, and an impact
+// takes about one time constant instead of an instant.
+//
+// The floating base's coordinates map as in docs/contacts.md: MuJoCo's free
+// joint holds the root origin p and the quaternion of exp([r]x) R0; its
+// velocity is p' (world) and the angular velocity in the root's frame,
+// R' J_l(r) r'.
+#include <mujoco/mujoco.h>
+#include <urdf_model/model.h>
+
+#include <algorithm>
+#include <cmath>
+#include <lcsim/core/format.hpp>
+#include <lcsim/mujoco/mujoco.hpp>
+#include <lcsim/scene/scene.hpp>
+#include <optional>
+#include <regex>
+#include <stdexcept>
+
+#include "mujoco/detail.hpp"
+
+namespace lcsim::mujoco {
+
+using Eigen::MatrixXd;
+
+std::string version_string() { return std::string("MuJoCo ") + mj_versionString(); }
+
+std::string settings_error(const Settings& s) {
+  auto bad = [](const char* name, double v, const char* rule) {
+    return std::string("mujoco setting ") + name + " must be " + rule + " (got " + short_number(v) +
+           ")";
+  };
+  if (!(std::isfinite(s.time_constant) && s.time_constant >= 0.0))
+    return bad("time_constant", s.time_constant, "finite and >= 0");
+  if (!(std::isfinite(s.damping_ratio) && s.damping_ratio > 0.0))
+    return bad("damping_ratio", s.damping_ratio, "finite and > 0");
+  if (!(s.dmin > 0.0 && s.dmin < 1.0)) return bad("dmin", s.dmin, "in (0, 1)");
+  if (!(s.dmax >= s.dmin && s.dmax < 1.0)) return bad("dmax", s.dmax, "in [dmin, 1)");
+  if (!(std::isfinite(s.width) && s.width > 0.0)) return bad("width", s.width, "finite and > 0");
+  return "";
+}
+
+namespace {
+
+double time_constant(const Settings& s, double h) {
+  return s.time_constant > 0.0 ? std::max(s.time_constant, 2.0 * h) : 2.0 * h;
+}
+
+}  // namespace
+
+std::string settings_description(const Settings& s, double h) {
+  return "mj_step (Euler integrator, Newton solver, 100 iterations, tolerance 1e-8), condim 1 "
+         "(frictionless), solref (" +
+         short_number(time_constant(s, h)) + " s, " + short_number(s.damping_ratio) +
+         "), solimp (" + short_number(s.dmin) + ", " + short_number(s.dmax) + ", " +
+         short_number(s.width) + " m)";
+}
+
+namespace {
+
+// The scene `model` was loaded from, while `model` is still what the file
+// gives (else nullopt); its restitution is the model's.
+std::optional<scene::Scene> scene_of(const mech::Model& model) {
+  if (!model.is_mechanical()) return std::nullopt;
+  try {
+    std::optional<scene::Scene> sc = scene::load_scene_details(model.source);
+    if (!sc) return std::nullopt;
+    const mech::MechanicalModel &a = *sc->model.mechanical, &b = *model.mechanical;
+    if (a.coordinates != b.coordinates || a.constraints != b.constraints ||
+        MatrixXd(a.M) != MatrixXd(b.M) || MatrixXd(a.D) != MatrixXd(b.D) ||
+        MatrixXd(a.K) != MatrixXd(b.K) || MatrixXd(a.E) != MatrixXd(b.E) || a.g != b.g ||
+        a.f != b.f)
+      return std::nullopt;
+    sc->model.mechanical->restitution = b.restitution;
+    return sc;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+// What check_expressible refuses, or "" (the scene found).
+std::string refusal(const mech::Model& model, std::optional<scene::Scene>& sc) {
+  sc = scene_of(model);
+  if (!sc)
+    return "mujoco: " + model.source +
+           ": MuJoCo runs URDF scenes only (a model file with `urdf:`, unchanged since loading)";
+  const mech::MechanicalModel& m = *model.mechanical;
+  const std::string where = "mujoco: " + model.source + ": ";
+  if (m.has_friction()) return where + "MuJoCo runs frictionless contact scenes only";
+  std::vector<bool> contact(static_cast<std::size_t>(m.num_constraints()), false);
+  for (const auto& cf : sc->contacts) contact[static_cast<std::size_t>(cf.row)] = true;
+  for (int i = 0; i < m.num_constraints(); ++i)
+    if (!contact[static_cast<std::size_t>(i)])
+      return where + "constraint '" + m.constraints[static_cast<std::size_t>(i)] +
+             "' is not a contact against a plane: MuJoCo runs contacts only";
+  for (const auto& cf : sc->contacts)
+    if (std::regex_search(cf.point.name, std::regex("\\.point[0-9]+$")))
+      return where + "contact '" + cf.point.name +
+             "' has explicit points: MuJoCo collides the URDF's <collision> geometry only";
+  if (!sc->base.floating && !sc->base.pose.isApprox(Eigen::Isometry3d::Identity(), 0.0))
+    return where + "a fixed base at a pose: MuJoCo runs a fixed root at the identity only";
+  std::vector<std::string> coords(m.coordinates.begin() + (sc->base.floating ? 6 : 0),
+                                  m.coordinates.end());
+  for (const auto& [name, j] : sc->urdf->joints_) {
+    if (j->type == urdf::Joint::FIXED) continue;
+    if (j->mimic) return where + "joint '" + name + "' is a mimic: MuJoCo's URDF reader has none";
+    if (std::find(coords.begin(), coords.end(), name) == coords.end())
+      return where + "joint '" + name +
+             "' is frozen in the scene: MuJoCo would move it (simulate every movable joint)";
+  }
+  return "";
+}
+
+}  // namespace
+
+void check_expressible(const mech::Model& model) {
+  std::optional<scene::Scene> sc;
+  if (std::string why = refusal(model, sc); !why.empty()) throw std::invalid_argument(why);
+}
+
+}  // namespace lcsim::mujoco

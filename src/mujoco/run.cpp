@@ -1,0 +1,432 @@
+// The MuJoCo run of a contact scene (mujoco.cpp says what MuJoCo integrates
+// and how its contacts differ): the model's settings, the state map, the
+// step loop and what it records.
+#include <mujoco/mujoco.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <lcsim/core/format.hpp>
+#include <lcsim/mujoco/mujoco.hpp>
+#include <lcsim/scene/scene.hpp>
+#include <optional>
+#include <stdexcept>
+
+#include "mujoco/detail.hpp"
+
+namespace lcsim::mujoco {
+
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::MatrixXd;
+using Eigen::Vector3d;
+using Eigen::VectorXd;
+
+Matrix3d skew(const Vector3d& r) {
+  Matrix3d K;
+  K << 0, -r.z(), r.y(), r.z(), 0, -r.x(), -r.y(), r.x(), 0;
+  return K;
+}
+
+// The left Jacobian of SO(3) (omega = J_l(r) r'); its coefficients by their
+// series below 1e-4 rad (next terms below 1e-17).
+Matrix3d left_jacobian(const Vector3d& r) {
+  const double t = r.norm();
+  const double a = t < 1e-4 ? 0.5 - t * t / 24.0 : (1.0 - std::cos(t)) / (t * t);
+  const double b = t < 1e-4 ? 1.0 / 6.0 - t * t / 120.0 : (t - std::sin(t)) / (t * t * t);
+  const Matrix3d K = skew(r);
+  return Matrix3d::Identity() + a * K + b * K * K;
+}
+
+Matrix3d exp_so3(const Vector3d& r) {
+  const double th = r.norm();
+  return th > 0.0 ? Eigen::AngleAxisd(th, r / th).toRotationMatrix() : Matrix3d::Identity();
+}
+
+// Where each lcsim coordinate lives in MuJoCo, and the scene's forces.
+struct Run {
+  MjModelPtr m;
+  MjDataPtr d;
+  int nb = 0;                    // 6 for a floating base
+  int free_q = -1, free_v = -1;  // the free joint's qpos and qvel addresses
+  std::vector<int> qadr, vadr;   // coordinate c >= nb -> qpos / qvel address
+  Matrix3d R0 = Matrix3d::Identity();
+  MatrixXd K_s, D;
+  VectorXd f_s;
+  std::vector<int> row_body;        // contact row -> MuJoCo body of its link (-1: none)
+  std::vector<Vector3d> row_local;  // its point in the link frame, minus nothing
+  std::vector<double> row_radius;
+  std::vector<Vector3d> row_normal;
+};
+
+int id_or_throw(const mjModel* m, int type, const std::string& name, const char* what) {
+  const int id = mj_name2id(m, type, name.c_str());
+  if (id < 0)
+    throw std::invalid_argument("mujoco: MuJoCo's model has no " + std::string(what) + " '" + name +
+                                "'");
+  return id;
+}
+
+// Geoms: the contact links' collide with the planes only; frictionless,
+// soft per Settings. Joints: no damping, armature, friction loss, stiffness
+// or range of MuJoCo's own.
+void configure(Run& r, const scene::Scene& setup, const Settings& s, double h) {
+  mjModel* m = r.m.get();
+  m->opt.timestep = h;
+  m->opt.integrator = mjINT_EULER;
+  for (int i = 0; i < 3; ++i) m->opt.gravity[i] = setup.gravity(i);
+  std::vector<bool> contact_body(static_cast<std::size_t>(m->nbody), false);
+  for (const auto& cf : setup.contacts)
+    contact_body[static_cast<std::size_t>(
+        id_or_throw(m, mjOBJ_BODY, cf.point.link, "body for link"))] = true;
+  const double tc = s.time_constant > 0.0 ? std::max(s.time_constant, 2.0 * h) : 2.0 * h;
+  for (int g = 0; g < m->ngeom; ++g) {
+    const bool plane = m->geom_type[g] == mjGEOM_PLANE && m->geom_bodyid[g] == 0;
+    const bool link = contact_body[static_cast<std::size_t>(m->geom_bodyid[g])];
+    m->geom_contype[g] = link ? 1 : 0;
+    m->geom_conaffinity[g] = plane ? 1 : 0;
+    m->geom_condim[g] = 1;
+    m->geom_solref[2 * g] = tc;
+    m->geom_solref[2 * g + 1] = s.damping_ratio;
+    const double imp[5] = {s.dmin, s.dmax, s.width, 0.5, 2.0};
+    std::copy(imp, imp + 5, m->geom_solimp + 5 * g);
+    m->geom_margin[g] = 0.0;
+    m->geom_gap[g] = 0.0;
+    for (int k = 0; k < 3; ++k) m->geom_friction[3 * g + k] = 0.0;
+  }
+  for (int j = 0; j < m->nv; ++j) {
+    m->dof_damping[j] = 0.0;
+    m->dof_armature[j] = 0.0;
+    m->dof_frictionloss[j] = 0.0;
+  }
+  for (int j = 0; j < m->njnt; ++j) {
+    m->jnt_limited[j] = 0;
+    m->jnt_stiffness[j] = 0.0;
+  }
+}
+
+void map_coordinates(Run& r, const scene::Scene& setup, const mech::MechanicalModel& mm) {
+  const mjModel* m = r.m.get();
+  r.nb = setup.base.floating ? 6 : 0;
+  r.R0 = setup.base.pose.linear();
+  if (r.nb > 0) {
+    const int j = id_or_throw(m, mjOBJ_JOINT, kFreeJoint, "free joint");
+    r.free_q = m->jnt_qposadr[j];
+    r.free_v = m->jnt_dofadr[j];
+  }
+  for (int c = r.nb; c < mm.dofs(); ++c) {
+    const int j = id_or_throw(m, mjOBJ_JOINT, mm.coordinates[static_cast<std::size_t>(c)], "joint");
+    r.qadr.push_back(m->jnt_qposadr[j]);
+    r.vadr.push_back(m->jnt_dofadr[j]);
+  }
+  const int k = mm.num_constraints();
+  r.row_body.assign(static_cast<std::size_t>(k), -1);
+  r.row_local.assign(static_cast<std::size_t>(k), Vector3d::Zero());
+  r.row_radius.assign(static_cast<std::size_t>(k), 0.0);
+  r.row_normal.assign(static_cast<std::size_t>(k), Vector3d::UnitZ());
+  for (const auto& cf : setup.contacts) {
+    const auto i = static_cast<std::size_t>(cf.row);
+    r.row_body[i] = mj_name2id(m, mjOBJ_BODY, cf.point.link.c_str());
+    r.row_local[i] = cf.point.local;
+    r.row_radius[i] = cf.point.radius;
+    r.row_normal[i] = cf.normal;
+  }
+  // The scene's own forces (src/bullet/multibody_world.cpp's scene_forces).
+  VectorXd q_ref = VectorXd::Zero(mm.dofs());
+  for (int j = 0; j < mm.dofs(); ++j)
+    if (const auto it = setup.q0.find(mm.coordinates[static_cast<std::size_t>(j)]);
+        it != setup.q0.end())
+      q_ref(j) = it->second;
+  r.K_s = MatrixXd(mm.K) - setup.lin.K_g;
+  r.f_s = mm.f - setup.lin.tau_g - setup.lin.K_g * q_ref;
+  r.D = MatrixXd(mm.D);
+}
+
+void set_state(Run& r, const VectorXd& q, const VectorXd& v) {
+  mjData* d = r.d.get();
+  if (r.nb > 0) {
+    const Vector3d rv = q.segment<3>(3);
+    const Matrix3d R = exp_so3(rv) * r.R0;
+    const Eigen::Quaterniond quat(R);
+    for (int i = 0; i < 3; ++i) d->qpos[r.free_q + i] = q(i);
+    d->qpos[r.free_q + 3] = quat.w();
+    d->qpos[r.free_q + 4] = quat.x();
+    d->qpos[r.free_q + 5] = quat.y();
+    d->qpos[r.free_q + 6] = quat.z();
+    const Vector3d omega_local = R.transpose() * (left_jacobian(rv) * v.segment<3>(3));
+    for (int i = 0; i < 3; ++i) {
+      d->qvel[r.free_v + i] = v(i);
+      d->qvel[r.free_v + 3 + i] = omega_local(i);
+    }
+  }
+  for (std::size_t c = 0; c < r.qadr.size(); ++c) {
+    d->qpos[r.qadr[c]] = q(r.nb + static_cast<int>(c));
+    d->qvel[r.vadr[c]] = v(r.nb + static_cast<int>(c));
+  }
+}
+
+void get_state(const Run& r, VectorXd& q, VectorXd& v) {
+  const mjData* d = r.d.get();
+  if (r.nb > 0) {
+    const Eigen::Quaterniond quat(d->qpos[r.free_q + 3], d->qpos[r.free_q + 4],
+                                  d->qpos[r.free_q + 5], d->qpos[r.free_q + 6]);
+    const Matrix3d R = quat.normalized().toRotationMatrix();
+    const Eigen::AngleAxisd aa(R * r.R0.transpose());
+    const Vector3d rv = aa.angle() * aa.axis();
+    const Vector3d omega_local(d->qvel[r.free_v + 3], d->qvel[r.free_v + 4], d->qvel[r.free_v + 5]);
+    for (int i = 0; i < 3; ++i) {
+      q(i) = d->qpos[r.free_q + i];
+      v(i) = d->qvel[r.free_v + i];
+    }
+    q.segment<3>(3) = rv;
+    v.segment<3>(3) = left_jacobian(rv).lu().solve(R * omega_local);
+  }
+  for (std::size_t c = 0; c < r.qadr.size(); ++c) {
+    q(r.nb + static_cast<int>(c)) = d->qpos[r.qadr[c]];
+    v(r.nb + static_cast<int>(c)) = d->qvel[r.vadr[c]];
+  }
+}
+
+// tau on the coordinates as qfrc_applied: a floating base's Q_p is the world
+// force at the root origin, Q_r the torque J_l(r)^-T Q_r (world), given to
+// MuJoCo in the root's frame.
+void apply_forces(Run& r, const VectorXd& q, const VectorXd& tau) {
+  mjData* d = r.d.get();
+  mju_zero(d->qfrc_applied, r.m->nv);
+  if (r.nb > 0) {
+    const Vector3d rv = q.segment<3>(3);
+    const Matrix3d R = exp_so3(rv) * r.R0;
+    const Vector3d t_world = left_jacobian(rv).transpose().lu().solve(tau.segment<3>(3));
+    const Vector3d t_local = R.transpose() * t_world;
+    for (int i = 0; i < 3; ++i) {
+      d->qfrc_applied[r.free_v + i] = tau(i);
+      d->qfrc_applied[r.free_v + 3 + i] = t_local(i);
+    }
+  }
+  for (std::size_t c = 0; c < r.vadr.size(); ++c)
+    d->qfrc_applied[r.vadr[c]] = tau(r.nb + static_cast<int>(c));
+}
+
+// Each MuJoCo contact's normal force, given to the scene's contact point of
+// the same body nearest to it (N).
+void contact_forces(const Run& r, VectorXd& u) {
+  const mjModel* m = r.m.get();
+  const mjData* d = r.d.get();
+  u.setZero();
+  for (int i = 0; i < d->ncon; ++i) {
+    const mjContact& c = d->contact[i];
+    const int g = m->geom_bodyid[c.geom1] == 0 ? c.geom2 : c.geom1;
+    const int body = m->geom_bodyid[g];
+    mjtNum f[6];
+    mj_contactForce(m, d, i, f);
+    const Vector3d pos(c.pos[0], c.pos[1], c.pos[2]);
+    Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> R(d->xmat + 9 * body);
+    const Vector3d x(d->xpos[3 * body], d->xpos[3 * body + 1], d->xpos[3 * body + 2]);
+    int best = -1;
+    double best_d = 0.0;
+    for (std::size_t k = 0; k < r.row_body.size(); ++k) {
+      if (r.row_body[k] != body) continue;
+      const Vector3d p = x + R * r.row_local[k] - r.row_radius[k] * r.row_normal[k];
+      const double dist = (p - pos).norm();
+      if (best < 0 || dist < best_d) {
+        best = static_cast<int>(k);
+        best_d = dist;
+      }
+    }
+    if (best >= 0) u(best) += f[0];
+  }
+}
+
+// The run's record: samples, the mode by contact force, events at its
+// changes (as src/bullet's RunRecorder), energies, the worst linear gap.
+struct Recorder {
+  const mech::MechanicalModel& mm;
+  const sim::Options& opt;
+  sim::Trajectory& tr;
+  sim::OutputSampler sampler;
+  sim::IndexSet mode;
+  void sample(double t, const VectorXd& q, const VectorXd& v, const VectorXd& u) {
+    const VectorXd y = mm.E * q + mm.g;
+    if (y.size() > 0) tr.max_violation = std::min(tr.max_violation, std::min(0.0, y.minCoeff()));
+    if (!opt.record_samples) return;
+    sim::Sample s;
+    s.t = t;
+    s.x.resize(2 * q.size());
+    s.x << q, v;
+    s.u = u;
+    s.y = y;
+    s.mode = mode;
+    tr.record_sample(std::move(s), opt);
+  }
+  void step(double t, const VectorXd& x_before, const VectorXd& q, const VectorXd& v,
+            const VectorXd& u, double tiny) {
+    sim::IndexSet now;
+    for (int i = 0; i < u.size(); ++i)
+      if (u(i) > tiny) now.push_back(i);
+    if (now != mode) {
+      sim::Event e;
+      e.t = t;
+      e.state_before = x_before;
+      e.state_after.resize(2 * q.size());
+      e.state_after << q, v;
+      e.mode_after = now;
+      bool gained = false;
+      for (int i : now)
+        if (std::find(mode.begin(), mode.end(), i) == mode.end()) gained = true;
+      e.type = gained ? sim::EventType::kImpact : sim::EventType::kRelease;
+      tr.events.push_back(std::move(e));
+      mode = now;
+    }
+    ++tr.steps;
+    ++tr.lcp_solves;
+  }
+};
+
+// check_expressible (throws), then the scene's MuJoCo model set up and
+// mapped; std::invalid_argument when MuJoCo cannot load it.
+void prepare(Run& r, const mech::Model& model, const Settings& s, double h) {
+  check_expressible(model);
+  const std::optional<scene::Scene> setup = scene::load_scene_details(model.source);
+  r.m = load_scene_model(*setup);
+  configure(r, *setup, s, h);
+  map_coordinates(r, *setup, *model.mechanical);
+}
+
+}  // namespace
+
+double mj_step_time(const mech::Model& model, const VectorXd& x0, double h, long steps,
+                    const Settings& s) {
+  mju_user_warning = [](const char*) {};
+  Run r;
+  prepare(r, model, s, h);
+  r.d = MjDataPtr(mj_makeData(r.m.get()));
+  const int N = model.mechanical->dofs();
+  const VectorXd q = x0.head(N), v = x0.tail(N);
+  set_state(r, q, v);
+  apply_forces(r, q, r.f_s - r.K_s * q - r.D * v);
+  const auto t0 = std::chrono::steady_clock::now();
+  for (long j = 0; j < steps; ++j) mj_step(r.m.get(), r.d.get());
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return wall / static_cast<double>(std::max(1L, steps));
+}
+
+// It is one piece: the step loop's stages (forces, mj_step, read back, record,
+// divergence) share the run's state and read in order.
+sim::Trajectory simulate_mujoco(const mech::Model& model, const VectorXd& x0,
+                                const sim::Options& options, const Settings& s) {
+  sim::Options opt = options;
+  sim::OptionsUsed used;
+  used.h = used.needs_mechanical = true;
+  if (auto refused = sim::refuse_invalid_run(model, x0, opt, "mujoco", used))
+    return std::move(*refused);
+  sim::Trajectory tr;
+  tr.method = "mujoco " + settings_description(s, opt.h);
+  tr.dynamics = "the URDF's nonlinear multibody (MuJoCo)";
+  tr.t_end = *opt.t_end;
+  tr.final_state = x0;
+  if (std::string why = settings_error(s); !why.empty()) {
+    tr.status = sim::RunStatus::kInvalidInput;
+    tr.message = why;
+    return tr;
+  }
+  // MuJoCo prints its warnings by default; the run reads them from
+  // mjData::warning (a bad acceleration ends it as a numerical failure).
+  mju_user_warning = [](const char*) {};
+  const auto wall0 = std::chrono::steady_clock::now();
+  const mech::MechanicalModel& mm = *model.mechanical;
+  Run r;
+  try {
+    prepare(r, model, s, opt.h);
+  } catch (const std::invalid_argument& e) {
+    tr.status = sim::RunStatus::kInvalidInput;
+    tr.message = e.what();
+    return tr;
+  }
+  for (int i = 0; i < mm.num_constraints(); ++i)
+    if (mm.restitution(i) > 0.0) {
+      tr.warn("mujoco-restitution-lost", 0.0,
+              "mujoco: restitution is lost: MuJoCo's contacts are damped springs (solref), "
+              "constraint '" +
+                  mm.constraints[static_cast<std::size_t>(i)] +
+                  "' has e = " + short_number(mm.restitution(i)));
+      break;
+    }
+  r.d = MjDataPtr(mj_makeData(r.m.get()));
+  const int N = mm.dofs(), k = mm.num_constraints();
+  VectorXd q = x0.head(N), v = x0.tail(N), u = VectorXd::Zero(k);
+  set_state(r, q, v);
+  mj_forward(r.m.get(), r.d.get());
+  tr.energy_initial = mech::total_energy(mm, q, v);
+  tr.max_violation = 0.0;
+  Recorder rec{mm, opt, tr, sim::OutputSampler(opt.dt_out), {}};
+  rec.sample(0.0, q, v, u);
+  sim::DivergenceGuard guard(model, x0, *opt.t_end);
+  const sim::StepGrid grid = sim::StepGrid::of(*opt.t_end, opt.h);
+  const double weight = (mm.f.cwiseAbs().sum() + 1.0);
+  VectorXd x_before(2 * N);
+  for (long j = 1; j <= grid.n; ++j) {
+    const bool last = j == grid.n;
+    const double h = last ? grid.h_last : grid.h;
+    const double t = last ? *opt.t_end : j * opt.h;
+    r.m->opt.timestep = h;
+    x_before << q, v;
+    apply_forces(r, q, r.f_s - r.K_s * q - r.D * v);
+    mj_step(r.m.get(), r.d.get());
+    contact_forces(r, u);
+    get_state(r, q, v);
+    std::string why = r.d->warning[mjWARN_BADQACC].number > 0
+                          ? "diverged at t = " + short_number(t) +
+                                ": MuJoCo's accelerations are not finite (mjWARN_BADQACC)"
+                          : guard.check(t, q, v, last);
+    if (!why.empty()) {
+      tr.status = sim::RunStatus::kNumericalFailure;
+      tr.message = "mujoco: " + why;
+      tr.t_end = t - h;
+      tr.final_state = x_before;
+      return tr;
+    }
+    rec.step(t, x_before, q, v, u, 1e-9 * weight);
+    if (rec.sampler.want(t, opt.h, last)) rec.sample(t, q, v, u);
+  }
+  tr.final_state.resize(2 * N);
+  tr.final_state << q, v;
+  tr.energy_final = mech::total_energy(mm, q, v);
+  tr.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  sim::check_diverged(model, x0, tr);
+  return tr;
+}
+
+namespace {
+
+class MujocoIntegrator : public sim::Integrator {
+ public:
+  std::string name() const override { return "mujoco"; }
+  sim::OptionsUsed options_used() const override {
+    sim::OptionsUsed u;
+    u.h = u.needs_mechanical = true;
+    return u;
+  }
+
+ protected:
+  std::string refusal(const mech::Model& model) const override {
+    try {
+      check_expressible(model);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "";
+  }
+  sim::Trajectory integrate(const mech::Model& model, const VectorXd& x0,
+                            const sim::Options& opt) const override {
+    return simulate_mujoco(model, x0, opt);
+  }
+};
+
+}  // namespace
+
+void register_backends() {
+  sim::integrators().add("mujoco", [] { return std::make_unique<MujocoIntegrator>(); });
+}
+
+}  // namespace lcsim::mujoco

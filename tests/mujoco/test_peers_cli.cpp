@@ -1,0 +1,53 @@
+// `lcsim compare --peer bullet|mujoco` on the contact scenes, run as a user
+// would (the lcsim program links MuJoCo where this test is built).
+// Tolerances as in test_mujoco_contacts.cpp (MuJoCo's resting sink bound
+// 2.4e-5 m) and tests/bullet/test_contact_scenes.cpp (Bullet's speculative
+// contacts at ERP 0: the rest is exact to the solver's residual, 1e-9).
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "support/run_lcsim.hpp"
+
+namespace {
+
+const std::string kRobots = std::string(LCSIM_SOURCE_DIR) + "/robots/";
+
+lcsim::cli_test::CliRun lcsim(const std::string& args) {
+  return lcsim::cli_test::run_lcsim(args,
+                                    lcsim::cli_test::private_temp("lcsim_peers_stderr", ".txt"));
+}
+
+TEST(PeersCli, CompareBothPeersOnTheDroppedBox) {
+  for (const char* peer : {"bullet", "mujoco"}) {
+    const auto r = lcsim("compare '" + kRobots + "box_drop_scene.yaml' --peer " + peer + " --json");
+    ASSERT_EQ(r.exit_code, 0) << peer << ": " << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["peer"], peer);
+    const double bound = std::string(peer) == "bullet" ? 1e-9 : 2.4e-5;
+    EXPECT_LE(j["error_final"].get<double>(), bound) << peer;
+    EXPECT_NE(j["bullet_solver"].get<std::string>().find(
+                  std::string(peer) == "bullet" ? "btStaticPlaneShape" : "solref"),
+              std::string::npos)
+        << j["bullet_solver"];
+  }
+}
+
+TEST(PeersCli, BulletRunsTheQuadrupedDrop) {
+  const auto r = lcsim("compare '" + kRobots + "quadruped_drop_scene.yaml' --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_LE(nlohmann::json::parse(r.out)["error_final"].get<double>(), 1e-9);
+}
+
+TEST(PeersCli, UnknownPeerAndInexpressibleSceneExitTwoWithOneLine) {
+  const auto bad = lcsim("compare '" + kRobots + "box_drop_scene.yaml' --peer drake");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("unknown peer 'drake'"), std::string::npos) << bad.err;
+  const auto carts = lcsim("compare '" + kRobots + "two_carts_scene.yaml' --peer mujoco");
+  EXPECT_EQ(carts.exit_code, 2);
+  EXPECT_NE(carts.err.find("not a contact"), std::string::npos) << carts.err;
+  EXPECT_EQ(carts.err.find('\n'), carts.err.size() - 1) << carts.err;  // one line
+}
+
+}  // namespace
