@@ -151,23 +151,29 @@ std::optional<ModelProblem> check_friction(const MechanicalModel& m) {
 
 }  // namespace
 
-std::optional<ModelProblem> check_mass_matrix(const SparseMatrix& M) {
+std::string asymmetry(const SparseMatrix& A, std::string_view name) {
   double scale = 0.0;
-  for (Eigen::Index j = 0; j < M.outerSize(); ++j)
-    for (SparseMatrix::InnerIterator it(M, j); it; ++it)
+  for (Eigen::Index j = 0; j < A.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(A, j); it; ++it)
       scale = std::max(scale, std::abs(it.value()));
-  for (Eigen::Index j = 0; j < M.outerSize(); ++j)
-    for (SparseMatrix::InnerIterator it(M, j); it; ++it) {
+  const auto entry = [&](Eigen::Index a, Eigen::Index b) {
+    return std::string(name) + "[" + std::to_string(a) + "][" + std::to_string(b) +
+           "] = " + short_number(A.coeff(a, b));
+  };
+  for (Eigen::Index j = 0; j < A.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(A, j); it; ++it) {
       const Eigen::Index i = it.row();
-      if (std::abs(it.value() - M.coeff(j, i)) > 1e-12 * scale) {
+      if (std::abs(it.value() - A.coeff(j, i)) > 1e-12 * scale) {
         const Eigen::Index a = std::min(i, j), b = std::max(i, j);
-        return ModelProblem{"mechanical.M", "not symmetric (M[" + std::to_string(a) + "][" +
-                                                std::to_string(b) +
-                                                "] = " + short_number(M.coeff(a, b)) + " but M[" +
-                                                std::to_string(b) + "][" + std::to_string(a) +
-                                                "] = " + short_number(M.coeff(b, a)) + ")"};
+        return entry(a, b) + " but " + entry(b, a);
       }
     }
+  return "";
+}
+
+std::optional<ModelProblem> check_mass_matrix(const SparseMatrix& M) {
+  if (const std::string why = asymmetry(M, "M"); !why.empty())
+    return ModelProblem{"mechanical.M", "not symmetric (" + why + ")"};
   const double rel = static_cast<double>(M.rows()) * std::numeric_limits<double>::epsilon();
   if (M.rows() <= kDenseMassCheckMax) {
     const MatrixXd Md = M.toDense();

@@ -153,6 +153,20 @@ std::string refuse_friction_3d(const mech::Model& model, std::string_view method
                        : "method " + with + " does");
 }
 
+// A method that needs D and K symmetric (OptionsUsed::symmetric_dk) and a
+// model whose D or K is not (gyroscopic damping, a follower force).
+std::string refuse_asymmetric(const mech::Model& model, std::string_view method,
+                              const OptionsUsed& used) {
+  if (!used.symmetric_dk || !model.is_mechanical()) return "";
+  std::string why = mech::asymmetry(model.mechanical->D, "D");
+  if (why.empty()) why = mech::asymmetry(model.mechanical->K, "K");
+  if (why.empty()) return "";
+  return "method '" + std::string(method) +
+         "' needs symmetric D and K (it factors M + h theta D + " +
+         "h^2 theta^2 K by Cholesky), and model '" + model.name + "' has " + why +
+         "; methods 'event' and 'euler' take it";
+}
+
 // A method that applies an impact law to a model with friction: the law must
 // handle friction, else the run would fail at its first impact.
 std::string refuse_friction_law(const mech::Model& model, const Options& opt,
@@ -197,6 +211,7 @@ std::string check_run(const mech::Model& model, const VectorXd& x0, const Option
   // 3-D first: a planar refusal would name methods that refuse 3-D friction too.
   if (std::string m = refuse_friction_3d(model, method, used); !m.empty()) return m;
   if (std::string m = refuse_friction(model, method, used); !m.empty()) return m;
+  if (std::string m = refuse_asymmetric(model, method, used); !m.empty()) return m;
   if (used.dense_lcs && model.lcs_state_size() > mech::kMaxDenseLcsState)
     return "method '" + std::string(method) +
            "' works on the dense LCS (matrix exponentials and LCPs of size n = 2N + 1), and " +

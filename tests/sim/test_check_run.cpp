@@ -145,6 +145,30 @@ INSTANTIATE_TEST_SUITE_P(CheckRun, EveryMethod, ::testing::ValuesIn(sim::integra
 
 // Every method the library has is registered without a call: "bullet" by
 // linking lcsim::bullet (this test executable does).
+// Moreau–Jean factors W = M + h theta D + h^2 theta^2 K by Cholesky, which
+// reads one triangle: a gyroscopic D (skew part) would be dropped without a
+// word. It refuses such a model naming the entry; the exact method runs it.
+TEST(CheckRun, MoreauJeanRefusesANonSymmetricDamping) {
+  mech::Model m = carts();
+  m.mechanical->D.coeffRef(0, 1) += 0.5;
+  m.mechanical->D.coeffRef(1, 0) -= 0.5;
+  const sim::Trajectory mj =
+      sim::make_integrator("moreau-jean")->run(m, m.initial, valid_options());
+  expect_refused(mj, "needs symmetric D and K");
+  expect_refused(mj, "D[0][1] = ");
+  const sim::Trajectory ex = sim::make_integrator("event")->run(m, m.initial, valid_options());
+  EXPECT_EQ(ex.status, Status::kCompleted) << ex.message;
+  // K alike, and a difference at rounding (1e-15 of the largest entry, as a
+  // scene's computed gravity stiffness may have) is symmetric.
+  mech::Model k = carts();
+  k.mechanical->K.coeffRef(0, 1) += 1e-15 * k.mechanical->K.coeffs().cwiseAbs().maxCoeff();
+  EXPECT_EQ(sim::make_integrator("moreau-jean")->run(k, k.initial, valid_options()).status,
+            Status::kCompleted);
+  k.mechanical->K.coeffRef(0, 1) += 1.0;
+  expect_refused(sim::make_integrator("moreau-jean")->run(k, k.initial, valid_options()),
+                 "K[0][1] = ");
+}
+
 TEST(CheckRun, EveryMethodIsRegisteredByLinking) {
   const auto names = sim::integrator_names();
   for (const char* n : {"event", "euler", "moreau-jean", "bullet"})

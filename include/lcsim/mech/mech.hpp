@@ -12,6 +12,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace lcsim::mech {
@@ -190,6 +191,10 @@ struct ModelProblem {
 // to kTangentOrthogonality), an initial state of the right size and a finite t_end > 0 when
 // set. nullopt when usable.
 std::optional<ModelProblem> check_model(const Model& model);
+// "" when A is symmetric to 1e-12 of its largest entry (the test check_model
+// applies to M), else the first pair that is not, named with `name`:
+// "K[0][1] = 2 but K[1][0] = 0".
+std::string asymmetry(const SparseMatrix& A, std::string_view name);
 // Relative tolerance of the orthogonality of a 3-D contact's rows: |a.b| <=
 // this |a| |b| (Euclidean, in the model's coordinates), and ||t| - |t2|| <=
 // this |t|. Rows typed with 16 digits pass; 0.7071 for 1/sqrt(2) does not

@@ -246,6 +246,10 @@ struct OptionsUsed {
   // mech::FrictionalContact::is_3d, issue 27); a method with friction but
   // not this refuses a model that has one (check_run).
   bool friction_3d = false;
+  // The method factors W = M + h theta D + h^2 theta^2 K by Cholesky (it
+  // reads one triangle), so it needs D and K symmetric: check_run refuses a
+  // model whose D or K is not (mech::asymmetry) rather than symmetrise it.
+  bool symmetric_dk = false;
 };
 
 // "" when `opt.sensitivity` is empty or asks what the model and the method

@@ -53,9 +53,10 @@ class MoreauJeanIntegrator : public Integrator {
   OptionsUsed options_used() const override {
     OptionsUsed u;  // its impact law is restitution inside the step LCP
     u.h = u.theta = u.lcp_solver = u.linear_algebra = u.needs_mechanical = true;
-    u.friction = true;     // the friction LCP in every step (mj_friction.hpp)
-    u.friction_3d = true;  // the cone's LCP in Stewart and Trinkle's form (the same)
-    u.sensitivity = true;  // the discrete map's derivative, frictionless (step_sensitivity.hpp)
+    u.friction = true;      // the friction LCP in every step (mj_friction.hpp)
+    u.friction_3d = true;   // the cone's LCP in Stewart and Trinkle's form (the same)
+    u.sensitivity = true;   // the discrete map's derivative, frictionless (step_sensitivity.hpp)
+    u.symmetric_dk = true;  // W by Cholesky (step_kernels.hpp)
     return u;
   }
   Trajectory integrate(const mech::Model& model, const VectorXd& x0,
