@@ -249,5 +249,175 @@ TEST(EventFriction3d, DOneIsThePlanarMethod) {
   }
 }
 
+// A box (m = 4 kg, translating and tilting: q = x, y, z, rx, ry; no yaw,
+// whose rows would not be orthogonal in these coordinates) on its four
+// corners (+-a, +-b) with its centre of mass at the floor's level, so
+// friction has no moment that tilts it: it slides as the single block
+// (mech::cone_slide), the corners carrying m g in all and the block's
+// friction, each corner on its own polygon with maximal dissipation. The four normal rows are
+// dependent (rank 3): the split of the loads is indeterminate, the motion is not
+// (resultant_determined).
+mech::Model box4(int d) {
+  const double m = 4.0, a = 0.3, b = 0.2;
+  mech::MechanicalModel mm;
+  mm.M = Eigen::Matrix<double, 5, 1>(m, m, m, 0.1, 0.2).asDiagonal().toDenseMatrix().sparseView();
+  Eigen::MatrixXd E(4, 5);
+  int r = 0;
+  for (double cx : {-a, a})
+    for (double cy : {-b, b}) E.row(r++) << 0, 0, 1, cy, -cx;
+  mm.E = E.sparseView();
+  mm.f = (Eigen::VectorXd(5) << 0, 0, -m * kG, 0, 0).finished();
+  for (int c = 0; c < 4; ++c) {
+    mech::FrictionalContact fc(c, (Eigen::VectorXd(5) << 1, 0, 0, 0, 0).finished(), kMu);
+    fc.tangent2 = (Eigen::VectorXd(5) << 0, 1, 0, 0, 0).finished().sparseView();
+    fc.edges = d;
+    mm.friction.push_back(fc);
+  }
+  return mech::model_of(mm, "box4");
+}
+
+TEST(EventFriction3d, BoxOnFourCornersSlidesAsTheBlock) {
+  for (int d : {2, 4, 8})
+    for (double a : {0.0, 0.5, 0.3, 1.4}) {
+      const double psi = a * kPi / d;
+      const mech::ConeSlide cf = mech::cone_slide(kS0, psi, kMu, kG, d);
+      const Eigen::VectorXd x0 =
+          (Eigen::VectorXd(10) << 0, 0, 0, 0, 0, kS0 * std::cos(psi), kS0 * std::sin(psi), 0, 0, 0)
+              .finished();
+      sim::Options o;
+      o.t_end = cf.t_stop + 0.25;
+      o.dt_out = 0.05;
+      const sim::Trajectory tr = sim::simulate(box4(d), x0, o, "event");
+      const std::string at = "d = " + std::to_string(d) + ", psi = " + std::to_string(psi);
+      ASSERT_EQ(tr.status, Status::kCompleted) << at << ": " << tr.message;
+      ASSERT_FALSE(tr.events.empty()) << at;
+      EXPECT_LE(rel(tr.events.back().t, cf.t_stop), kRel) << at;
+      EXPECT_LE(rel(tr.final_state(0), cf.x), kRel) << at;
+      EXPECT_LE(rel(tr.final_state(1), cf.y), kRel) << at;
+      EXPECT_LE(tr.final_state.segment(2, 3).cwiseAbs().maxCoeff(), 1e-14) << at;  // flat
+      for (const sim::Sample& s : tr.samples) {
+        ASSERT_EQ(s.lambda_T2.size(), 4);
+        const bool sliding = s.t > 1e-9 && s.t < cf.t_stop - 1e-9;
+        const double vx = s.x(5), vy = s.x(6), sp = std::hypot(vx, vy);
+        double support = -1e300;  // max_i D_i.s
+        for (int i = 0; i < 2 * d; ++i)
+          support = std::max(support, std::cos(i * kPi / d) * vx + std::sin(i * kPi / d) * vy);
+        // The loads' split is indeterminate (the mode selection keeps an
+        // independent set of corners: two diagonal ones here); their sum is
+        // m g and the friction's resultant the block's, -mu m g D.
+        double load = 0.0, work = 0.0;
+        for (int c = 0; c < 4; ++c) {
+          EXPECT_GE(s.u(c), 0.0) << at;
+          load += s.u(c);
+          work += s.u_t(c) * vx + s.lambda_T2(c) * vy;
+          // Each corner: maximal dissipation F.s = -mu N max_i D_i.s.
+          if (sliding) {
+            EXPECT_NEAR(s.u_t(c) * vx + s.lambda_T2(c) * vy, -kMu * s.u(c) * support,
+                        1e-12 * kMu * 4.0 * kG * sp)
+                << at << " t = " << s.t;
+          }
+        }
+        EXPECT_NEAR(load, 4.0 * kG, 1e-12 * 4.0 * kG) << at << " t = " << s.t;
+        if (sliding) {
+          EXPECT_NEAR(work, -kMu * 4.0 * kG * support, 1e-12 * kMu * 4.0 * kG * sp) << at;
+        }
+      }
+    }
+}
+
+// Random models: k = 1..3 point masses on the floor, each with its own
+// contact (tangents turned by a random angle, d in 2..6, mu in 0.1..0.8),
+// coupled through a non-diagonal mass matrix and springs, pushed by random
+// horizontal forces, starting on the floor with random tangential
+// velocities. Every sample: the energy never rises (1e-9 of its scale: the
+// rounding of the phases' exponentials), normal forces >= 0, the friction
+// force in the polygon mu u_N conv{D_i} (each face, 1e-9 relative) and of
+// maximal dissipation while sliding. Every run completes or is refused by
+// name (a Painlevé-type phase, a selection without a consistent mode),
+// never stalls.
+TEST(EventFriction3d, RandomModelsDissipateAndKeepTheCoulombLaw) {
+  std::mt19937 rng(2711);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  int completed = 0, refused = 0, samples = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const int k = 1 + trial % 3, N = 3 * k;
+    mech::MechanicalModel m;
+    Eigen::MatrixXd R = Eigen::MatrixXd::NullaryExpr(N, N, [&] { return U(rng); });
+    Eigen::MatrixXd M =
+        Eigen::MatrixXd::Identity(N, N) * (1.0 + 0.5 * (U(rng) + 1)) + 0.3 * R * R.transpose() / N;
+    m.M = M.sparseView();
+    Eigen::MatrixXd L = Eigen::MatrixXd::Zero(N, N);
+    for (int i = 0; i + 3 < N; ++i) L(i, i) = 1, L(i, i + 3) = -1;  // springs between masses
+    m.K = (2.0 * (U(rng) + 1.0) * L.transpose() * L).sparseView();
+    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(k, N);
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(N), x0 = Eigen::VectorXd::Zero(2 * N);
+    std::vector<int> dd(static_cast<size_t>(k));
+    for (int c = 0; c < k; ++c) {
+      E(c, 3 * c + 2) = 1.0;
+      f(3 * c) = 3.0 * U(rng), f(3 * c + 1) = 3.0 * U(rng), f(3 * c + 2) = -kG * 2.0;
+      const double al = kPi * U(rng);
+      Eigen::VectorXd t = Eigen::VectorXd::Zero(N), t2 = t;
+      t(3 * c) = std::cos(al), t(3 * c + 1) = std::sin(al);
+      t2(3 * c) = -std::sin(al), t2(3 * c + 1) = std::cos(al);
+      mech::FrictionalContact fc(c, t, 0.1 + 0.35 * (U(rng) + 1.0));
+      fc.tangent2 = t2.sparseView();
+      fc.edges = dd[static_cast<size_t>(c)] = 2 + static_cast<int>(2.5 * (U(rng) + 1.0));
+      m.friction.push_back(fc);
+      x0(3 * c) = 0.2 * U(rng), x0(3 * c + 1) = 0.2 * U(rng);
+      x0(N + 3 * c) = 2.0 * U(rng), x0(N + 3 * c + 1) = 2.0 * U(rng);
+    }
+    m.E = E.sparseView();
+    m.f = f;
+    const mech::Model model = mech::model_of(m, "random3d");
+    sim::Options o;
+    o.t_end = 1.5;
+    o.dt_out = 0.01;
+    const sim::Trajectory tr = sim::simulate(model, x0, o, "event");
+    if (tr.status != Status::kCompleted) {
+      ++refused;
+      EXPECT_EQ(tr.status, Status::kNumericalFailure) << trial << ": " << tr.message;
+      EXPECT_TRUE(tr.message.find("Painlev") != std::string::npos ||
+                  tr.message.find("stick / slip selection") != std::string::npos)
+          << trial << ": " << tr.message;
+      continue;
+    }
+    ++completed;
+    double e_prev = tr.energy_initial;
+    const double e_scale = 1.0 + std::abs(tr.energy_initial) + 0.5 * x0.tail(N).squaredNorm();
+    for (const sim::Sample& s : tr.samples) {
+      ++samples;
+      const double e = mech::total_energy(*model.mechanical, s.x.head(N), s.x.tail(N));
+      EXPECT_LE(e, e_prev + 1e-9 * e_scale) << trial << " t = " << s.t;
+      e_prev = std::min(e_prev, e);
+      for (int c = 0; c < k; ++c) {
+        const mech::FrictionalContact& fc = model.mechanical->friction[static_cast<size_t>(c)];
+        const double uN = s.u(c), Fx = s.u_t(c), Fy = s.lambda_T2(c);
+        const double force = 1e-9 * (1.0 + std::abs(uN));  // rounding of a phase's forces
+        EXPECT_GE(uN, -force) << trial;
+        const int d = dd[static_cast<size_t>(c)];
+        for (int j = 0; j < 2 * d; ++j) {
+          const double th = (j + 0.5) * kPi / d;
+          EXPECT_LE(std::cos(th) * Fx + std::sin(th) * Fy,
+                    fc.mu * uN * std::cos(kPi / (2 * d)) + force)
+              << trial << " t = " << s.t;
+        }
+        const Eigen::VectorXd v = s.x.tail(N);
+        const double s1 = Eigen::VectorXd(fc.tangent).dot(v);
+        const double s2 = Eigen::VectorXd(fc.tangent2).dot(v);
+        if (std::hypot(s1, s2) > 1e-6) {
+          double support = -1e300;
+          for (int i = 0; i < 2 * d; ++i)
+            support = std::max(support, std::cos(i * kPi / d) * s1 + std::sin(i * kPi / d) * s2);
+          EXPECT_NEAR(Fx * s1 + Fy * s2, -fc.mu * uN * support, force * std::hypot(s1, s2))
+              << trial << " t = " << s.t;
+        }
+      }
+    }
+  }
+  std::printf("[  counts  ] 200 random 3-D models: %d completed, %d refused by name, %d samples\n",
+              completed, refused, samples);
+  EXPECT_EQ(completed + refused, 200);
+}
+
 }  // namespace
 }  // namespace lcsim

@@ -29,7 +29,8 @@ namespace lcsim::sim::detail {
 
 namespace {
 
-// Combinations tried at most (33 for one contact with d = 8).
+// Combinations tried at most (33 for one contact with d = 8; all stick,
+// the most common outcome when several contacts stop together, is the first).
 constexpr size_t kMaxCombinations = 4096;
 
 }  // namespace
@@ -126,12 +127,12 @@ std::string EventDriven::select_cone_friction(double t, const lcs::IndexSet& und
   std::vector<double> target;
   const std::vector<std::vector<FrictionMode>> cand = cone_candidates(out.mode, xa, rows, target);
   out.friction.clear();
-  size_t total = 1;
+  double total = 1.0;  // combinations (may be many: only kMaxCombinations are tried)
   for (const auto& c : cand) {
     out.friction.push_back(c.front());
-    total = std::min(total * c.size(), kMaxCombinations + 1);
+    total *= static_cast<double>(c.size());
   }
-  if (total == 1) return "";  // every contact's mode follows from its velocity
+  if (total == 1.0) return "";  // every contact's mode follows from its velocity
   if (!rows.empty()) project_rows(out.mode, rows, target, xa);
   const mech::MechanicalModel& m = *model_.mechanical;
   std::string names;
@@ -139,13 +140,11 @@ std::string EventDriven::select_cone_friction(double t, const lcs::IndexSet& und
     if (cand[f].size() > 1)
       names += text(names.empty() ? "'" : ", '",
                     m.constraints[static_cast<size_t>(m.friction[f].contact)], "'");
-  if (total > kMaxCombinations)
-    return text("stick / slip selection at t = ", t, ": the contacts ", names, " have more than ",
-                kMaxCombinations,
-                " combinations of stick and slip on the cone's edges and faces (not enumerated)");
+  const size_t tries =
+      total > static_cast<double>(kMaxCombinations) ? kMaxCombinations : static_cast<size_t>(total);
   std::string painleve;
   std::vector<FrictionMode> fm(cand.size());
-  for (size_t code = 0; code < total; ++code) {
+  for (size_t code = 0; code < tries; ++code) {
     size_t c = code;
     for (size_t f = 0; f < cand.size(); ++f) {
       fm[f] = cand[f][c % cand[f].size()];
@@ -163,6 +162,10 @@ std::string EventDriven::select_cone_friction(double t, const lcs::IndexSet& und
     }
   }
   if (!painleve.empty()) return painleve;
+  if (tries < total)
+    return text("stick / slip selection at t = ", t, ": none of the first ", tries, " of ", total,
+                " combinations of stick and slip on the cone's edges and faces of the contacts ",
+                names, " is consistent (not enumerated further)");
   return text("stick / slip selection at t = ", t, ": no mode of the contacts ", names,
               " is consistent (each of stick and slip on the cone's edges and faces leaves a "
               "friction monitor negative)");

@@ -132,4 +132,19 @@ void EventDriven::add_cone_monitors(Phase& ph, size_t f) const {
   }
 }
 
+bool EventDriven::resultant_determined(const MatrixXd& S, const MatrixXd& MinvGt,
+                                       const MatrixXd& HAv, MatrixXd& F_all) {
+  const Eigen::JacobiSVD<MatrixXd> svd(S, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const VectorXd& sv = svd.singularValues();
+  const double tol = 1e-10 * sv(0);  // rank: the stick rows' duplicates are exact
+  Eigen::Index rank = 0;
+  while (rank < sv.size() && sv(rank) > tol) ++rank;
+  F_all = -S.completeOrthogonalDecomposition().solve(HAv);
+  const double scale =
+      S.cwiseAbs().maxCoeff() * F_all.cwiseAbs().maxCoeff() + HAv.cwiseAbs().maxCoeff();
+  if (!((S * F_all + HAv).cwiseAbs().maxCoeff() <= 1e-10 * scale)) return false;
+  const MatrixXd Z = svd.matrixV().rightCols(sv.size() - rank);  // null space of S
+  return (MinvGt * Z).cwiseAbs().maxCoeff() <= 1e-10 * MinvGt.cwiseAbs().maxCoeff();
+}
+
 }  // namespace lcsim::sim::detail

@@ -328,6 +328,13 @@ class EventDriven {
   void cone_forces(Phase& ph, size_t f, const RowVectorXd& uN, const MatrixXd& F_all,
                    Eigen::Index first) const;
   void add_cone_monitors(Phase& ph, size_t f) const;
+  // A singular H M^-1 G' with slip (several contacts of one body holding the
+  // same tangent rows): true, with the minimum-norm forces in F_all, when
+  // S F = -HAv is consistent and every force in S's null space Z acts on
+  // nothing (M^-1 G' Z = 0), so the motion is determined though the split of
+  // the forces between the contacts is not.
+  static bool resultant_determined(const MatrixXd& S, const MatrixXd& MinvGt, const MatrixXd& HAv,
+                                   MatrixXd& F_all);
   // The sliding velocity (along t, t2) of entry f as rows on the augmented state.
   std::pair<RowVectorXd, RowVectorXd> cone_sliding_rows(size_t f) const;
   std::string select_cone_friction(double t, const lcs::IndexSet& undetermined, VectorXd& xa,

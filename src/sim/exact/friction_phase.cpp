@@ -123,6 +123,8 @@ bool EventDriven::friction_feedback(Phase& ph, const VectorXd& xa, std::string& 
     F_all = -S.completeOrthogonalDecomposition().solve(H * Av);
     ph.Acl.middleRows(N_, N_) += MinvGt * F_all;
     if (!has_cone_) indeterminate_split(ph, S, stick, xa, F_all);  // forces only: H' Z = 0
+  } else if (has_cone_ && resultant_determined(S, MinvGt, H * Av, F_all)) {
+    ph.Acl.middleRows(N_, N_) += MinvGt * F_all;
   } else {
     err =
         "the constraint matrix H M^-1 G' of the mode with slip is singular (dependent "
@@ -238,6 +240,9 @@ void EventDriven::fill_friction(Sample& s, const Phase& ph, const VectorXd& xa) 
   s.u_t = ph.Ft.rows() == static_cast<Eigen::Index>(friction_contacts_.size())
               ? VectorXd(ph.Ft * xa)
               : VectorXd::Zero(static_cast<Eigen::Index>(friction_contacts_.size()));
+  if (has_cone_)
+    s.lambda_T2 =
+        ph.Ft2.rows() == s.u_t.size() ? VectorXd(ph.Ft2 * xa) : VectorXd::Zero(s.u_t.size());
 }
 
 void EventDriven::set_friction(Event& e, const EventResult& ev) const {
