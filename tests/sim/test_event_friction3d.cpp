@@ -339,6 +339,7 @@ TEST(EventFriction3d, RandomModelsDissipateAndKeepTheCoulombLaw) {
   std::mt19937 rng(2711);
   std::uniform_real_distribution<double> U(-1.0, 1.0);
   int completed = 0, refused = 0, samples = 0;
+  int face_to_edge = 0, edge_to_face = 0, stick_to_slip = 0, to_stick = 0, impacts = 0;
   for (int trial = 0; trial < 200; ++trial) {
     const int k = 1 + trial % 3, N = 3 * k;
     mech::MechanicalModel m;
@@ -382,6 +383,14 @@ TEST(EventFriction3d, RandomModelsDissipateAndKeepTheCoulombLaw) {
       continue;
     }
     ++completed;
+    for (const sim::Event& e : tr.events) {  // which transitions the runs went through
+      const auto has = [&](const char* a) { return e.note.find(a) != std::string::npos; };
+      face_to_edge += has("slip-face") && has("-> slip-edge");
+      edge_to_face += has("slip-edge") && has("-> slip-face");
+      stick_to_slip += has("stick -> slip");
+      to_stick += has("-> stick");
+      impacts += e.type == EventType::kImpact;
+    }
     double e_prev = tr.energy_initial;
     const double e_scale = 1.0 + std::abs(tr.energy_initial) + 0.5 * x0.tail(N).squaredNorm();
     for (const sim::Sample& s : tr.samples) {
@@ -416,6 +425,10 @@ TEST(EventFriction3d, RandomModelsDissipateAndKeepTheCoulombLaw) {
   }
   std::printf("[  counts  ] 200 random 3-D models: %d completed, %d refused by name, %d samples\n",
               completed, refused, samples);
+  std::printf(
+      "[  counts  ] events: %d edge -> face, %d face -> edge, %d stick -> slip, %d -> stick, "
+      "%d impacts\n",
+      edge_to_face, face_to_edge, stick_to_slip, to_stick, impacts);
   EXPECT_EQ(completed + refused, 200);
 }
 
