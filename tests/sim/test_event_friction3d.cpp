@@ -432,5 +432,36 @@ TEST(EventFriction3d, RandomModelsDissipateAndKeepTheCoulombLaw) {
   EXPECT_EQ(completed + refused, 200);
 }
 
+// A point mass dropped from 0.05 m with a tangential velocity: it lands
+// (the cone's impact law at e = 0 removes the normal velocity and takes at
+// most mu P_N off the sliding, on the polygon), then slides to rest as
+// mech::cone_slide from the velocity the impact left, where it left it.
+TEST(EventFriction3d, AfterAnImpactSlidesToRestAsTheClosedForm) {
+  for (int d : {2, 4})
+    for (double a : {0.0, 0.5, 0.3}) {
+      const double psi = a * kPi / d, s0 = 2.0;
+      const VectorXd x0 =
+          (VectorXd(6) << 0, 0, 0.05, s0 * std::cos(psi), s0 * std::sin(psi), 0).finished();
+      sim::Options o;
+      o.t_end = 1.5;
+      const sim::Trajectory tr = sim::simulate(block(d), x0, o, "event");
+      const std::string at = "d = " + std::to_string(d) + ", psi = " + std::to_string(psi);
+      ASSERT_EQ(tr.status, Status::kCompleted) << at << ": " << tr.message;
+      ASSERT_GE(tr.events.size(), 2u) << at;
+      const sim::Event& hit = tr.events.front();
+      ASSERT_EQ(hit.type, EventType::kImpact) << at;
+      EXPECT_NEAR(hit.t, std::sqrt(2 * 0.05 / kG), 1e-12) << at;
+      const VectorXd& xp = hit.state_after;
+      EXPECT_LE(std::abs(xp(5)), 1e-12) << at;  // inelastic
+      const double u = std::hypot(xp(3), xp(4));
+      ASSERT_GT(u, 0.1) << at;  // still sliding after the impact
+      const mech::ConeSlide cf = mech::cone_slide(u, std::atan2(xp(4), xp(3)), kMu, kG, d);
+      EXPECT_EQ(tr.events.back().type, EventType::kStick) << at;
+      EXPECT_LE(rel(tr.events.back().t, hit.t + cf.t_stop), kRel) << at;
+      EXPECT_LE(rel(tr.final_state(0), xp(0) + cf.x), kRel) << at;
+      EXPECT_LE(rel(tr.final_state(1), xp(1) + cf.y), kRel) << at;
+    }
+}
+
 }  // namespace
 }  // namespace lcsim
