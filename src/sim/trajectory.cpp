@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "sim/exact/event_driven_detail.hpp"
+
 namespace lcsim::sim {
 
 std::string_view to_string(EventType t) {
@@ -111,9 +113,25 @@ class EventDrivenIntegrator : public Integrator {
     OptionsUsed u;
     u.impact = u.lcp_solver = u.event_search = u.dense_lcs = true;
     u.friction = true;     // stick / slip modes (friction_phase.cpp, friction_modes.cpp)
+    u.friction_3d = true;  // stick / edge / face slip on the cone (cone_phase.cpp, cone_modes.cpp)
     u.sensitivity = true;  // forward sensitivities (sensitivity.cpp)
     return u;
   }
+
+ protected:
+  // A cone's modes are coded in a FrictionMode (detail::kMaxEventConeEdges).
+  std::string refusal(const mech::Model& model) const override {
+    if (!model.is_mechanical()) return "";
+    const mech::MechanicalModel& m = *model.mechanical;
+    for (size_t f = 0; f < m.friction.size(); ++f)
+      if (m.edges_of(m.friction[f]) > detail::kMaxEventConeEdges)
+        return text("method 'event' takes cones of at most ", detail::kMaxEventConeEdges,
+                    " edge pairs (d) (model '", model.name, "' has d = ", m.edges_of(m.friction[f]),
+                    " at mechanical.friction[", f, "])");
+    return "";
+  }
+
+ public:
   Trajectory integrate(const mech::Model& model, const VectorXd& x0,
                        const Options& opt) const override {
     return integrate_event_driven(model, x0, opt);

@@ -1,8 +1,9 @@
-// Three-dimensional friction (issue 27) in the simulation methods: only
-// 'moreau-jean' integrates it (tests/sim/test_mj_friction3d.cpp), so every
-// other method refuses a model with a two-tangent contact by one input-error
-// line naming the entry and 'moreau-jean' (the methods without friction too:
-// they refuse friction of any kind).
+// Three-dimensional friction (issue 27) in the simulation methods: 'event'
+// (tests/sim/test_event_friction3d.cpp) and 'moreau-jean'
+// (tests/sim/test_mj_friction3d.cpp) integrate it, so every other method
+// refuses a model with a two-tangent contact by one input-error line naming
+// the entry and those two (the methods without friction too: they refuse
+// friction of any kind).
 #include <gtest/gtest.h>
 
 #include <lcsim/mech/mech.hpp>
@@ -25,7 +26,7 @@ mech::Model block3d() {
   return mech::model_of(m, "block3d");
 }
 
-TEST(Friction3dRefusal, EveryMethodButMoreauJeanRefusesAModelWithTwoTangents) {
+TEST(Friction3dRefusal, EveryMethodButEventAndMoreauJeanRefusesAModelWithTwoTangents) {
   const mech::Model model = block3d();
   ASSERT_FALSE(mech::check_model(model));
   const Eigen::VectorXd x0 = (Eigen::VectorXd(6) << 0, 0, 0, 1, 0, 0).finished();
@@ -33,17 +34,31 @@ TEST(Friction3dRefusal, EveryMethodButMoreauJeanRefusesAModelWithTwoTangents) {
   o.t_end = 0.1;
   int refused = 0;
   for (const std::string& name : sim::integrators().names()) {
-    if (name == "moreau-jean") continue;
+    if (name == "moreau-jean" || name == "event") continue;
     const sim::Trajectory tr = sim::make_integrator(name)->run(model, x0, o);
     EXPECT_EQ(tr.status, Status::kInvalidInput) << name;
-    // Every method, with friction or not: the 3-D refusal comes first (the
-    // planar one would name 'event', which refuses it too).
+    // Every method, with friction or not: the 3-D refusal comes first.
     EXPECT_EQ(tr.message, "method '" + name +
                               "' does not yet handle 3-D friction (model 'block3d' has two "
-                              "tangents at mechanical.friction[0]); method 'moreau-jean' does");
+                              "tangents at mechanical.friction[0]); method 'event', "
+                              "'moreau-jean' does");
     ++refused;
   }
-  EXPECT_GE(refused, 2);  // 'event', 'euler' at least
+  EXPECT_GE(refused, 1);  // 'euler' at least
+}
+
+// The exact method codes a cone's facets in its modes: d up to 27.
+TEST(Friction3dRefusal, EventRefusesConesBeyondItsEdgeLimit) {
+  mech::Model model = block3d();
+  model.mechanical->friction[0].edges = 28;
+  const Eigen::VectorXd x0 = (Eigen::VectorXd(6) << 0, 0, 0, 1, 0, 0).finished();
+  sim::Options o;
+  o.t_end = 0.1;
+  const sim::Trajectory tr = sim::make_integrator("event")->run(model, x0, o);
+  EXPECT_EQ(tr.status, Status::kInvalidInput);
+  EXPECT_EQ(tr.message,
+            "method 'event' takes cones of at most 27 edge pairs (d) (model 'block3d' has d = 28 "
+            "at mechanical.friction[0])");
 }
 
 }  // namespace

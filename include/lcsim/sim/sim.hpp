@@ -46,6 +46,10 @@ struct Sample {
   // Tangential multipliers (mean friction force over the step, N), one per
   // entry of mechanical.friction in its order; empty for frictionless models.
   VectorXd u_t;
+  // Models with 3-D contacts (two tangents): the friction force along each
+  // entry's second tangent (N), in the order of mechanical.friction (0 for a
+  // planar entry); empty otherwise and for methods that do not give it.
+  VectorXd lambda_T2;
   // The mode of each entry of mechanical.friction, in its order; empty for
   // frictionless models and for methods that do not determine it.
   std::vector<FrictionMode> friction_mode;

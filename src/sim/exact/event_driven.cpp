@@ -60,7 +60,7 @@ std::string friction_note(const std::vector<FrictionMode>& before,
   for (size_t f = 0; f < after.size() && f < before.size(); ++f) {
     if (before[f] == after[f]) continue;
     note += (note.empty() ? "'" : "; '") + names[static_cast<size_t>(contacts[f])] +
-            "': " + std::string(to_string(before[f])) + " -> " + std::string(to_string(after[f]));
+            "': " + friction_mode_name(before[f]) + " -> " + friction_mode_name(after[f]);
   }
   return note;
 }

@@ -16,6 +16,11 @@
 //                         sliding monitors (issue 17)
 //   friction_modes.cpp    stick / slip selection at an event (the
 //                         acceleration-level friction LCP, thesis (4.44))
+//   cone_phase.cpp        3-D contacts on a polyhedral cone (issue 27): the
+//                         rows and columns of stick, edge and face slip,
+//                         their monitors and forces
+//   cone_modes.cpp        mode selection at an event for models with such
+//                         contacts (candidates checked on the phase's monitors)
 #pragma once
 
 #include <Eigen/Dense>
@@ -28,6 +33,7 @@
 #include <memory>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace lcsim::sim::detail {
@@ -37,6 +43,26 @@ using Eigen::RowVectorXd;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 constexpr double kSqrtEps = 0x1p-26;  // sqrt(kEps), exactly
+
+// The modes of a 3-D contact with d >= 2 edge pairs (cone_phase.cpp), kept in
+// the phase's FrictionMode vector past the public values: slip with the
+// force on edge i (0 <= i < 2d: the velocity within pi/(2d) of edge
+// direction i, the force mu u_N against it) or on face j (the velocity along
+// the bisector of edges j and j+1, the force on the opposite face), coded
+// 16 + 2i and 16 + 2j + 1. Samples and events carry kSlip (FrictionMode's
+// public values); event notes name the facet (friction_mode_name).
+// 16 + 4d <= 127 bounds d.
+constexpr int kConeCodeBase = 16;
+constexpr int kMaxEventConeEdges = (127 - kConeCodeBase) / 4;  // 27
+inline FrictionMode cone_edge(int i) { return static_cast<FrictionMode>(kConeCodeBase + 2 * i); }
+inline FrictionMode cone_face(int j) {
+  return static_cast<FrictionMode>(kConeCodeBase + 2 * j + 1);
+}
+inline bool cone_slip(FrictionMode m) { return static_cast<int>(m) >= kConeCodeBase; }
+inline bool cone_on_face(FrictionMode m) { return (static_cast<int>(m) - kConeCodeBase) % 2 == 1; }
+inline int cone_index(FrictionMode m) { return (static_cast<int>(m) - kConeCodeBase) / 2; }
+// "slip-edge-i", "slip-face-j" for a cone mode, else to_string(m).
+std::string friction_mode_name(FrictionMode m);
 
 // An upper bound on the spectral radius, ||B^16||^(1/16) ||A|| with
 // B = A/||A|| (Gelfand's formula; 4 squarings, no eigen-decomposition).
@@ -59,6 +85,9 @@ struct Phase {
   // its tangential multiplier u_T = Ft x (n_F x n); both empty otherwise.
   std::vector<FrictionMode> friction;
   MatrixXd Ft;
+  // Models with 3-D contacts on a cone (d >= 2): the friction force along
+  // each contact's second tangent, u_T2 = Ft2 x (n_F x n); empty otherwise.
+  MatrixXd Ft2;
   // Balanced coordinates z = x ./ D with Ab = D^{-1} Acl D (powers of 2):
   // a stiff spring k makes Acl's entries span k and 1 while its frequencies
   // are sqrt(k); exponentials of the balanced matrix keep the relative
@@ -287,6 +316,38 @@ class EventDriven {
                                                const std::vector<int>& zero, const VectorXd& xa,
                                                long& solves) const;
   bool consistent(const Phase& ph, const VectorXd& xa, double t) const;
+  // 3-D contacts on a polyhedral cone (cone_phase.cpp, cone_modes.cpp).
+  bool is_cone(size_t f) const { return f < cone_d_.size() && cone_d_[f] >= 2; }
+  // The rows entry f holds at acceleration level in `mode` (also force
+  // columns) and what its friction adds to its normal's force column
+  // (empty when nothing).
+  void cone_rows(size_t f, FrictionMode mode, std::vector<RowVectorXd>& held,
+                 RowVectorXd& column) const;
+  // Ft, Ft2 rows of entry f from its normal's row uN and its held rows'
+  // multipliers (the rows of F_all from `first`).
+  void cone_forces(Phase& ph, size_t f, const RowVectorXd& uN, const MatrixXd& F_all,
+                   Eigen::Index first) const;
+  void add_cone_monitors(Phase& ph, size_t f) const;
+  // A singular H M^-1 G' with slip (several contacts of one body holding the
+  // same tangent rows): true, with the minimum-norm forces in F_all, when
+  // S F = -HAv is consistent and every force in S's null space Z acts on
+  // nothing (M^-1 G' Z = 0), so the motion is determined though the split of
+  // the forces between the contacts is not.
+  static bool resultant_determined(const MatrixXd& S, const MatrixXd& MinvGt, const MatrixXd& HAv,
+                                   MatrixXd& F_all);
+  // The sliding velocity (along t, t2) of entry f as rows on the augmented state.
+  std::pair<RowVectorXd, RowVectorXd> cone_sliding_rows(size_t f) const;
+  std::string select_cone_friction(double t, const lcs::IndexSet& undetermined, VectorXd& xa,
+                                   EventResult& out);
+  // The modes each entry of mechanical.friction may take at state xa, in
+  // the order tried, and the velocity rows that vanish (rows over v and
+  // their values: zero, or the belt's velocity).
+  std::vector<std::vector<FrictionMode>> cone_candidates(const lcs::IndexSet& mode,
+                                                         const VectorXd& xa,
+                                                         std::vector<RowVectorXd>& zero_rows,
+                                                         std::vector<double>& zero_target) const;
+  void project_rows(const lcs::IndexSet& mode, const std::vector<RowVectorXd>& rows,
+                    const std::vector<double>& target, VectorXd& xa) const;
   // held: the constraints the ending phase kept closed (empty at the start).
   EventResult process_event(double t, const VectorXd& xa, const lcs::IndexSet& held = {});
   // The accumulation that an impact of contact r at t (time resolution
@@ -449,6 +510,10 @@ class EventDriven {
   MatrixXd Minv_;
   std::vector<int> friction_contacts_;
   std::vector<impact::ContactOutcome> outcome_;
+  // d of each entry of mechanical.friction (1 for a planar one); some >= 2
+  // (has_cone_): the cone's modes and selection (cone_modes.cpp).
+  std::vector<int> cone_d_;
+  bool has_cone_ = false;
   // Forward sensitivities (Options::sensitivity; null otherwise).
   void init_sensitivity();
   std::shared_ptr<Sensitivity> sens_;

@@ -151,6 +151,7 @@ bool EventDriven::consistent(const Phase& ph, const VectorXd& xa, double t) cons
 // vanish set exactly to zero). "" or the failure message.
 std::string EventDriven::select_friction(double t, const lcs::IndexSet& undetermined, VectorXd& xa,
                                          EventResult& out) {
+  if (has_cone_) return select_cone_friction(t, undetermined, xa, out);  // cone_modes.cpp
   std::vector<FrictionMode> fixed;
   const std::vector<int> zero = zero_sliding(out.mode, xa, fixed);
   out.friction = fixed;

@@ -22,6 +22,9 @@ namespace {
 
 double sigma_of(FrictionMode f) { return f == FrictionMode::kSlipPositive ? 1.0 : -1.0; }
 bool slipping(FrictionMode f) {
+  return f == FrictionMode::kSlipPositive || f == FrictionMode::kSlipNegative || cone_slip(f);
+}
+bool planar_slip(FrictionMode f) {
   return f == FrictionMode::kSlipPositive || f == FrictionMode::kSlipNegative;
 }
 
@@ -30,7 +33,11 @@ bool slipping(FrictionMode f) {
 void EventDriven::init_friction() {
   const mech::MechanicalModel& m = *model_.mechanical;
   Minv_ = Eigen::LLT<MatrixXd>(MatrixXd(m.M)).solve(MatrixXd::Identity(N_, N_));
-  for (const mech::FrictionalContact& fc : m.friction) friction_contacts_.push_back(fc.contact);
+  for (const mech::FrictionalContact& fc : m.friction) {
+    friction_contacts_.push_back(fc.contact);
+    cone_d_.push_back(m.edges_of(fc));
+    has_cone_ = has_cone_ || cone_d_.back() >= 2;
+  }
   outcome_.assign(static_cast<size_t>(k_), impact::ContactOutcome::kNone);
 }
 
@@ -56,7 +63,7 @@ std::string EventDriven::painleve_phase(const Phase& ph, const MatrixXd& S, int 
     if (!slipping(ph.friction[f])) continue;
     const int r = m.friction[f].contact;
     msg += text(" ", r, " ('", m.constraints[static_cast<size_t>(r)], "', ",
-                to_string(ph.friction[f]), ")");
+                friction_mode_name(ph.friction[f]), ")");
   }
   msg += " slipping, the normal matrix E_I M^-1 (E_I - sigma mu T)' is not a P-matrix";
   if (nI == 1) msg += text(" (W_NN - sigma mu W_NT = ", Ns(0, 0), " <= 0)");
@@ -65,26 +72,40 @@ std::string EventDriven::painleve_phase(const Phase& ph, const MatrixXd& S, int 
          "(not resolved)";
 }
 
-// F (normals), Ft and Acl of a mode with closed frictional contacts; false
-// (err set) for a Painlevé-type or singular phase.
+// F (normals), Ft (Ft2) and Acl of a mode with closed frictional contacts;
+// false (err set) for a Painlevé-type or singular phase. Rows held at
+// acceleration level: the planar sticking tangents, and a cone contact's
+// (cone_phase.cpp), in the order of mechanical.friction.
 bool EventDriven::friction_feedback(Phase& ph, const VectorXd& xa, std::string& err) const {
   const mech::MechanicalModel& m = *model_.mechanical;
   const Eigen::Index nI = static_cast<Eigen::Index>(ph.mode.size());
-  std::vector<int> stick;
-  for (size_t f = 0; f < ph.friction.size(); ++f)
-    if (ph.friction[f] == FrictionMode::kStick) stick.push_back(static_cast<int>(f));
-  const Eigen::Index ns = static_cast<Eigen::Index>(stick.size()), nc = nI + ns;
+  std::vector<int> stick;  // planar sticking contacts
+  std::vector<RowVectorXd> held, cone_column(ph.friction.size());
+  std::vector<Eigen::Index> first(ph.friction.size(), 0);  // a contact's first held row
+  for (size_t f = 0; f < ph.friction.size(); ++f) {
+    first[f] = nI + static_cast<Eigen::Index>(held.size());
+    if (is_cone(f)) {
+      cone_rows(f, ph.friction[f], held, cone_column[f]);
+    } else if (ph.friction[f] == FrictionMode::kStick) {
+      stick.push_back(static_cast<int>(f));
+      held.push_back(RowVectorXd(m.friction[f].tangent.transpose()));
+    }
+  }
+  const Eigen::Index ns = static_cast<Eigen::Index>(held.size()), nc = nI + ns;
   MatrixXd H(nc, N_), G(nc, N_);
   for (Eigen::Index i = 0; i < nI; ++i) H.row(i) = m.E.row(ph.mode[static_cast<size_t>(i)]);
   G.topRows(nI) = H.topRows(nI);
   for (size_t f = 0; f < ph.friction.size(); ++f) {
     if (!slipping(ph.friction[f])) continue;
     const auto it = std::find(ph.mode.begin(), ph.mode.end(), m.friction[f].contact);
-    G.row(it - ph.mode.begin()) -=
-        sigma_of(ph.friction[f]) * m.friction[f].mu * m.friction[f].tangent.transpose();
+    if (is_cone(f))
+      G.row(it - ph.mode.begin()) += cone_column[f];
+    else
+      G.row(it - ph.mode.begin()) -=
+          sigma_of(ph.friction[f]) * m.friction[f].mu * m.friction[f].tangent.transpose();
   }
   for (Eigen::Index s = 0; s < ns; ++s)
-    H.row(nI + s) = G.row(nI + s) = m.friction[static_cast<size_t>(stick[s])].tangent.transpose();
+    H.row(nI + s) = G.row(nI + s) = held[static_cast<size_t>(s)];
   const MatrixXd MinvGt = Minv_ * G.transpose();
   const MatrixXd S = H * MinvGt;
   if (err = painleve_phase(ph, S, static_cast<int>(ns)); !err.empty()) return false;
@@ -97,10 +118,13 @@ bool EventDriven::friction_feedback(Phase& ph, const VectorXd& xa, std::string& 
     // Dependent rows without slip (two corners of a box sticking on one
     // floor): S = H M^-1 H' is symmetric semi-definite and H v' = 0 is
     // consistent, so the forces are determined up to its null space
-    // (a statically indeterminate split: indeterminate_split).
+    // (a statically indeterminate split: indeterminate_split, planar rows
+    // only; a cone contact keeps the minimum-norm split).
     F_all = -S.completeOrthogonalDecomposition().solve(H * Av);
     ph.Acl.middleRows(N_, N_) += MinvGt * F_all;
-    indeterminate_split(ph, S, stick, xa, F_all);  // forces only: H' Z = 0
+    if (!has_cone_) indeterminate_split(ph, S, stick, xa, F_all);  // forces only: H' Z = 0
+  } else if (has_cone_ && resultant_determined(S, MinvGt, H * Av, F_all)) {
+    ph.Acl.middleRows(N_, N_) += MinvGt * F_all;
   } else {
     err =
         "the constraint matrix H M^-1 G' of the mode with slip is singular (dependent "
@@ -108,12 +132,16 @@ bool EventDriven::friction_feedback(Phase& ph, const VectorXd& xa, std::string& 
     return false;
   }
   ph.F = F_all.topRows(nI);
+  if (has_cone_) ph.Ft2 = MatrixXd::Zero(ph.Ft.rows(), n_);
   for (size_t f = 0; f < ph.friction.size(); ++f) {
     const Eigen::Index fi = static_cast<Eigen::Index>(f);
-    if (ph.friction[f] == FrictionMode::kStick) {
-      ph.Ft.row(fi) = F_all.row(nI + (std::find(stick.begin(), stick.end(), fi) - stick.begin()));
-    } else if (slipping(ph.friction[f])) {
-      const auto it = std::find(ph.mode.begin(), ph.mode.end(), m.friction[f].contact);
+    if (ph.friction[f] == FrictionMode::kOpen) continue;
+    const auto it = std::find(ph.mode.begin(), ph.mode.end(), m.friction[f].contact);
+    if (is_cone(f)) {
+      cone_forces(ph, f, ph.F.row(it - ph.mode.begin()), F_all, first[f]);
+    } else if (ph.friction[f] == FrictionMode::kStick) {
+      ph.Ft.row(fi) = F_all.row(first[f]);
+    } else if (planar_slip(ph.friction[f])) {
       ph.Ft.row(fi) = -sigma_of(ph.friction[f]) * m.friction[f].mu * ph.F.row(it - ph.mode.begin());
     }
   }
@@ -174,6 +202,10 @@ void EventDriven::add_friction_monitors(Phase& ph) const {
   for (size_t f = 0; f < ph.friction.size(); ++f) {
     const FrictionMode mode = ph.friction[f];
     if (mode == FrictionMode::kOpen) continue;
+    if (is_cone(f)) {
+      add_cone_monitors(ph, f);
+      continue;
+    }
     const mech::FrictionalContact& fc = m.friction[f];
     const Eigen::Index fi = static_cast<Eigen::Index>(f);
     Monitor mon;
@@ -203,9 +235,14 @@ void EventDriven::fill_friction(Sample& s, const Phase& ph, const VectorXd& xa) 
   if (friction_contacts_.empty()) return;
   s.friction_mode = ph.friction;
   s.friction_mode.resize(friction_contacts_.size(), FrictionMode::kOpen);
+  for (FrictionMode& fm : s.friction_mode)
+    if (cone_slip(fm)) fm = FrictionMode::kSlip;  // the facet is internal (cone_phase.cpp)
   s.u_t = ph.Ft.rows() == static_cast<Eigen::Index>(friction_contacts_.size())
               ? VectorXd(ph.Ft * xa)
               : VectorXd::Zero(static_cast<Eigen::Index>(friction_contacts_.size()));
+  if (has_cone_)
+    s.lambda_T2 =
+        ph.Ft2.rows() == s.u_t.size() ? VectorXd(ph.Ft2 * xa) : VectorXd::Zero(s.u_t.size());
 }
 
 void EventDriven::set_friction(Event& e, const EventResult& ev) const {
@@ -214,6 +251,8 @@ void EventDriven::set_friction(Event& e, const EventResult& ev) const {
   e.friction_impulse = ev.friction_impulse.size() == nf ? ev.friction_impulse : VectorXd::Zero(nf);
   e.friction_mode_after = ev.friction;
   e.friction_mode_after.resize(friction_contacts_.size(), FrictionMode::kOpen);
+  for (FrictionMode& fm : e.friction_mode_after)
+    if (cone_slip(fm)) fm = FrictionMode::kSlip;
 }
 
 }  // namespace lcsim::sim::detail
