@@ -322,6 +322,27 @@ contacts: [{link: a, plane: floor, name: toe_a}]
   EXPECT_NEAR(ranges[0].range, 2 * std::asin(0.01), 1e-12);
 }
 
+// Body against body (robots/gripper_box_scene.yaml): each fingertip's
+// sphere centre lies on the normal of the box's side face through the
+// box's centre, at d from it. Rolling the box by th about its centre (x)
+// tilts the face: the exact gap changes by d (cos th - 1), the linear one
+// not at all (its row is 0 along box.rx), and the tip, seen from the box,
+// moves by 2 d |sin(th/2)|: 1 % at th = 2 asin(0.01), as for the toe
+// (same tolerance, same reasons).
+TEST(ContactRanges, FingertipAgainstATurningBoxHoldsForTwiceTheArcsine) {
+  const scene::Scene s = *scene::load_scene_details(kRobots + "gripper_box_scene.yaml");
+  const auto ranges = scene::contact_ranges(s, 0.01);
+  int tips = 0;
+  for (const auto& r : ranges) {
+    if (r.plane != "box/box") continue;
+    ++tips;
+    EXPECT_EQ(r.coordinate, "box.rx") << r.contact;
+    EXPECT_EQ(r.end, "threshold") << r.contact;
+    EXPECT_NEAR(r.range, 2 * std::asin(0.01), 1e-12) << r.contact;
+  }
+  EXPECT_EQ(tips, 2);
+}
+
 // A floating body without contacts or torque: z(t) = z0 + vz t - g t^2/2
 // and x(t) = x0 + vx t exactly (the linear model of a free body is exact),
 // the rotation unchanged. The exact method's matrix exponentials reproduce
