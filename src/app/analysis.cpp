@@ -430,7 +430,8 @@ void contacts_section(Draft& d, const std::optional<scene::Scene>& scene) {
   const std::vector<scene::ContactRange> ranges = scene::contact_ranges(*scene, threshold);
   d.j["contacts"] = scene::to_json(ranges);
   d.out << "contacts at q0 (gap m; the linear gap is off by <= " << short_number(100.0 * threshold)
-        << " % of its change for the tightest coordinate moved alone):\n";
+        << " % of the contact point's displacement for the tightest coordinate moved "
+           "alone):\n";
   for (const auto& r : ranges)
     d.out << "  " << r.contact << " on " << r.plane << ": gap " << short_number(r.gap)
           << (r.closed ? " (closed)" : "") << ", |" << r.coordinate

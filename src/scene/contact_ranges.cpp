@@ -13,25 +13,6 @@ namespace lcsim::scene {
 
 namespace {
 
-// The farthest s in (0, end] with !exceeds(s) before the first crossing:
-// 64 steps, then 50 bisections (as linear_ranges). `crossed` says whether
-// the threshold was crossed.
-template <class F>
-double scan(const F& exceeds, double end, bool& crossed) {
-  constexpr int kSteps = 64, kBisections = 50;
-  double ok = 0.0, bad = -1.0;
-  for (int k = 1; k <= kSteps && bad < 0.0; ++k) {
-    const double s = k == kSteps ? end : end * k / kSteps;
-    (exceeds(s) ? bad : ok) = s;
-  }
-  for (int k = 0; k < kBisections && bad > 0.0; ++k) {
-    const double mid = 0.5 * (ok + bad);
-    (exceeds(mid) ? bad : ok) = mid;
-  }
-  crossed = bad > 0.0;
-  return ok;
-}
-
 struct Axis {
   std::string unit;
   double lower = 0.0, upper = 0.0;  // how far it may go each way (m or rad)
@@ -54,30 +35,40 @@ Axis axis_of(const Bodies& b, std::size_t i, double q0) {
   return a;
 }
 
+// Where contact c's point is, seen from what it touches: in the world for a
+// plane, in the frame of the other body's link for a body's shape (so the
+// shape's own motion counts as the point's, relative to it).
+Eigen::Vector3d seen_point(const Bodies& dyn, const ContactFrame& c, const VectorXd& q) {
+  const Eigen::Vector3d w = dyn.link_pose(c.point.body, c.point.link, q) * c.point.local;
+  if (!c.against) return w;
+  return dyn.link_pose(c.against->body, c.against->link, q).inverse() * w;
+}
+
 // How far coordinate i can move either way (the smaller) before contact
-// c's linear gap is off by `threshold` of its change, and what ends it.
-struct Reach {
+// c's linear gap is off by `threshold` of the point's displacement, and
+// what ends it.
+struct Extent {
   double distance = std::numeric_limits<double>::infinity();
   std::string end = "search";
 };
-Reach reach_along(const Bodies& dyn, const ContactFrame& c, const std::vector<Plane>& planes,
-                  const VectorXd& q0, Eigen::Index i, const Axis& a, double threshold) {
-  Reach r;
+Extent reach_along(const Bodies& dyn, const ContactFrame& c, const std::vector<Plane>& planes,
+                   const VectorXd& q0, Eigen::Index i, const Axis& a, double threshold) {
+  Extent r;
+  const Eigen::Vector3d p0 = seen_point(dyn, c, q0);
   for (const double dir : {-1.0, 1.0}) {
     const auto exceeds = [&](double step) {
       VectorXd q = q0;
       q(i) += dir * step;
+      const double moved = (seen_point(dyn, c, q) - p0).norm();
       const double exact = signed_distance(dyn, c, planes, q) - c.gap;
       const double linear = c.normal_row(i) * dir * step;
-      const double change = std::max(std::abs(exact), std::abs(linear));
-      return change > 0.0 && std::abs(exact - linear) > threshold * change;
+      return moved > 0.0 && std::abs(exact - linear) > threshold * moved;
     };
-    bool crossed = false;
-    const double got = scan(exceeds, dir < 0 ? a.lower : a.upper, crossed);
-    if (got < r.distance) {
-      r.distance = got;
+    const Reach got = first_crossing(exceeds, dir < 0 ? a.lower : a.upper);
+    if (got.ok < r.distance) {
+      r.distance = got.ok;
       const bool limit = dir < 0 ? a.limit_lower : a.limit_upper;
-      r.end = crossed ? "threshold" : limit ? "limit" : "search";
+      r.end = got.crossed ? "threshold" : limit ? "limit" : "search";
     }
   }
   return r;
@@ -107,7 +98,7 @@ std::vector<ContactRange> contact_ranges(const Scene& s, double threshold) {
       const auto ii = static_cast<Eigen::Index>(i);
       const Axis a = axis_of(dyn, i, q0(ii));
       if (any_rad && a.unit != "rad") continue;  // rotations bend the gap; report theirs
-      const Reach got = reach_along(dyn, c, s.planes, q0, ii, a, threshold);
+      const Extent got = reach_along(dyn, c, s.planes, q0, ii, a, threshold);
       if (got.distance < r.range || r.coordinate.empty()) {
         r.coordinate = s.lin.joints[i];
         r.unit = a.unit;

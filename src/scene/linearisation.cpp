@@ -56,6 +56,20 @@ struct Evaluator {
 
 }  // namespace
 
+Reach first_crossing(const std::function<bool(double)>& exceeds, double end) {
+  constexpr int kSteps = 64, kBisections = 50;
+  double ok = 0.0, bad = -1.0;
+  for (int k = 1; k <= kSteps && bad < 0.0; ++k) {
+    const double s = k == kSteps ? end : end * k / kSteps;
+    (exceeds(s) ? bad : ok) = s;
+  }
+  for (int k = 0; k < kBisections && bad > 0.0; ++k) {
+    const double mid = 0.5 * (ok + bad);
+    (exceeds(mid) ? bad : ok) = mid;
+  }
+  return {ok, bad > 0.0};
+}
+
 void check_linearisation_threshold(double threshold) {
   if (!(threshold > 0.0) || !std::isfinite(threshold))
     throw InputError("linearisation_threshold must be a finite number > 0 (got " +
@@ -136,20 +150,9 @@ std::vector<LinearRange> linear_ranges(const Scene& scene, double threshold) {
         q(ii) += dir * s;
         return ev.at(q).max() > threshold;
       };
-      constexpr int kSteps = 64, kBisections = 50;
-      double ok = 0.0, bad = -1.0;
-      for (int k = 1; k <= kSteps && bad < 0.0; ++k) {
-        const double s = k == kSteps ? end : end * k / kSteps;
-        if (exceeds(s))
-          bad = s;
-        else
-          ok = s;
-      }
-      for (int k = 0; k < kBisections && bad > 0.0; ++k) {
-        const double mid = 0.5 * (ok + bad);
-        (exceeds(mid) ? bad : ok) = mid;
-      }
-      if (bad > 0.0) why = "threshold";
+      const Reach got = first_crossing(exceeds, end);
+      const double ok = got.ok;
+      if (got.crossed) why = "threshold";
       // At the limit itself, the URDF's number (q0 - (q0 - lower) may round).
       const double at =
           why == "limit" ? (dir < 0 ? j->limits->lower : j->limits->upper) : q0 + dir * ok;

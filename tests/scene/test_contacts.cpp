@@ -235,10 +235,15 @@ TEST_F(Contacts, BoxAtRestHasTheGapsAndForcesOfItsGeometry) {
 // analyze's contact section (scene::contact_ranges) on the box at rest:
 // the bottom corners are closed, the top ones 0.1 m open; for corner0 at
 // p = (-0.15, -0.1, -0.05) the tightest coordinate is the roll rx, where
-// the exact gap changes by py sin(th) + pz (cos(th) - 1) and the linear one
-// by py th. The 1 % crossing of their difference relative to the larger
-// change, found here by bisection on that closed form on each side (the
-// nearer one counts), agrees with the scan's 50 bisections to 1e-12 rad.
+// the exact gap changes by py sin(th) + pz (cos(th) - 1), the linear one by
+// py th, and the corner moves by 2 rho |sin(th/2)|, rho = |(py, pz)|. The
+// 1 % crossing of the gap's error relative to that displacement, found
+// here by bisection on the closed form on each side (the nearer one
+// counts), agrees with the scan's 50 bisections to 1e-12 rad (the scan's
+// bisection interval ends near 1e-17 rad; rounding in the error, ~1e-16 m
+// against a displacement ~4e-3 m, moves the crossing by ~1e-13 rad).
+// (Before the displacement was the scale, the error was taken relative to
+// the larger of the two gap changes: 0.0389915 rad then, 0.0434653 now.)
 TEST(ContactRanges, BoxCornersAtRest) {
   const scene::Scene s = *scene::load_scene_details(kRobots + "box_drop_scene.yaml");
   const auto ranges = scene::contact_ranges(s, 0.01);
@@ -248,10 +253,10 @@ TEST(ContactRanges, BoxCornersAtRest) {
     EXPECT_EQ(r.closed, !top) << r.contact;
     EXPECT_NEAR(r.gap, top ? 0.1 : 0.0, 1e-15) << r.contact;
   }
-  const double py = -0.1, pz = -0.05;
+  const double py = -0.1, pz = -0.05, rho = std::hypot(py, pz);
   const auto off = [&](double th) {
     const double exact = py * std::sin(th) + pz * (std::cos(th) - 1), linear = py * th;
-    return std::abs(exact - linear) - 0.01 * std::max(std::abs(exact), std::abs(linear));
+    return std::abs(exact - linear) - 0.01 * 2 * rho * std::abs(std::sin(th / 2));
   };
   double nearest = 10.0;
   for (const double dir : {-1.0, 1.0}) {
@@ -269,6 +274,73 @@ TEST(ContactRanges, BoxCornersAtRest) {
   EXPECT_EQ(ranges[0].unit, "rad");
   EXPECT_EQ(ranges[0].end, "threshold");
   EXPECT_NEAR(ranges[0].range, nearest, 1e-12);
+}
+
+// A leg: a revolute hip (about y) over a floor, a sphere of radius 0.05
+// at L = 0.4 m straight below it, touching the floor. Along the hip the
+// linear gap does not change (the row of E is 0 there) while the exact one
+// rises by L (1 - cos th) and the sphere's centre moves by 2 L |sin(th/2)|:
+// the error relative to that displacement is |sin(th/2)|, 1 % at
+// th = 2 asin(0.01) on both sides, whatever L. (A second leg's joint
+// does not move the sphere: it is no candidate.) Tolerance 1e-12 rad: the bisection's interval ends
+// near 1e-17 rad and rounding in L (1 - cos th) (~1e-16 m against ~8e-5 m) moves the crossing by
+// ~1e-13 rad.
+TEST_F(Contacts, ToeBelowAHipHoldsForTwiceTheArcsineOfTheThreshold) {
+  const std::string link = R"(<inertial><mass value="1"/>
+      <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>)";
+  const auto leg = [&](const std::string& n, const std::string& parent, double x) {
+    return "<link name=\"" + n + "\">" + link +
+           "<collision><origin xyz=\"0 0 -0.4\"/><geometry><sphere radius=\"0.05\"/></geometry>"
+           "</collision></link><joint name=\"" +
+           n + "_hip\" type=\"revolute\"><parent link=\"" + parent + "\"/><child link=\"" + n +
+           "\"/><origin xyz=\"" + std::to_string(x) +
+           " 0 0\"/><axis xyz=\"0 1 0\"/><limit lower=\"-3\" upper=\"3\" effort=\"1\" "
+           "velocity=\"1\"/></joint>";
+  };
+  // The leg rides on a vertical slider `lift` (so that the toe's row of E
+  // is not zero: a contact no coordinate moves is refused); in metres, it
+  // is no candidate beside the rotations.
+  const std::string urdf =
+      "<robot name=\"legs\"><link name=\"base\">" + link + "</link><link name=\"carriage\">" +
+      link +
+      "</link><joint name=\"lift\" type=\"prismatic\"><parent link=\"base\"/><child "
+      "link=\"carriage\"/><axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" "
+      "velocity=\"1\"/></joint>" +
+      leg("a", "carriage", 0.0) + leg("b", "base", 0.3) + "</robot>";
+  const scene::Scene s = load(R"(urdf: r.urdf
+joints: [{name: lift, stops: []}, {name: a_hip, stops: []}, {name: b_hip, stops: []}]
+planes: [{name: floor, point: [0, 0, -0.45], normal: [0, 0, 1]}]
+contacts: [{link: a, plane: floor, name: toe_a}]
+)",
+                              urdf);
+  const auto ranges = scene::contact_ranges(s, 0.01);
+  ASSERT_EQ(ranges.size(), 1u);
+  EXPECT_EQ(ranges[0].coordinate, "a_hip");
+  EXPECT_EQ(ranges[0].unit, "rad");
+  EXPECT_EQ(ranges[0].end, "threshold");
+  EXPECT_TRUE(ranges[0].closed);
+  EXPECT_NEAR(ranges[0].range, 2 * std::asin(0.01), 1e-12);
+}
+
+// Body against body (robots/gripper_box_scene.yaml): each fingertip's
+// sphere centre lies on the normal of the box's side face through the
+// box's centre, at d from it. Rolling the box by th about its centre (x)
+// tilts the face: the exact gap changes by d (cos th - 1), the linear one
+// not at all (its row is 0 along box.rx), and the tip, seen from the box,
+// moves by 2 d |sin(th/2)|: 1 % at th = 2 asin(0.01), as for the toe
+// (same tolerance, same reasons).
+TEST(ContactRanges, FingertipAgainstATurningBoxHoldsForTwiceTheArcsine) {
+  const scene::Scene s = *scene::load_scene_details(kRobots + "gripper_box_scene.yaml");
+  const auto ranges = scene::contact_ranges(s, 0.01);
+  int tips = 0;
+  for (const auto& r : ranges) {
+    if (r.plane != "box/box") continue;
+    ++tips;
+    EXPECT_EQ(r.coordinate, "box.rx") << r.contact;
+    EXPECT_EQ(r.end, "threshold") << r.contact;
+    EXPECT_NEAR(r.range, 2 * std::asin(0.01), 1e-12) << r.contact;
+  }
+  EXPECT_EQ(tips, 2);
 }
 
 // A floating body without contacts or torque: z(t) = z0 + vz t - g t^2/2

@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <cstddef>
+#include <functional>
 #include <lcsim/scene/scene.hpp>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -63,6 +64,18 @@ class LinearisationStates {
 std::string linearisation_warning(const LinearisationCheck& check, double threshold);
 void check_linearisation_threshold(double threshold);
 
+// The scan both ranges below use along one coordinate, from 0 outwards to
+// `end` (> 0): exceeds(s) at s = end k / 64, k = 1..64, until the first s
+// where it holds, then 50 bisections between that s and the last one where
+// it did not. `ok` is the farthest s before the first crossing (end when
+// none), `crossed` whether there was one. exceeds need not be monotone: a
+// crossing the 64 steps skip over is not seen.
+struct Reach {
+  double ok = 0.0;
+  bool crossed = false;
+};
+Reach first_crossing(const std::function<bool(double)>& exceeds, double end);
+
 // Per simulated joint, the interval of q about q0 (other joints at q0) in
 // which e(q) <= threshold: from q0 outwards in 64 steps to the joint's limit
 // (or pi rad / 1 m when it has none), then 50 bisections where e first
@@ -85,13 +98,18 @@ std::vector<LinearRange> linear_ranges(const Scene& scene, double threshold);
 // Per contact of the scene (Scene::contacts, in row order): its gap at q0
 // (the model's E q0 + g, m), whether it is closed there
 // (mech::gap_is_zero), and how far the configuration can move before the
-// linear gap is off by more than `threshold`. Along each coordinate alone
-// (others at q0) the error of the linear gap is
-//   e = |phi(q) - gap_lin(q)| / max(|phi(q) - phi(q0)|, |gap_lin(q) - phi(q0)|)
-// (0 where both changes vanish: a rotation about the plane's normal), the
-// error relative to the gap's change since q0; it is scanned as
-// linear_ranges scans (64 steps to pi rad, 1 m or the joint's limit, then
-// 50 bisections), both ways, and `range` is the smaller distance reached,
+// linear gap is off by more than `threshold` of the contact point's own
+// displacement. Along each coordinate alone (others at q0) the error is
+//   e = |phi(q) - gap_lin(q)| / |p(q) - p(q0)|,
+// p the contact point (the link point, the sphere's centre for a sphere)
+// seen from what it touches: in the world for a plane, in the frame of
+// the other body's link for a body's shape. The scale does not vanish where
+// the gap's row does not depend on the coordinate (a toe straight below its
+// hip: e = |sin(th/2)|, 1 % at th = 2 asin(0.01) ~ 0.0200 rad); a
+// coordinate that does not move p (|p(q) - p(q0)| = 0: another leg's joint,
+// a sphere turning about its centre) never ends a range. It is scanned by
+// first_crossing (64 steps to pi rad, 1 m or the joint's limit, then 50
+// bisections), both ways, and `range` is the smaller distance reached,
 // `coordinate` the coordinate whose range is the smallest among those in
 // rad (rotations bend the gap; a translation or prismatic joint along
 // which the point moves straight never does), or among all if none is a
