@@ -157,6 +157,15 @@ bool local_cone(const Local& L, Eigen::Vector3d& x, int& facet) {
 double cone_residual(const ConeGsProblem& p, const VectorXd& lambda, const VectorXd& u) {
   double res = 0.0;
   const int nN = p.n_normal, nF = p.n_friction;
+  std::vector<Polygon> polygons;  // the edges' tables by d (no trigonometry per contact)
+  auto polygon = [&](int d) -> const Polygon& {
+    for (const Polygon& q : polygons)
+      if (q.d == d) return q;
+    polygons.emplace_back(d);
+    return polygons.back();
+  };
+  for (const int d : *p.d)
+    if (d > 1) polygon(d);
   for (int a = 0; a < nN; ++a) {
     res = std::max(res, std::abs(std::min(lambda(a), u(a))));
     const int t = (*p.tangent_of)[static_cast<size_t>(a)];
@@ -169,17 +178,13 @@ double cone_residual(const ConeGsProblem& p, const VectorXd& lambda, const Vecto
       xi = std::abs(u1);
       b0 = std::max(p1, 0.0), b1 = std::max(-p1, 0.0), w0 = u1 + xi, w1 = -u1 + xi;
     } else {
-      const double step = kPi / d;
-      int i = static_cast<int>(std::floor(std::atan2(p2, p1) / step));
-      i = ((i % (2 * d)) + 2 * d) % (2 * d);
-      const auto [ci, si] = impact::cone_edge(i, d);
-      const auto [cj, sj] = impact::cone_edge((i + 1) % (2 * d), d);
+      const Polygon& P = polygon(d);
+      const int i = P.wrap(static_cast<int>(std::floor(std::atan2(p2, p1) * d / kPi)));
+      const int k1 = P.wrap(i + 1);
+      const double ci = P.c[i], si = P.s[i], cj = P.c[k1], sj = P.s[k1];
       const double det = ci * sj - si * cj;  // sin(pi/d) > 0
       b0 = (p1 * sj - p2 * cj) / det, b1 = (ci * p2 - si * p1) / det;
-      for (int k = 0; k < 2 * d; ++k) {
-        const auto [ck, sk] = impact::cone_edge(k, d);
-        xi = std::max(xi, -(ck * u1 + sk * u2));
-      }
+      for (int k = 0; k < 2 * d; ++k) xi = std::max(xi, -(P.c[k] * u1 + P.s[k] * u2));
       w0 = ci * u1 + si * u2 + xi, w1 = cj * u1 + sj * u2 + xi;
     }
     res = std::max({res, std::abs(std::min(b0, w0)), std::abs(std::min(b1, w1)),
