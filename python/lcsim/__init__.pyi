@@ -75,7 +75,8 @@ class Event:
     mode: list[int]
     note: str
     friction_impulse: np.ndarray  # per frictional contact (empty without friction)
-    friction_modes: list[str]  # 'open', 'stick', 'slip+', 'slip-' or 'slip' (3-D) after the event
+    friction_impulse2: np.ndarray  # along the second tangents (empty without 3-D friction)
+    friction_modes: list[str]  # 'open', 'stick', 'slip+', 'slip-', 'slip-edge-<i>', 'slip-face-<i>'
     dt: list[Optional[float]]  # d t_event / d sensitivity column, None where absent
 
 class Trajectory:
@@ -85,6 +86,10 @@ class Trajectory:
     u: np.ndarray
     u_t: np.ndarray  # tangential multipliers, (n, frictional contacts)
     friction_modes: np.ndarray  # int8 (n, frictional contacts): FRICTION_MODES index, -1 none
+    u_t2: np.ndarray  # second tangents' multipliers, (n, contacts) with 3-D friction, else (n, 0)
+    friction_facets: np.ndarray  # int16 like u_t2: 2i edge i, 2i+1 face i, -1 none
+    @property
+    def friction_mode_names(self) -> list[list[Optional[str]]]: ...
     y: np.ndarray
     modes: np.ndarray
     @property

@@ -18,6 +18,16 @@ namespace {
 using Eigen::VectorXd;
 
 constexpr std::int8_t kNoFrictionMode = -1;
+constexpr std::int16_t kNoFacet = -1;
+
+// A cone facet as Trajectory.friction_facets holds it: 2i for edge i, 2i + 1
+// for the face between edges i and i + 1, -1 for none.
+std::int16_t facet_code(impact::ConeFacet f) {
+  return f.edge < 0 ? kNoFacet : static_cast<std::int16_t>(2 * f.edge + (f.face ? 1 : 0));
+}
+impact::ConeFacet facet_of_code(std::int16_t c) {
+  return c < 0 ? impact::ConeFacet{} : impact::ConeFacet{c / 2, c % 2 == 1};
+}
 
 // Samples as they stream from the run (sim::Options::sample_sink), row
 // after row, sized by the model (as the CSV is): a sample without u or y
@@ -28,15 +38,20 @@ struct SampleBuffers {
   // n x frictional contacts: sim::FrictionMode's value, kNoFrictionMode where
   // the sample records none.
   std::vector<std::int8_t> friction_mode;
+  // Models with 3-D friction (empty otherwise): n x frictional contacts, the
+  // multipliers along the second tangents and the facets (facet_code).
+  std::vector<double> u_t2;
+  std::vector<std::int16_t> facet;
   // Forward sensitivities (Options::sensitivity): n x state x columns, and
   // n x columns with 1 where the column's derivative exists.
   std::vector<double> dx;
   std::vector<std::uint8_t> dx_ok;
-  py::ssize_t nx = 0, k = 0, nf = 0, nc = 0;
+  py::ssize_t nx = 0, k = 0, nf = 0, nc = 0, nf3 = 0;  // nf3: nf with 3-D friction, else 0
   explicit SampleBuffers(const mech::Model& m)
       : nx(m.state_size()),
         k(m.num_constraints()),
-        nf(m.is_mechanical() ? static_cast<py::ssize_t>(m.mechanical->friction.size()) : 0) {}
+        nf(m.is_mechanical() ? static_cast<py::ssize_t>(m.mechanical->friction.size()) : 0),
+        nf3(m.is_mechanical() && m.mechanical->has_friction_3d() ? nf : 0) {}
   void reserve(std::size_t n) {
     const auto rows = [n](py::ssize_t w) { return n * static_cast<std::size_t>(w); };
     t.reserve(n);
@@ -63,6 +78,13 @@ struct SampleBuffers {
                                     ? static_cast<std::int8_t>(s.friction_mode[j])
                                     : kNoFrictionMode);
     }
+    if (nf3 > 0) {
+      append(u_t2, s.u_t2, nf3);
+      for (py::ssize_t j = 0; j < nf3; ++j)
+        facet.push_back(s.friction_facet.size() == static_cast<std::size_t>(nf3)
+                            ? facet_code(s.friction_facet[static_cast<std::size_t>(j)])
+                            : kNoFacet);
+    }
     if (s.dx.size() > 0) {
       nc = s.dx.cols();
       for (Eigen::Index r = 0; r < s.dx.rows(); ++r)
@@ -85,6 +107,8 @@ struct Run {
   py::array_t<double> t, x, u, y;
   py::array_t<double> u_t;                  // tangential multipliers, n x frictional contacts
   py::array_t<std::int8_t> friction_modes;  // n x frictional contacts (SampleBuffers)
+  py::array_t<double> u_t2;                 // n x frictional contacts (3-D), else n x 0
+  py::array_t<std::int16_t> facets;         // n x frictional contacts (3-D; facet_code)
   py::array modes;                          // bool, n x k
   py::array_t<double> dx;                   // n x state x columns (SampleBuffers)
   py::array_t<std::uint8_t> dx_ok;          // n x columns
@@ -105,6 +129,11 @@ struct Run {
     if (nf > 0 && friction_modes.at(i, 0) != kNoFrictionMode)
       for (py::ssize_t j = 0; j < nf; ++j)
         s.friction_mode.push_back(static_cast<sim::FrictionMode>(friction_modes.at(i, j)));
+    if (u_t2.shape(1) > 0) {
+      s.u_t2 = recorded(row(u_t2));
+      for (py::ssize_t j = 0; j < facets.shape(1); ++j)
+        s.friction_facet.push_back(facet_of_code(facets.at(i, j)));
+    }
     const py::ssize_t k = modes.shape(1);
     const auto* on = static_cast<const std::uint8_t*>(modes.data()) + i * k;
     for (py::ssize_t j = 0; j < k; ++j)
@@ -181,6 +210,8 @@ std::shared_ptr<Run> simulate(const ModelHandle& model, const std::optional<Vect
   run->y = numpy_owning(std::move(buf.y), {n, buf.k});
   run->u_t = numpy_owning(std::move(buf.u_t), {n, buf.nf});
   run->friction_modes = numpy_owning(std::move(buf.friction_mode), {n, buf.nf});
+  run->u_t2 = numpy_owning(std::move(buf.u_t2), {n, buf.nf3});
+  run->facets = numpy_owning(std::move(buf.facet), {n, buf.nf3});
   run->modes =
       numpy_owning(std::move(buf.active), {n, buf.k}).attr("view")("bool").cast<py::array>();
   const py::ssize_t nc = static_cast<py::ssize_t>(run->traj.sensitivity_columns.size());
@@ -209,14 +240,22 @@ void bind_event(py::module_& m) {
   e.def_readonly("friction_impulse", &sim::Event::friction_impulse,
                  "Tangential impulse per frictional contact (model order; empty without "
                  "friction).");
+  e.def_readonly("friction_impulse2", &sim::Event::friction_impulse2,
+                 "Impulse along the second tangent per frictional contact (model order, N s; "
+                 "empty without 3-D friction).");
   e.def_property_readonly(
       "friction_modes",
       [](const sim::Event& ev) {
         std::vector<std::string> out;
-        for (sim::FrictionMode fm : ev.friction_mode_after) out.emplace_back(sim::to_string(fm));
+        const auto& fa = ev.friction_facet_after;
+        for (std::size_t j = 0; j < ev.friction_mode_after.size(); ++j)
+          out.push_back(fa.size() == ev.friction_mode_after.size()
+                            ? sim::friction_mode_text(ev.friction_mode_after[j], fa[j])
+                            : std::string(sim::to_string(ev.friction_mode_after[j])));
         return out;
       },
-      "Mode per frictional contact after the event: 'open', 'stick', 'slip+' or 'slip-'.");
+      "Mode per frictional contact after the event: 'open', 'stick', 'slip+', 'slip-', or for "
+      "a 3-D contact 'slip-edge-<i>' / 'slip-face-<i>' ('slip' where the facet is unknown).");
   e.def_property_readonly(
       "dt",
       [](const sim::Event& ev) {
@@ -246,6 +285,37 @@ void bind_samples(RunClass& r) {
       "Modes of the frictional contacts (model order), shape (n, contacts), int8: 0 "
       "open, 1 stick, 2 slip+, 3 slip-, 4 slip (3-D) (lcsim.FRICTION_MODES); -1 where the method "
       "does not determine them.");
+  r.def_readonly("u_t2", &Run::u_t2,
+                 "Multipliers along the second tangents (N, model order), shape (n, contacts) "
+                 "for a model with 3-D friction (0 for a planar entry), (n, 0) otherwise; NaN "
+                 "where a sample records none.");
+  r.def_readonly("friction_facets", &Run::facets,
+                 "The cone facet of each sliding 3-D contact, shape as u_t2, int16: 2i for "
+                 "edge i, 2i + 1 for the face between edges i and i + 1, -1 for none.");
+  r.def_property_readonly(
+      "friction_mode_names",
+      [](const Run& run) {
+        py::list rows;
+        const py::ssize_t n = run.friction_modes.shape(0), nf = run.friction_modes.shape(1);
+        const bool cone = run.facets.shape(1) == nf && nf > 0;
+        for (py::ssize_t i = 0; i < n; ++i) {
+          py::list row;
+          for (py::ssize_t j = 0; j < nf; ++j) {
+            const std::int8_t m = run.friction_modes.at(i, j);
+            if (m == kNoFrictionMode) {
+              row.append(py::none());
+              continue;
+            }
+            const impact::ConeFacet f =
+                cone ? facet_of_code(run.facets.at(i, j)) : impact::ConeFacet{};
+            row.append(sim::friction_mode_text(static_cast<sim::FrictionMode>(m), f));
+          }
+          rows.append(std::move(row));
+        }
+        return rows;
+      },
+      "The modes as the CSV's fm_ columns write them, one list per sample: 'open', 'stick', "
+      "'slip+', 'slip-', 'slip-edge-<i>', 'slip-face-<i>' (None where not determined).");
   r.def_readonly("x", &Run::x, "States, shape (n, state size): q then v for mechanical models.");
   r.def_readonly("u", &Run::u,
                  "Multipliers (regular part), shape (n, constraints); NaN where not recorded.");

@@ -213,6 +213,9 @@ std::vector<std::string> csv_header(const mech::Model& model) {
     for (const auto& c : m.constraints) header.push_back("y_" + c);
     // Friction only: models without it keep their columns byte for byte.
     for (const auto& f : m.friction) header.push_back("ut_" + m.constraints[f.contact]);
+    // 3-D friction only: planar models keep their columns byte for byte.
+    if (m.has_friction_3d())
+      for (const auto& f : m.friction) header.push_back("ut2_" + m.constraints[f.contact]);
     for (const auto& f : m.friction) header.push_back("fm_" + m.constraints[f.contact]);
   } else {
     // Names when the model gives them (circuits), else x1.., u1.., y1...
@@ -254,6 +257,10 @@ int friction_count(const mech::Model& model) {
   return model.is_mechanical() ? static_cast<int>(model.mechanical->friction.size()) : 0;
 }
 
+bool friction_3d(const mech::Model& model) {
+  return model.is_mechanical() && model.mechanical->has_friction_3d();
+}
+
 // The friction modes of a sample (nf cells, blank when it records none).
 void append_csv_friction_modes(std::string& out, const sim::Sample& s, int nf, std::size_t r) {
   const std::size_t size = s.friction_mode.size();
@@ -263,7 +270,11 @@ void append_csv_friction_modes(std::string& out, const sim::Sample& s, int nf, s
                            std::to_string(nf));
   for (std::size_t j = 0; j < static_cast<std::size_t>(nf); ++j) {
     out += ',';
-    if (size != 0) out += sim::to_string(s.friction_mode[j]);
+    if (size == 0) continue;
+    if (s.friction_facet.size() == size)
+      out += sim::friction_mode_text(s.friction_mode[j], s.friction_facet[j]);
+    else
+      out += sim::to_string(s.friction_mode[j]);
   }
 }
 
@@ -289,9 +300,10 @@ CsvOutputs csv_outputs(const mech::Model& model) {
 
 // Row `r` of the CSV: t, x, u, y, the outputs (LCS models that have them),
 // the tangential multipliers and friction modes (nf of each, models with
-// friction only), mode.
-void append_csv_row(std::string& out, const sim::Sample& s, int n, int k, int nf, std::size_t r,
-                    const CsvOutputs& outputs) {
+// friction only; the multipliers along the second tangents when `cone`, the
+// model has 3-D friction), mode.
+void append_csv_row(std::string& out, const sim::Sample& s, int n, int k, int nf, bool cone,
+                    std::size_t r, const CsvOutputs& outputs) {
   if (s.x.size() != n)
     throw std::logic_error("trajectory_csv: sample " + std::to_string(r) + " has a state of size " +
                            std::to_string(s.x.size()) + ", expected " + std::to_string(n));
@@ -302,6 +314,7 @@ void append_csv_row(std::string& out, const sim::Sample& s, int n, int k, int nf
   append_csv_outputs(out, s, outputs);
   if (nf > 0) {
     append_csv_vector(out, s.u_t, nf, "u_t", r);
+    if (cone) append_csv_vector(out, s.u_t2, nf, "u_t2", r);
     append_csv_friction_modes(out, s, nf, r);
   }
   out += ',';
@@ -325,7 +338,7 @@ std::string trajectory_csv(const mech::Model& model, const sim::Trajectory& traj
   const int n = model.state_size(), k = model.num_constraints(), nf = friction_count(model);
   const CsvOutputs outputs = csv_outputs(model);
   for (std::size_t r = 0; r < traj.samples.size(); ++r)
-    append_csv_row(out, traj.samples[r], n, k, nf, r, outputs);
+    append_csv_row(out, traj.samples[r], n, k, nf, friction_3d(model), r, outputs);
   return out;
 }
 
@@ -337,6 +350,7 @@ TrajectoryCsvWriter::TrajectoryCsvWriter(const std::filesystem::path& path,
       n_(model.state_size()),
       k_(model.num_constraints()),
       nf_(friction_count(model)),
+      cone_(friction_3d(model)),
       outputs_(csv_outputs(model)) {
   TemporaryFile t = temporary_beside(path);
   fd_ = t.fd;
@@ -354,7 +368,7 @@ TrajectoryCsvWriter::~TrajectoryCsvWriter() {
 void TrajectoryCsvWriter::write(const sim::Sample& s) noexcept {
   if (fd_ < 0 || error_ != 0 || !logic_error_.empty()) return;
   try {
-    append_csv_row(buffer_, s, n_, k_, nf_, rows_++, outputs_);
+    append_csv_row(buffer_, s, n_, k_, nf_, cone_, rows_++, outputs_);
   } catch (const std::exception& e) {
     logic_error_ = e.what();
     return;
@@ -400,9 +414,14 @@ nlohmann::json trajectory_json(const mech::Model& model, const sim::Trajectory& 
     if (friction_count(model) > 0) {  // frictionless models keep their keys
       events.back()["friction_impulse"] = to_json(e.friction_impulse);
       nlohmann::json modes = nlohmann::json::array();
-      for (sim::FrictionMode fm : e.friction_mode_after)
-        modes.push_back(std::string(sim::to_string(fm)));
+      const auto& fa = e.friction_facet_after;
+      for (std::size_t j = 0; j < e.friction_mode_after.size(); ++j)
+        modes.push_back(fa.size() == e.friction_mode_after.size()
+                            ? sim::friction_mode_text(e.friction_mode_after[j], fa[j])
+                            : std::string(sim::to_string(e.friction_mode_after[j])));
       events.back()["friction_mode_after"] = std::move(modes);
+      if (friction_3d(model))  // planar models keep their keys
+        events.back()["friction_impulse2"] = to_json(e.friction_impulse2);
     }
   }
   j["events"] = std::move(events);

@@ -92,6 +92,7 @@ std::optional<ModelProblem> check_friction_3d(const MechanicalModel& m, const Fr
   if (c.velocity != 0.0)
     return ModelProblem{at + ".velocity", "a moving surface is planar only (got " +
                                               short_number(c.velocity) + " with two tangents)"};
+  if (c.world_frame) return std::nullopt;  // orthonormal in the world (FrictionalContact)
   const Eigen::SparseVector<double> n = m.E.row(c.contact).transpose();
   const std::string row = "the normal row E[" + std::to_string(c.contact) + "]";
   const std::pair<std::string, double> pairs[] = {

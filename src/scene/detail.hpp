@@ -196,10 +196,25 @@ std::vector<Plane> read_planes(const Keys& keys, const std::string& source);
 // `contacts:` and `contact_options:` (scene_contacts.cpp): each contact
 // point's row added to `out` (after the joint stops and constraints), its
 // frame returned with its row; a note when points were dropped.
+// A contact's friction (`friction:` mu and `d:` per entry of `contacts:` or
+// in `contact_options:`, scene_contact_friction.cpp): mu < 0 frictionless.
+struct ContactFriction {
+  double mu = -1.0;
+  int d = 0;  // 0: the model's default
+};
 struct SceneContacts {
   std::vector<ContactFrame> frames;
+  std::vector<ContactFriction> friction;  // per frame
   std::vector<std::string> notes;
 };
+// The `friction:` and `d:` keys of `ck` (at `k`: a contacts entry, or
+// contact_options), `dflt` where absent; checked (mu >= 0 finite, d a whole
+// number in [1, 1024], d only with friction).
+ContactFriction read_contact_friction(const Keys& ck, const std::string& source,
+                                      const std::string& k, const ContactFriction& dflt);
+// The 3-D frictional contacts of the frames with friction (mech::FrictionalContact:
+// the frame's tangent rows, world_frame), appended to m.friction.
+void add_contact_friction(const SceneContacts& sc, mech::MechanicalModel& m);
 // A body as contacts name it: "" in a one-URDF scene (a link is named
 // alone), else its name (a link is named "<body>/<link>").
 struct ContactBody {

@@ -162,6 +162,7 @@ Scene read_scene(const std::string& yaml_text, const std::string& source) {
       add_contacts(keys, source, {{"", &urdf}}, planes, bodies, q0v, constraints);
   check_unique_names(constraints, source);
   mech::MechanicalModel m = assemble(lin, dyn, constraints, joints);
+  add_contact_friction(contacts, m);
   m.restitution = read_restitution(keys, source, m.constraints);
   check_mass_matrix(lin.M, joints, source);
   model.initial = read_initial(keys, source, simulated(joints, urdf), joints, q0v);

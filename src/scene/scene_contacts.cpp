@@ -30,13 +30,15 @@ constexpr double kPenetrationTolerance = 1e-6;
 struct ContactOptions {
   double max_distance = std::numeric_limits<double>::infinity();  // m
   double penetration_tolerance = kPenetrationTolerance;           // m
+  ContactFriction friction;  // every contact's default (scene_contact_friction.cpp)
 };
 
 ContactOptions read_options(const Keys& keys, const std::string& source) {
   ContactOptions o;
   if (!keys.count("contact_options")) return o;
   const Keys ok = io::yaml::mapping(keys.at("contact_options"), source, "contact_options",
-                                    {"max_distance", "penetration_tolerance"});
+                                    {"max_distance", "penetration_tolerance", "friction", "d"});
+  o.friction = read_contact_friction(ok, source, "contact_options", ContactFriction{});
   for (const auto& [key, value] : {std::pair<const char*, double*>{"max_distance", &o.max_distance},
                                    {"penetration_tolerance", &o.penetration_tolerance}}) {
     if (!ok.count(key)) continue;
@@ -153,8 +155,10 @@ SceneContacts add_contacts(const Keys& keys, const std::string& source,
   std::size_t dropped = 0, total = 0;
   for (std::size_t i = 0; i < cn.size(); ++i) {
     const std::string k = "contacts[" + std::to_string(i) + "]";
-    const Keys ck = io::yaml::mapping(cn[i], source, k,
-                                      {"link", "plane", "against", "points", "radius", "name"});
+    const Keys ck = io::yaml::mapping(
+        cn[i], source, k,
+        {"link", "plane", "against", "points", "radius", "name", "friction", "d"});
+    const ContactFriction friction = read_contact_friction(ck, source, k, opt.friction);
     if (!ck.count("link")) fail(source, k + ".link", "missing");
     const LinkRef ref = find_link(bodies, ck.at("link"), source, k + ".link");
     if (!ck.count("against")) plane_named(ck, source, k, planes);  // checked before the points
@@ -183,6 +187,7 @@ SceneContacts add_contacts(const Keys& keys, const std::string& source,
       f.row = static_cast<Eigen::Index>(out.rows.size());
       out.add(f.normal_row, f.gap - f.normal_row.dot(q0), f.point.name);
       sc.frames.push_back(std::move(f));
+      sc.friction.push_back(friction);
     }
   }
   if (dropped > 0)

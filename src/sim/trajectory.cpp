@@ -45,6 +45,12 @@ std::string_view to_string(FrictionMode m) {
   return "unknown";
 }
 
+std::string friction_mode_text(FrictionMode m, impact::ConeFacet facet) {
+  if (m == FrictionMode::kSlip && facet.edge >= 0)
+    return impact::cone_mode_text(impact::ContactOutcome::kSlip, facet);
+  return std::string(to_string(m));
+}
+
 void Trajectory::record_sample(Sample s, const Options& opt) {
   if (opt.sample_sink)
     opt.sample_sink(s);

@@ -78,3 +78,72 @@ def test_a_three_dimensional_contact_built_in_python():
             M=np.eye(3), E=np.array([[0.0, 0.0, 1.0]]),
             friction=[{"contact": 0, "tangents": [[1, 0, 0], [0, 1, 0]], "mu": 0.5, "d": 0}])
     assert str(e.value) == "friction[0].d: must be >= 1 (got 0)"
+
+
+def test_moreau_jean_outputs_the_second_tangent_and_the_facet(tmp_path, lcsim_binary):
+    """A slide on the bisector of edges 0 and 1 (d = 4): u_t2 is the force along t2,
+    mu g cos(pi/8) sin(pi/8) against the velocity (unit mass), the facet face 4 (code
+    2*4 + 1 = 9), the same numbers and names as the CLI's CSV columns ut2_floor and
+    fm_floor."""
+    a = math.pi / 8
+    path = tmp_path / "p3.yaml"
+    path.write_text(MODEL.replace("M: [[1, 0, 0], [0, 1, 0], [0, 0, 1]]",
+                                  "M: [[1, 0, 0], [0, 1, 0], [0, 0, 1]]\n  f: [0, 0, -9.81]")
+                    % (", d: 4", math.cos(a), math.sin(a)))
+    text = path.read_text().replace(", -2]", ", 0]")
+    path.write_text(text)
+    run = lcsim.simulate(lcsim.load(str(path)), method="moreau-jean", t_end=0.05, h=1e-3,
+                         dt_out=0.01)
+    assert run.ok, run.message
+    assert run.u_t2.shape == (len(run.t), 1)
+    assert run.friction_facets.shape == (len(run.t), 1)
+    F = 0.5 * 9.81 * math.cos(a)
+    # Rounding of the step's implicit solve: 1e-12 relative to the force.
+    assert np.all(np.abs(run.u_t2[1:, 0] + F * math.sin(a)) < 1e-12 * F)
+    assert np.all(run.friction_facets[1:, 0] == 9)
+    names = run.friction_mode_names
+    assert all(row == ["slip-face-4"] for row in names[1:])
+    out = tmp_path / "p3.csv"
+    r = subprocess.run([str(lcsim_binary), "simulate", str(path), "--method", "moreau-jean",
+                        "--t-end", "0.05", "--h", "1e-3", "--dt-out", "0.01", "--out", str(out)],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    lines = out.read_text().splitlines()
+    head = lines[0].split(",")
+    i, j = head.index("ut2_floor"), head.index("fm_floor")
+    assert j == i + 1 and head[i - 1] == "ut_floor"
+    for k, line in enumerate(lines[2:], start=1):
+        cells = line.split(",")
+        assert float(cells[i]) == run.u_t2[k, 0]
+        assert cells[j] == names[k][0]
+
+
+def test_planar_runs_have_no_second_tangent(tmp_path):
+    path = tmp_path / "p2.yaml"
+    path.write_text(MODEL.replace("tangents: [[1, 0, 0], [0, 1, 0]]", "tangent: [1, 0, 0]")
+                    % ("", 1.0, 0.0))
+    run = lcsim.simulate(lcsim.load(str(path)), method="moreau-jean", t_end=0.01)
+    assert run.ok, run.message
+    assert run.u_t2.shape == (len(run.t), 0)
+    assert run.friction_facets.shape == (len(run.t), 0)
+
+
+def test_bad_3d_friction_is_one_line_and_exit_2_from_simulate(tmp_path, lcsim_binary):
+    """mu < 0, d < 1, tangents not orthogonal to the normal, a friction entry on an
+    unknown contact: each one line naming the entry and the value, exit 2."""
+    cases = [
+        ("mu: 0.5", "mu: -0.5", "mechanical.friction[0].mu: must be >= 0 (got -0.5)"),
+        ("mu: 0.5", "mu: 0.5, d: 0", "mechanical.friction[0].d: must be a whole number >= 1"),
+        ("tangents: [[1, 0, 0], [0, 1, 0]]", "tangents: [[1, 0, 0.5], [0, 1, 0]]",
+         "tangents[0] and the normal row E[0] are not orthogonal"),
+        ("contact: floor", "contact: roof",
+         "mechanical.friction[0].contact: no constraint named 'roof'"),
+    ]
+    for old, new, want in cases:
+        path = tmp_path / "bad.yaml"
+        path.write_text((MODEL % ("", 1.0, 0.0)).replace(old, new))
+        r = subprocess.run([str(lcsim_binary), "simulate", str(path), "--method", "moreau-jean",
+                            "--t-end", "0.01"], capture_output=True, text=True)
+        assert r.returncode == 2, (new, r.stderr)
+        assert r.stderr.count("\n") == 1, r.stderr
+        assert want in r.stderr, r.stderr

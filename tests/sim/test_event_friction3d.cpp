@@ -296,7 +296,7 @@ TEST(EventFriction3d, BoxOnFourCornersSlidesAsTheBlock) {
       EXPECT_LE(rel(tr.final_state(1), cf.y), kRel) << at;
       EXPECT_LE(tr.final_state.segment(2, 3).cwiseAbs().maxCoeff(), 1e-14) << at;  // flat
       for (const sim::Sample& s : tr.samples) {
-        ASSERT_EQ(s.lambda_T2.size(), 4);
+        ASSERT_EQ(s.u_t2.size(), 4);
         const bool sliding = s.t > 1e-9 && s.t < cf.t_stop - 1e-9;
         const double vx = s.x(5), vy = s.x(6), sp = std::hypot(vx, vy);
         double support = -1e300;  // max_i D_i.s
@@ -309,10 +309,10 @@ TEST(EventFriction3d, BoxOnFourCornersSlidesAsTheBlock) {
         for (int c = 0; c < 4; ++c) {
           EXPECT_GE(s.u(c), 0.0) << at;
           load += s.u(c);
-          work += s.u_t(c) * vx + s.lambda_T2(c) * vy;
+          work += s.u_t(c) * vx + s.u_t2(c) * vy;
           // Each corner: maximal dissipation F.s = -mu N max_i D_i.s.
           if (sliding) {
-            EXPECT_NEAR(s.u_t(c) * vx + s.lambda_T2(c) * vy, -kMu * s.u(c) * support,
+            EXPECT_NEAR(s.u_t(c) * vx + s.u_t2(c) * vy, -kMu * s.u(c) * support,
                         1e-12 * kMu * 4.0 * kG * sp)
                 << at << " t = " << s.t;
           }
@@ -400,7 +400,7 @@ TEST(EventFriction3d, RandomModelsDissipateAndKeepTheCoulombLaw) {
       e_prev = std::min(e_prev, e);
       for (int c = 0; c < k; ++c) {
         const mech::FrictionalContact& fc = model.mechanical->friction[static_cast<size_t>(c)];
-        const double uN = s.u(c), Fx = s.u_t(c), Fy = s.lambda_T2(c);
+        const double uN = s.u(c), Fx = s.u_t(c), Fy = s.u_t2(c);
         const double force = 1e-9 * (1.0 + std::abs(uN));  // rounding of a phase's forces
         EXPECT_GE(uN, -force) << trial;
         const int d = dd[static_cast<size_t>(c)];

@@ -13,7 +13,11 @@ namespace lcsim::io {
 
 // CSV with header t, state (q names then v names for mechanical models, x1..
 // or the model's state names otherwise), u1.. (u_<pair>), y1.. (y_<pair>),
-// the model's outputs, mode (active constraints joined by ';').
+// the model's outputs, for models with friction ut_<contact> (the tangential
+// multiplier, N), ut2_<contact> (along the second tangent, N; models with
+// 3-D friction only) and fm_<contact> (the mode: open, stick, slip+, slip-,
+// or for a 3-D contact slip-edge-<i> / slip-face-<i>), mode (active
+// constraints joined by ';').
 std::string trajectory_csv(const mech::Model& model, const sim::Trajectory& traj);
 
 // The names of the state's entries as the trajectory CSV has them: the
@@ -52,6 +56,7 @@ class TrajectoryCsvWriter {
   static constexpr std::size_t kBufferBytes = 1 << 20;
   std::string path_, temporary_, buffer_, logic_error_;
   int n_ = 0, k_ = 0, nf_ = 0, fd_ = -1, error_ = 0;  // nf_: frictional contacts
+  bool cone_ = false;  // the model has 3-D friction: the ut2_ columns
   std::size_t rows_ = 0;
   CsvOutputs outputs_;
 };

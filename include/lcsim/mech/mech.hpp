@@ -55,6 +55,12 @@ struct FrictionalContact {
   // the case d = 1 (edges +t and -t).
   Eigen::SparseVector<double> tangent2;
   int edges = 0;  // d >= 1, or 0 for the model's default
+  // The tangents are t_k' J of an orthonormal world frame (t_1, t_2, n) at a
+  // contact point with Jacobian J (a scene's contact, scene::ContactFrame):
+  // the frame is orthonormal where it was built, and the rows in generalised
+  // coordinates (rotations among them) need not be Euclidean-orthogonal, so
+  // check_mechanical skips its orthogonality and equal-length tests.
+  bool world_frame = false;
   bool is_3d() const { return tangent2.size() > 0; }
 
   FrictionalContact() = default;

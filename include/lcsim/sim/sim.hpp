@@ -36,6 +36,10 @@ std::string_view to_string(EventType t);
 // contact (two tangents) sliding, its friction on the cone's boundary.
 enum class FrictionMode : signed char { kOpen, kStick, kSlipPositive, kSlipNegative, kSlip };
 std::string_view to_string(FrictionMode m);  // "open", "stick", "slip+", "slip-", "slip"
+// A contact's mode as the outputs write it: to_string(m), except a 3-D slip
+// on a known facet (facet.edge >= 0): "slip-edge-<i>" or "slip-face-<i>"
+// (impact::cone_mode_text's names).
+std::string friction_mode_text(FrictionMode m, impact::ConeFacet facet);
 
 struct Sample {
   double t = 0.0;
@@ -46,13 +50,17 @@ struct Sample {
   // Tangential multipliers (mean friction force over the step, N), one per
   // entry of mechanical.friction in its order; empty for frictionless models.
   VectorXd u_t;
-  // Models with 3-D contacts (two tangents): the friction force along each
-  // entry's second tangent (N), in the order of mechanical.friction (0 for a
-  // planar entry); empty otherwise and for methods that do not give it.
-  VectorXd lambda_T2;
   // The mode of each entry of mechanical.friction, in its order; empty for
   // frictionless models and for methods that do not determine it.
   std::vector<FrictionMode> friction_mode;
+  // Models with 3-D friction (mech::MechanicalModel::has_friction_3d; both
+  // empty otherwise, so planar outputs stay as they were): the multiplier
+  // along each entry's second tangent (mean force over the step, N; 0 for a
+  // planar entry), and the cone facet holding the friction force of each
+  // entry in mode kSlip (edge -1 elsewhere; empty when the method does not
+  // determine it).
+  VectorXd u_t2;
+  std::vector<impact::ConeFacet> friction_facet;
   // Forward sensitivities (Options::sensitivity; both empty otherwise,
   // docs/sensitivities.md): dx(:, c) = dx/dtheta_c, the derivative of x with
   // respect to column c of Trajectory::sensitivity_columns (rows as x; units
@@ -73,6 +81,10 @@ struct Event {
   // entry of mechanical.friction (N s, zero when no jump) and its mode after.
   VectorXd friction_impulse;
   std::vector<FrictionMode> friction_mode_after;
+  // Models with 3-D friction (empty otherwise): the impulse along each
+  // entry's second tangent (N s) and the cone facet after, as Sample's.
+  VectorXd friction_impulse2;
+  std::vector<impact::ConeFacet> friction_facet_after;
   // How the event was resolved when that is not plain: for an accumulation,
   // the contacts, the impacts seen and how the limit time and state were
   // extrapolated; for a kStick / kSlip event, each contact whose mode

@@ -33,9 +33,15 @@ RowVectorXd along(const mech::FrictionalContact& fc, double a) {
 
 }  // namespace
 
-std::string friction_mode_name(FrictionMode m) {
+impact::ConeFacet force_facet(FrictionMode m, int d) {
+  if (!cone_slip(m) || d < 1) return {};
+  return {(cone_index(m) + d) % (2 * d), cone_on_face(m)};
+}
+
+std::string friction_mode_name(FrictionMode m, int d) {
   if (!cone_slip(m)) return std::string(to_string(m));
-  return text(cone_on_face(m) ? "slip-face-" : "slip-edge-", cone_index(m));
+  const impact::ConeFacet facet = force_facet(m, d);
+  return text(facet.face ? "slip-face-" : "slip-edge-", facet.edge);
 }
 
 void EventDriven::cone_rows(size_t f, FrictionMode mode, std::vector<RowVectorXd>& held,

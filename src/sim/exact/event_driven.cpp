@@ -55,12 +55,13 @@ EventType friction_event_type(const std::vector<FrictionMode>& before,
 // contact whose mode changed.
 std::string friction_note(const std::vector<FrictionMode>& before,
                           const std::vector<FrictionMode>& after, const std::vector<int>& contacts,
-                          const std::vector<std::string>& names) {
+                          const std::vector<std::string>& names, const std::vector<int>& cone_d) {
   std::string note;
   for (size_t f = 0; f < after.size() && f < before.size(); ++f) {
     if (before[f] == after[f]) continue;
+    const int d = f < cone_d.size() ? cone_d[f] : 1;
     note += (note.empty() ? "'" : "; '") + names[static_cast<size_t>(contacts[f])] +
-            "': " + friction_mode_name(before[f]) + " -> " + friction_mode_name(after[f]);
+            "': " + friction_mode_name(before[f], d) + " -> " + friction_mode_name(after[f], d);
   }
   return note;
 }
@@ -375,7 +376,7 @@ bool EventDriven::classify_event(Event& e, const EventResult& ev, const lcs::Ind
   if (!gained && !lost && ev.friction != old_friction) {
     e.type = friction_event_type(old_friction, ev.friction);
     e.note = friction_note(old_friction, ev.friction, friction_contacts_,
-                           model_.mechanical->constraints);
+                           model_.mechanical->constraints, cone_d_);
   } else if (!gained && !lost) {
     return false;
   }

@@ -61,8 +61,12 @@ inline FrictionMode cone_face(int j) {
 inline bool cone_slip(FrictionMode m) { return static_cast<int>(m) >= kConeCodeBase; }
 inline bool cone_on_face(FrictionMode m) { return (static_cast<int>(m) - kConeCodeBase) % 2 == 1; }
 inline int cone_index(FrictionMode m) { return (static_cast<int>(m) - kConeCodeBase) / 2; }
-// "slip-edge-i", "slip-face-j" for a cone mode, else to_string(m).
-std::string friction_mode_name(FrictionMode m);
+// A cone mode's facet as the impact laws and Moreau–Jean name it: the facet
+// holding the friction force (opposite the velocity's, i + d mod 2d) for a
+// contact with d edge pairs; edge -1 for a mode that is not a cone slip.
+impact::ConeFacet force_facet(FrictionMode m, int d);
+// "slip-edge-i", "slip-face-j" (force_facet's) for a cone mode, else to_string(m).
+std::string friction_mode_name(FrictionMode m, int d);
 
 // An upper bound on the spectral radius, ||B^16||^(1/16) ||A|| with
 // B = A/||A|| (Gelfand's formula; 4 squarings, no eigen-decomposition).
@@ -461,6 +465,8 @@ class EventDriven {
                       const std::vector<FrictionMode>& old_friction) const;
   void end_run(RunState& r) const;
   void fill_friction(Sample& s, const Phase& ph, const VectorXd& xa) const;
+  // Contact f's d (1 when planar or frictionless).
+  int cone_d(size_t f) const { return f < cone_d_.size() ? cone_d_[f] : 1; }
   // An event's tangential impulses and friction modes after (models with
   // friction only).
   void set_friction(Event& e, const EventResult& ev) const;

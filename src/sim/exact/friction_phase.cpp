@@ -63,7 +63,7 @@ std::string EventDriven::painleve_phase(const Phase& ph, const MatrixXd& S, int 
     if (!slipping(ph.friction[f])) continue;
     const int r = m.friction[f].contact;
     msg += text(" ", r, " ('", m.constraints[static_cast<size_t>(r)], "', ",
-                friction_mode_name(ph.friction[f]), ")");
+                friction_mode_name(ph.friction[f], cone_d(f)), ")");
   }
   msg += " slipping, the normal matrix E_I M^-1 (E_I - sigma mu T)' is not a P-matrix";
   if (nI == 1) msg += text(" (W_NN - sigma mu W_NT = ", Ns(0, 0), " <= 0)");
@@ -240,9 +240,11 @@ void EventDriven::fill_friction(Sample& s, const Phase& ph, const VectorXd& xa) 
   s.u_t = ph.Ft.rows() == static_cast<Eigen::Index>(friction_contacts_.size())
               ? VectorXd(ph.Ft * xa)
               : VectorXd::Zero(static_cast<Eigen::Index>(friction_contacts_.size()));
-  if (has_cone_)
-    s.lambda_T2 =
-        ph.Ft2.rows() == s.u_t.size() ? VectorXd(ph.Ft2 * xa) : VectorXd::Zero(s.u_t.size());
+  if (!has_cone_) return;
+  s.u_t2 = ph.Ft2.rows() == s.u_t.size() ? VectorXd(ph.Ft2 * xa) : VectorXd::Zero(s.u_t.size());
+  s.friction_facet.assign(friction_contacts_.size(), impact::ConeFacet{});
+  for (size_t f = 0; f < ph.friction.size() && f < friction_contacts_.size(); ++f)
+    s.friction_facet[f] = force_facet(ph.friction[f], cone_d(f));
 }
 
 void EventDriven::set_friction(Event& e, const EventResult& ev) const {
@@ -251,6 +253,11 @@ void EventDriven::set_friction(Event& e, const EventResult& ev) const {
   e.friction_impulse = ev.friction_impulse.size() == nf ? ev.friction_impulse : VectorXd::Zero(nf);
   e.friction_mode_after = ev.friction;
   e.friction_mode_after.resize(friction_contacts_.size(), FrictionMode::kOpen);
+  if (has_cone_) {
+    e.friction_facet_after.assign(friction_contacts_.size(), impact::ConeFacet{});
+    for (size_t f = 0; f < e.friction_mode_after.size(); ++f)
+      e.friction_facet_after[f] = force_facet(e.friction_mode_after[f], cone_d(f));
+  }
   for (FrictionMode& fm : e.friction_mode_after)
     if (cone_slip(fm)) fm = FrictionMode::kSlip;
 }

@@ -7,10 +7,7 @@
 #include <string>
 
 namespace lcsim::sim::detail {
-namespace {
 
-// The 2 x 2 local problem of one frictional contact: u_N = Wnn ln + Wnt lt +
-// rn, u_T = Wnt ln + Wtt lt + rt. False when no mode holds (Painlevé-type).
 bool local_coulomb(double Wnn, double Wnt, double Wtt, double rn, double rt, double mu, double& ln,
                    double& lt) {
   ln = lt = 0.0;
@@ -46,8 +43,6 @@ bool local_coulomb(double Wnn, double Wnt, double Wtt, double rn, double rt, dou
   lt = -s_first * mu * fallback_n;
   return true;
 }
-
-}  // namespace
 
 double friction_residual(const FrictionGsProblem& p, const VectorXd& lambda, const VectorXd& u) {
   double res = 0.0;

@@ -55,6 +55,12 @@ struct FrictionGsResult : OutcomeStartingAs<lcp::Status::kNumericalFailure> {
 FrictionGsResult solve_friction_gs(const FrictionGsProblem& p, double tolerance, int max_sweeps,
                                    VectorXd& lambda, VectorXd& u);
 
+// The 2 x 2 local problem of one frictional contact (above): u_N = Wnn ln +
+// Wnt lt + rn, u_T = Wnt ln + Wtt lt + rt. False when no mode holds
+// (Painlevé-type). Also cone_gs.hpp's local solve at a contact with d = 1.
+bool local_coulomb(double Wnn, double Wnt, double Wtt, double rn, double rt, double mu, double& ln,
+                   double& lt);
+
 // ||min(z, w)||_inf of impact::friction_lcp at z = (lambda_N, lambda_T + mu
 // lambda_N, max(0, -u_T)), with u = W lambda + b given.
 double friction_residual(const FrictionGsProblem& p, const VectorXd& lambda, const VectorXd& u);

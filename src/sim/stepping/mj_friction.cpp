@@ -6,6 +6,7 @@
 #include <string>
 #include <utility>
 
+#include "sim/stepping/cone_gs.hpp"
 #include "sim/stepping/friction_gs.hpp"
 
 namespace lcsim::sim::detail {
@@ -20,7 +21,8 @@ MjFriction::MjFriction(const mech::MechanicalModel& m, const MjOperators& ops)
       cone_(m.has_friction_3d()),
       t2_col_(m.num_constraints() + static_cast<int>(m.friction.size())),
       empty_(m.dofs(), 1),
-      lamT2_(VectorXd::Zero(m.has_friction_3d() ? m.num_constraints() : 0)) {
+      lamT2_(VectorXd::Zero(m.has_friction_3d() ? m.num_constraints() : 0)),
+      facet_prev_(static_cast<size_t>(m.num_constraints()), -1) {
   for (size_t f = 0; f < m.friction.size(); ++f)
     of_contact_[static_cast<size_t>(m.friction[f].contact)] = static_cast<int>(f);
   Gc_.makeCompressed();
@@ -161,13 +163,7 @@ void MjFriction::assemble_cone() {
 // The step's cone LCP (mj_friction.hpp); lam_ gets (lambda_N, the impulses
 // along t, along t2) from the edge impulses.
 bool MjFriction::solve_cone(const lcp::Solver& solver, long& solves, lcp::Result& failed) {
-  if (na_ + ne_ + nf_ > kDenseFallbackMax) {
-    failed.status = lcp::Status::kNumericalFailure;
-    failed.message = "the 3-D friction step LCP has " + std::to_string(na_ + ne_ + nf_) +
-                     " unknowns, more than the dense limit " + std::to_string(kDenseFallbackMax) +
-                     " (no sparse solver for the cone yet)";
-    return false;
-  }
+  if (na_ + ne_ + nf_ > kDenseFallbackMax) return solve_cone_sparse(solves, failed);
   rate_D_.resize(ne_);
   for (long j = 0; j < nf_; ++j)
     for (int i = 0; i < 2 * d_[static_cast<size_t>(j)]; ++i) {
@@ -181,7 +177,16 @@ bool MjFriction::solve_cone(const lcp::Solver& solver, long& solves, lcp::Result
     p_.q.head(na_) = b_.head(na_);
     p_.q.segment(na_, ne_) = rate_D_;
   }
-  if (!solve_kept(true, solver, solves, failed)) return false;
+  // Where the dense LCP finds no solution (its pivots on a Delassus matrix
+  // of dependent rows: four corners of one face), the sweeps, whose local
+  // 3 x 3 blocks stay positive definite; wherever the dense path solves,
+  // its numbers stand.
+  if (!solve_kept(true, solver, solves, failed)) {
+    lcp::Result dense = failed;
+    if (solve_cone_sparse(solves, failed)) return true;
+    failed.message = dense.message + "; then " + failed.message;
+    return false;
+  }
   lam_.head(na_) = zprev_.head(na_);
   for (long j = 0; j < nf_; ++j) {
     double p1 = 0.0, p2 = 0.0;
@@ -244,6 +249,31 @@ bool MjFriction::warm() {
   return true;
 }
 
+// The cone's step by block Gauss–Seidel (cone_gs.hpp) on Wg_ = G W^{-1} G',
+// lam_ holding the previous step's impulses (the warm start, step()); a
+// sweep limit is numerical trouble (the step fails with its residual).
+bool MjFriction::solve_cone_sparse(long& solves, lcp::Result& failed) {
+  const ConeGsProblem p{
+      &Wg_, &b_, &tangent_of_, &mu_, &d_, static_cast<int>(na_), static_cast<int>(nf_)};
+  facet_.resize(static_cast<size_t>(nf_));
+  for (long j = 0; j < nf_; ++j)
+    facet_[static_cast<size_t>(j)] = facet_prev_[static_cast<size_t>(
+        m_.friction[static_cast<size_t>(fric_[static_cast<size_t>(j)])].contact)];
+  const ConeGsResult r = solve_cone_gs(p, kGsTolerance, kGsMaxSweeps, lam_, facet_, u_);
+  ++solves;
+  if (r.status == lcp::Status::kSolved && all_finite(lam_)) {
+    for (long j = 0; j < nf_; ++j)
+      facet_prev_[static_cast<size_t>(
+          m_.friction[static_cast<size_t>(fric_[static_cast<size_t>(j)])].contact)] =
+          facet_[static_cast<size_t>(j)];
+    return true;
+  }
+  failed.status = r.status == lcp::Status::kSolved ? lcp::Status::kNumericalFailure : r.status;
+  failed.message = "friction cone Gauss-Seidel: " +
+                   (r.message.empty() ? std::string("impulses not finite") : r.message);
+  return false;
+}
+
 bool MjFriction::solve_sparse(const lcp::Solver& solver, long& solves, lcp::Result& failed,
                               std::string& warning) {
   const FrictionGsProblem p{&Wg_, &b_, &tangent_of_, &mu_, static_cast<int>(na_)};
@@ -298,6 +328,9 @@ bool MjFriction::step(MjIteration& f, const IndexSet& A, const std::vector<const
   for (long j = 0; j < nf_; ++j)
     lam_(na_ + j) =
         lamT_prev_(m_.friction[static_cast<size_t>(fric_[static_cast<size_t>(j)])].contact);
+  for (long j = 0; cone_ && j < nf_; ++j)  // the sparse cone path's warm start
+    lam_(na_ + nf_ + j) =
+        lamT2_(m_.friction[static_cast<size_t>(fric_[static_cast<size_t>(j)])].contact);
   const bool ok = cone_                    ? solve_cone(solver, solves, failed)
                   : ng <= pivot_max_active ? solve_dense(Wd_, solver, solves, failed)
                                            : solve_sparse(solver, solves, failed, warning);

@@ -31,8 +31,14 @@
 // Trinkle's form (impact::friction_cone_lcp: lambda_N, 2d edge impulses, the
 // slack xi, the sliding speed in the polygon's dual norm), solved dense: on
 // the previous step's basis when A is unchanged (warm()), else by
-// impact::solve_friction_cone_lcp. No sparse solver for the cone yet: a step
-// whose LCP has more than kDenseFallbackMax unknowns fails with a message.
+// impact::solve_friction_cone_lcp. A step whose LCP has more than
+// kDenseFallbackMax unknowns is solved by block Gauss–Seidel over the
+// contacts on the sparse Wg (cone_gs.hpp), warm-started from the previous
+// step's impulses and facets, stopped on the cone LCP's natural residual;
+// where it does not converge in kGsMaxSweeps sweeps the step fails
+// (numerical trouble, never a kept iterate). The sweeps also take a step
+// whose dense LCP found no solution (dependent rows: four corners of one
+// face); where the dense path solves, its numbers stand.
 #pragma once
 
 #include <lcsim/impact/impact.hpp>
@@ -78,6 +84,7 @@ class MjFriction {
   bool warm();
   void assemble_cone();
   bool solve_cone(const lcp::Solver& solver, long& solves, lcp::Result& failed);
+  bool solve_cone_sparse(long& solves, lcp::Result& failed);
   bool solve_sparse(const lcp::Solver& solver, long& solves, lcp::Result& failed,
                     std::string& warning);
 
@@ -118,6 +125,9 @@ class MjFriction {
   std::vector<int> d_, first_;
   MatrixXd Wb_;
   VectorXd rate_D_, lamT2_;
+  // The sparse cone path: per constraint, the facet of the last step (the
+  // search's start, cone_gs.hpp), and per F this step's.
+  std::vector<int> facet_prev_, facet_;
 };
 
 }  // namespace lcsim::sim::detail

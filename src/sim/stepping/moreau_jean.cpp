@@ -113,6 +113,15 @@ FrictionMode friction_mode_after_step(const mech::FrictionalContact& fc, const V
   return s > 0.0 ? FrictionMode::kSlipPositive : FrictionMode::kSlipNegative;
 }
 
+// The cone facet holding a sliding 3-D contact's friction force after a
+// step with velocity v (Sample::friction_facet): the facet of maximal
+// dissipation for its sliding velocity (impact::cone_facet, as the impact
+// names it).
+impact::ConeFacet facet_after_step(const mech::MechanicalModel& m,
+                                   const mech::FrictionalContact& fc, const VectorXd& v) {
+  return impact::cone_facet(fc.sliding(v), fc.tangent2.dot(v), m.edges_of(fc));
+}
+
 // One Moreau–Jean run: the trajectory it builds, the state (q, v) and what
 // the steps keep from one to the next (active set, impulses, the Delassus
 // matrix, scratch vectors).
@@ -168,6 +177,10 @@ class MjRun {
     lambda_T_ = VectorXd::Zero(m_.has_friction() ? k_ : 0);
     u_t_ = VectorXd::Zero(static_cast<Eigen::Index>(m_.friction.size()));
     fmode_.assign(m_.friction.size(), FrictionMode::kOpen);
+    if (m_.has_friction_3d()) {
+      u_t2_ = VectorXd::Zero(static_cast<Eigen::Index>(m_.friction.size()));
+      facet_.assign(m_.friction.size(), impact::ConeFacet{});
+    }
     y_.resize(k_);
     ops_.E_times(q_, y_);
     y_ += m_.g;
@@ -262,6 +275,8 @@ class MjRun {
       lambda_T_.setZero();
       u_t_.setZero();
       std::fill(fmode_.begin(), fmode_.end(), FrictionMode::kOpen);
+      u_t2_.setZero();
+      std::fill(facet_.begin(), facet_.end(), impact::ConeFacet{});
     }
     u_set_.clear();
     mode_.clear();
@@ -300,6 +315,9 @@ class MjRun {
       u_t_(static_cast<Eigen::Index>(fi)) = lambda_T_(fc.contact) / h;
       if (const int p = pos_[static_cast<size_t>(fc.contact)]; p >= 0 && z_(p) > 0.0)
         fmode_[fi] = friction_mode_after_step(fc, v_next_);
+      if (u_t2_.size() == 0) continue;  // planar model
+      u_t2_(static_cast<Eigen::Index>(fi)) = friction_->lambda_T2()(fc.contact) / h;
+      if (fmode_[fi] == FrictionMode::kSlip) facet_[fi] = facet_after_step(m_, fc, v_next_);
     }
     keep_impulses(h, false);
     return true;
@@ -446,6 +464,8 @@ class MjRun {
     if (friction_) {
       s.u_t = u_t_;
       s.friction_mode = fmode_;
+      s.u_t2 = u_t2_;
+      s.friction_facet = facet_;
     }
     if (sens_) sens_->fill(s.dx, s.dx_exists);
     tr_.record_sample(std::move(s), opt_);
@@ -479,6 +499,10 @@ class MjRun {
   // normal impulse is positive; then stick when the sliding velocity at the
   // step's end is zero to rounding, else slip along its sign.
   std::vector<FrictionMode> fmode_;
+  // Models with 3-D friction (empty otherwise): the mean force along each
+  // entry's second tangent (N) and the facet of each sliding entry.
+  VectorXd u_t2_;
+  std::vector<impact::ConeFacet> facet_;
   VectorXd y_;  // gaps E q + g
   VectorXd u_;  // mean contact forces over the step
   lcp::Options lopt_;
