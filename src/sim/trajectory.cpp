@@ -23,6 +23,8 @@ std::string_view to_string(EventType t) {
       return "stick";
     case EventType::kSlip:
       return "slip";
+    case EventType::kSchedule:
+      return "schedule";
   }
   return "unknown";
 }
@@ -112,6 +114,7 @@ class EventDrivenIntegrator : public Integrator {
     u.impact = u.lcp_solver = u.event_search = u.dense_lcs = true;
     u.friction = true;     // stick / slip modes (friction_phase.cpp, friction_modes.cpp)
     u.sensitivity = true;  // forward sensitivities (sensitivity.cpp)
+    u.inputs = true;       // exosystems and scheduled events (exact/schedule.cpp)
     return u;
   }
   Trajectory integrate(const mech::Model& model, const VectorXd& x0,

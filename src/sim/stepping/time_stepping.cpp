@@ -38,6 +38,7 @@ class EulerIntegrator : public Integrator {
   OptionsUsed options_used() const override {
     OptionsUsed u;  // every impact inelastic: Options::impact is not read
     u.h = u.lcp_solver = u.force = u.dense_lcs = true;
+    u.inputs = true;  // force inputs evaluated at each step's end (euler.cpp)
     return u;
   }
   Trajectory integrate(const mech::Model& model, const VectorXd& x0,
@@ -54,6 +55,7 @@ class MoreauJeanIntegrator : public Integrator {
     u.h = u.theta = u.lcp_solver = u.linear_algebra = u.needs_mechanical = true;
     u.friction = true;     // the friction LCP in every step (mj_friction.hpp)
     u.friction_3d = true;  // the cone's LCP in Stewart and Trinkle's form (the same)
+    u.inputs = true;       // force inputs theta-weighted over each step (step_kernels.hpp)
     return u;
   }
   Trajectory integrate(const mech::Model& model, const VectorXd& x0,
