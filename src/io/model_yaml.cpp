@@ -351,8 +351,16 @@ YAML::Node load_model_root(const std::string& yaml_text, const std::string& sour
 bool is_scene(const YAML::Node& root) { return root.IsMap() && root["urdf"]; }
 
 mech::Model parse_matrix_model(const YAML::Node& root, const std::string& source) {
-  const Keys keys =
-      mapping(root, source, "", {"name", "mechanical", "lcs", "initial", "t_end", "inputs"});
+  // `inputs:` (docs/inputs.md) is taken out first, so that the message for
+  // an unknown key lists the keys every model has, as it always did.
+  YAML::Node body = root, inputs_node;
+  const bool has_inputs = root.IsMap() && root["inputs"];
+  if (has_inputs) {
+    inputs_node = root["inputs"];
+    body = YAML::Clone(root);
+    body.remove("inputs");
+  }
+  const Keys keys = mapping(body, source, "", {"name", "mechanical", "lcs", "initial", "t_end"});
   mech::Model model;
   model.source = source;
   if (keys.count("name")) {
@@ -370,11 +378,11 @@ mech::Model parse_matrix_model(const YAML::Node& root, const std::string& source
   if (!has_mech && !has_lcs)
     fail(source, "mechanical", "missing (expected a `mechanical:` or an `lcs:` section)");
   std::vector<mech::Input> inputs;
-  if (keys.count("inputs")) {
+  if (has_inputs) {
     if (has_lcs)
       fail(source, "inputs",
            "inputs are for mechanical models (an `lcs:` model's sources are its own states)");
-    inputs = yaml::inputs(keys.at("inputs"), source);
+    inputs = yaml::inputs(inputs_node, source);
   }
   if (has_mech) model.mechanical = parse_mechanical(keys.at("mechanical"), source, inputs);
   if (has_lcs) model.lcs = parse_lcs(keys.at("lcs"), source);
