@@ -66,7 +66,7 @@ class Model:
     def constraints(self) -> list[str]: ...
 
 class Event:
-    """An event of a run: an impact, a contact, a release, an accumulation, the start, or a frictional contact starting to stick or to slip."""
+    """An event of a run: an impact, a contact, a release, an accumulation, the start, a frictional contact starting to stick or to slip, or a breakpoint of an input (`schedule`, docs/inputs.md)."""
     t: float
     type: str
     state_before: np.ndarray

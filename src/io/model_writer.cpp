@@ -65,6 +65,10 @@ std::string model_yaml(const mech::Model& model, const std::string& header) {
     throw std::invalid_argument("io::model_yaml: '" + model.name +
                                 "' is an lcs: model; only mechanical models are written");
   const mech::MechanicalModel& m = *model.mechanical;
+  if (m.has_inputs())  // not written: a copy without them would be another model
+    throw std::invalid_argument(
+        "io::model_yaml: '" + model.name +
+        "' has inputs (docs/inputs.md); models with inputs are not written");
   std::ostringstream out;
   std::istringstream h(header);
   for (std::string line; std::getline(h, line);) out << "# " << line << "\n";

@@ -220,10 +220,12 @@ std::vector<mech::FrictionalContact> parse_friction(const YAML::Node& n,
   return out;
 }
 
-mech::MechanicalModel parse_mechanical(const YAML::Node& node, const std::string& source) {
-  const Keys keys = mapping(node, source, "mechanical",
-                            {"M", "D", "K", "E", "g", "f", "restitution", "coordinates",
-                             "constraints", "friction", "friction_d"});
+mech::MechanicalModel parse_mechanical(const YAML::Node& node, const std::string& source,
+                                       const std::vector<mech::Input>& inputs) {
+  const Keys keys =
+      mapping(node, source, "mechanical",
+              {"M", "D", "K", "E", "g", "f", "restitution", "coordinates", "constraints",
+               "friction", "friction_d", "force_inputs", "gap_inputs"});
   const auto has = [&](const char* k) { return keys.count(k) > 0; };
   mech::MechanicalModel m;
   if (!has("M")) fail(source, "mechanical.M", "missing (the mass matrix is required)");
@@ -273,6 +275,13 @@ mech::MechanicalModel parse_mechanical(const YAML::Node& node, const std::string
   if (has("friction")) m.friction = parse_friction(keys.at("friction"), m, source);
   if (has("friction_d"))
     m.cone_edges = cone_edges(keys.at("friction_d"), source, "mechanical.friction_d");
+  m.inputs = inputs;  // docs/inputs.md
+  if (has("force_inputs"))
+    m.force_inputs =
+        yaml::input_uses(keys.at("force_inputs"), inputs, N, source, "mechanical.force_inputs", nn);
+  if (has("gap_inputs"))
+    m.gap_inputs =
+        yaml::input_uses(keys.at("gap_inputs"), inputs, k, source, "mechanical.gap_inputs", kk);
   // What the file's structure did not already refuse: M symmetric positive
   // definite, restitution in [0, 1], finite entries, no all-zero row of E.
   if (auto p = mech::check_mechanical(m)) fail(source, p->field, p->what);
@@ -344,7 +353,16 @@ bool is_scene(const YAML::Node& root) {
 }
 
 mech::Model parse_matrix_model(const YAML::Node& root, const std::string& source) {
-  const Keys keys = mapping(root, source, "", {"name", "mechanical", "lcs", "initial", "t_end"});
+  // `inputs:` (docs/inputs.md) is taken out first, so that the message for
+  // an unknown key lists the keys every model has, as it always did.
+  YAML::Node body = root, inputs_node;
+  const bool has_inputs = root.IsMap() && root["inputs"];
+  if (has_inputs) {
+    inputs_node = root["inputs"];
+    body = YAML::Clone(root);
+    body.remove("inputs");
+  }
+  const Keys keys = mapping(body, source, "", {"name", "mechanical", "lcs", "initial", "t_end"});
   mech::Model model;
   model.source = source;
   if (keys.count("name")) {
@@ -361,7 +379,14 @@ mech::Model parse_matrix_model(const YAML::Node& root, const std::string& source
     fail(source, "mechanical, lcs", "a model is one or the other; give only one of the sections");
   if (!has_mech && !has_lcs)
     fail(source, "mechanical", "missing (expected a `mechanical:` or an `lcs:` section)");
-  if (has_mech) model.mechanical = parse_mechanical(keys.at("mechanical"), source);
+  std::vector<mech::Input> inputs;
+  if (has_inputs) {
+    if (has_lcs)
+      fail(source, "inputs",
+           "inputs are for mechanical models (an `lcs:` model's sources are its own states)");
+    inputs = yaml::inputs(inputs_node, source);
+  }
+  if (has_mech) model.mechanical = parse_mechanical(keys.at("mechanical"), source, inputs);
   if (has_lcs) model.lcs = parse_lcs(keys.at("lcs"), source);
   if (keys.count("initial")) {
     model.initial = vector(keys.at("initial"), source, "initial");

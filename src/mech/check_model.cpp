@@ -278,12 +278,45 @@ std::optional<ModelProblem> check_values(const MechanicalModel& m) {
   return std::nullopt;
 }
 
+// The inputs (docs/inputs.md): named once each, usable signals, and uses
+// that name an input with a finite gain of the right size.
+std::optional<ModelProblem> check_inputs(const MechanicalModel& m) {
+  for (std::size_t j = 0; j < m.inputs.size(); ++j) {
+    const Input& in = m.inputs[j];
+    const std::string field = "inputs[" + std::to_string(j) + "]";
+    if (in.name.empty()) return ModelProblem{field, "an input needs a name"};
+    for (std::size_t i = 0; i < j; ++i)
+      if (m.inputs[i].name == in.name)
+        return ModelProblem{field, "input '" + in.name + "' is named twice"};
+    if (std::string why = check_input(in); !why.empty())
+      return ModelProblem{field, "input '" + in.name + "': " + why};
+  }
+  const auto check_uses = [&](const std::vector<InputUse>& uses, const char* key,
+                              Eigen::Index size) -> std::optional<ModelProblem> {
+    for (std::size_t i = 0; i < uses.size(); ++i) {
+      const std::string field = std::string("mechanical.") + key + "[" + std::to_string(i) + "]";
+      if (uses[i].input < 0 || static_cast<std::size_t>(uses[i].input) >= m.inputs.size())
+        return ModelProblem{field, "names no input (got index " + std::to_string(uses[i].input) +
+                                       " of " + std::to_string(m.inputs.size()) + ")"};
+      if (uses[i].gain.size() != size)
+        return ModelProblem{field + ".gain", "expected " + std::to_string(size) + " entries (got " +
+                                                 std::to_string(uses[i].gain.size()) + ")"};
+      if (auto at = non_finite_vector(uses[i].gain))
+        return ModelProblem{field + ".gain" + *at, "not finite"};
+    }
+    return std::nullopt;
+  };
+  if (auto p = check_uses(m.force_inputs, "force_inputs", m.M.rows())) return p;
+  return check_uses(m.gap_inputs, "gap_inputs", m.E.rows());
+}
+
 }  // namespace
 
 std::optional<ModelProblem> check_mechanical(const MechanicalModel& m) {
   if (auto p = check_dimensions(m)) return p;
   if (auto p = check_finite(m)) return p;
   if (auto p = check_values(m)) return p;
+  if (auto p = check_inputs(m)) return p;
   return check_friction(m);
 }
 

@@ -3,6 +3,7 @@
 #include <Eigen/SparseQR>
 #include <algorithm>
 #include <lcsim/mech/mech.hpp>
+#include <limits>
 #include <stdexcept>
 
 namespace lcsim::mech {
@@ -27,18 +28,88 @@ bool MechanicalModel::has_friction_3d() const {
                      [](const FrictionalContact& c) { return c.is_3d(); });
 }
 
+namespace {
+int exosystem_size(const MechanicalModel& m) {
+  int e = 0;
+  for (const Input& in : m.inputs) e += in.exo_size();
+  return e;
+}
+
+// The first state of each input's exosystem in the augmented state.
+std::vector<int> exosystem_offsets(const MechanicalModel& m) {
+  std::vector<int> at;
+  int next = 2 * m.dofs() + 1;
+  for (const Input& in : m.inputs) {
+    at.push_back(next);
+    next += in.exo_size();
+  }
+  return at;
+}
+
+// The exosystems in A, their outputs in the v rows (forces) and in C (gaps).
+void add_inputs(const MechanicalModel& m, const Eigen::LLT<MatrixXd>& llt, lcs::Lcs& s) {
+  const int n = m.dofs();
+  const std::vector<int> at = exosystem_offsets(m);
+  for (std::size_t j = 0; j < m.inputs.size(); ++j) {
+    const int d = m.inputs[j].exo_size();
+    s.A.block(at[j], at[j], d, d) = m.inputs[j].exo_matrix();
+  }
+  for (const InputUse& use : m.force_inputs) {
+    const Input& in = m.inputs[static_cast<std::size_t>(use.input)];
+    s.A.block(n, at[static_cast<std::size_t>(use.input)], n, in.exo_size()) +=
+        llt.solve(use.gain) * in.exo_output();
+  }
+  for (const InputUse& use : m.gap_inputs) {
+    const Input& in = m.inputs[static_cast<std::size_t>(use.input)];
+    s.C.block(0, at[static_cast<std::size_t>(use.input)], m.num_constraints(), in.exo_size()) +=
+        use.gain * in.exo_output();
+  }
+}
+}  // namespace
+
+VectorXd exosystem_states(const MechanicalModel& m, double t) {
+  VectorXd w(exosystem_size(m));
+  int at = 0;
+  for (const Input& in : m.inputs) {
+    w.segment(at, in.exo_size()) = in.exo_state(t);
+    at += in.exo_size();
+  }
+  return w;
+}
+
+double next_breakpoint(const MechanicalModel& m, double t) {
+  double next = std::numeric_limits<double>::infinity();
+  for (const Input& in : m.inputs) next = std::min(next, in.next_breakpoint(t));
+  return next;
+}
+
+VectorXd force_at(const MechanicalModel& m, double t) {
+  VectorXd f = m.f;
+  for (const InputUse& use : m.force_inputs)
+    f += use.gain * m.inputs[static_cast<std::size_t>(use.input)].value(t);
+  return f;
+}
+
+VectorXd gap_at(const MechanicalModel& m, double t) {
+  VectorXd g = m.g;
+  for (const InputUse& use : m.gap_inputs)
+    g += use.gain * m.inputs[static_cast<std::size_t>(use.input)].value(t);
+  return g;
+}
+
 lcs::Lcs to_lcs(const MechanicalModel& m) {
   const int n = m.dofs();
   const int k = m.num_constraints();
   const Eigen::LLT<MatrixXd> llt(m.M.toDense());
+  const int na = 2 * n + 1 + exosystem_size(m);
   lcs::Lcs s;
-  s.A = MatrixXd::Zero(2 * n + 1, 2 * n + 1);
+  s.A = MatrixXd::Zero(na, na);
   s.A.block(0, n, n, n) = MatrixXd::Identity(n, n);
   s.A.block(n, 0, n, n) = -llt.solve(m.K.toDense());
   s.A.block(n, n, n, n) = -llt.solve(m.D.toDense());
   s.A.block(n, 2 * n, n, 1) = llt.solve(m.f);
-  s.B = MatrixXd::Zero(2 * n + 1, k);
-  s.C = MatrixXd::Zero(k, 2 * n + 1);
+  s.B = MatrixXd::Zero(na, k);
+  s.C = MatrixXd::Zero(k, na);
   if (k > 0) {  // an empty block at a non-zero offset is UB in Eigen (found by UBSan)
     const MatrixXd E = m.E.toDense();
     s.B.block(n, 0, n, k) = llt.solve(E.transpose());
@@ -46,6 +117,7 @@ lcs::Lcs to_lcs(const MechanicalModel& m) {
     s.C.col(2 * n) = m.g;
   }
   s.D = MatrixXd::Zero(k, k);
+  if (m.has_inputs()) add_inputs(m, llt, s);
   return s;
 }
 
@@ -148,7 +220,7 @@ int Model::num_constraints() const {
 }
 
 int Model::lcs_state_size() const {
-  if (mechanical) return 2 * mechanical->dofs() + 1;
+  if (mechanical) return 2 * mechanical->dofs() + 1 + exosystem_size(*mechanical);
   if (lcs) return lcs->n();
   return 0;
 }

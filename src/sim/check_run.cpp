@@ -183,6 +183,28 @@ std::string refuse_friction_law(const mech::Model& model, const Options& opt,
 
 }  // namespace
 
+// A model with inputs (docs/inputs.md) needs a method that evaluates them;
+// a moving stop (gap_inputs) and sensitivities are not simulated yet.
+std::string refuse_inputs(const mech::Model& model, const Options& opt, std::string_view method,
+                          const OptionsUsed& used) {
+  if (!model.is_mechanical() || !model.mechanical->has_inputs()) return "";
+  const mech::MechanicalModel& m = *model.mechanical;
+  if (!used.inputs)
+    return text("method '", method, "' does not evaluate inputs (model '", model.name, "' has ",
+                m.inputs.size(), " in `inputs:`); methods 'event', 'euler' and 'moreau-jean' do");
+  // Moving stops: the exact method only (the one method that searches
+  // events: it locates each impact on the moving stop), without friction.
+  if (!m.gap_inputs.empty() && !used.event_search)
+    return text("method '", method, "' does not simulate mechanical.gap_inputs (a moving stop; ",
+                "model '", model.name, "'); method 'event' does");
+  if (!m.gap_inputs.empty() && m.has_friction())
+    return text("model '", model.name,
+                "': mechanical.gap_inputs (a moving stop) with friction is not simulated yet");
+  if (!opt.sensitivity.empty())
+    return text("model '", model.name, "' has inputs: sensitivities are not computed with inputs");
+  return "";
+}
+
 Options keep_used(const Options& opt, const OptionsUsed& used) {
   Options out = opt;
   const Options defaults{};
@@ -221,6 +243,7 @@ std::string check_run(const mech::Model& model, const VectorXd& x0, const Option
   if (!opt.t_end) return "no horizon: set Options::t_end, or t_end in the model";
   if (std::string m = check_values(opt, used); !m.empty()) return m;
   if (std::string m = refuse_friction_law(model, opt, used); !m.empty()) return m;
+  if (std::string m = refuse_inputs(model, opt, method, used); !m.empty()) return m;
   if (std::string m = ignored_options(opt, method, used); !m.empty()) return m;
   if (std::string m = check_sensitivity(model, opt, method, used); !m.empty()) return m;
   if (std::string m = infeasible_start(model, x0); !m.empty()) return m;

@@ -25,6 +25,8 @@ std::string_view to_string(EventType t) {
       return "stick";
     case EventType::kSlip:
       return "slip";
+    case EventType::kSchedule:
+      return "schedule";
   }
   return "unknown";
 }
@@ -121,6 +123,7 @@ class EventDrivenIntegrator : public Integrator {
     u.friction = true;     // stick / slip modes (friction_phase.cpp, friction_modes.cpp)
     u.friction_3d = true;  // stick / edge / face slip on the cone (cone_phase.cpp, cone_modes.cpp)
     u.sensitivity = true;  // forward sensitivities (sensitivity.cpp)
+    u.inputs = true;       // exosystems and scheduled events (exact/schedule.cpp)
     return u;
   }
 

@@ -34,7 +34,8 @@ std::vector<std::string> model_notes(const mech::Model& model);
 // spelling that stores least: a list of rows when small (at most 64 entries),
 // {diagonal: [...]} when diagonal, else {rows, cols, entries} with its
 // non-zeros, so a chain of N carts takes O(N) bytes. `header` lines are
-// written first as comments. std::invalid_argument for an `lcs:` model.
+// written first as comments. std::invalid_argument for an `lcs:` model or a
+// model with inputs (docs/inputs.md).
 std::string model_yaml(const mech::Model& model, const std::string& header = "");
 
 }  // namespace lcsim::io

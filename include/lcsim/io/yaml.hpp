@@ -72,4 +72,14 @@ std::string dims(const Mat& m) {
 void expect_size(const Eigen::VectorXd& v, Eigen::Index size, const std::string& source,
                  const std::string& key, const std::string& why);
 
+// A model file's `inputs:` list (src/io/model_inputs.cpp, docs/inputs.md),
+// each checked (mech::check_input).
+std::vector<mech::Input> inputs(const YAML::Node& n, const std::string& source);
+// A list of {input: name, gain: [size numbers]} at `key`
+// (mechanical.force_inputs, mechanical.gap_inputs); `why` says where size
+// comes from.
+std::vector<mech::InputUse> input_uses(const YAML::Node& n, const std::vector<mech::Input>& inputs,
+                                       Eigen::Index size, const std::string& source,
+                                       const std::string& key, const std::string& why);
+
 }  // namespace lcsim::io::yaml

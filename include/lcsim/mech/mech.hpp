@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
 #include <lcsim/lcs/lcs.hpp>
+#include <lcsim/mech/inputs.hpp>
 #include <lcsim/mech/tolerances.hpp>  // the zero tests of a gap, for every user of a model
 #include <limits>
 #include <optional>
@@ -90,6 +91,13 @@ struct MechanicalModel {
   // 0.924 of the circular cone's (docs/friction.md, "The cone's error").
   int cone_edges = kDefaultConeEdges;
   static constexpr int kDefaultConeEdges = 4;
+  // Inputs that vary in time (issue 29, docs/inputs.md), empty by default so
+  // that a model without them is what it always was: the signals, and where
+  // they enter: f(t) = f + sum gain u(t) (gains of N entries) and
+  // g(t) = g + sum gain u(t) (gains of k entries: a moving stop).
+  std::vector<Input> inputs;
+  std::vector<InputUse> force_inputs, gap_inputs;
+  bool has_inputs() const { return !inputs.empty(); }
   bool has_friction() const { return !friction.empty(); }
   // Whether some frictional contact has two tangents (FrictionalContact::is_3d).
   bool has_friction_3d() const;
@@ -107,8 +115,19 @@ void fill_defaults(MechanicalModel& m);
 
 // LCS of eq. (3.65) on the augmented state (q, v, 1) of size 2N + 1:
 // A = [0 I 0; -M^{-1}K -M^{-1}D M^{-1}f; 0 0 0], B = [0; M^{-1}E'; 0],
-// C = [E 0 g], D = 0.
+// C = [E 0 g], D = 0. A model with inputs appends their exosystems'
+// states w (input by input, exosystem_states): w' = S w, and the force and
+// gap gains times each input's output row l in the v rows of A and in C.
 lcs::Lcs to_lcs(const MechanicalModel& m);
+
+// The exosystems' states at t (the right limits at a breakpoint), input by
+// input: what the state w is re-initialised to at a scheduled event.
+VectorXd exosystem_states(const MechanicalModel& m, double t);
+// The first breakpoint of any input after t (strictly); +inf if none.
+double next_breakpoint(const MechanicalModel& m, double t);
+// f(t) and g(t) with the inputs' values at t (the time-stepping methods).
+VectorXd force_at(const MechanicalModel& m, double t);
+VectorXd gap_at(const MechanicalModel& m, double t);
 
 // Energies (J): T = ½ v'Mv, V = ½ q'Kq - f'q, total = T + V.
 double kinetic_energy(const MechanicalModel& m, const VectorXd& v);
@@ -173,7 +192,8 @@ struct Model {
   bool is_mechanical() const { return mechanical.has_value(); }
   int state_size() const;  // 2N for mechanical, n for LCS
   int num_constraints() const;
-  // Size of as_lcs(): 2N + 1 for mechanical models (augmented), n for LCS.
+  // Size of as_lcs(): 2N + 1 (plus the inputs' exosystems) for mechanical
+  // models (augmented), n for LCS.
   int lcs_state_size() const;
   // The LCS to simulate: to_lcs(mechanical) (augmented) or the LCS itself.
   // Dense; std::invalid_argument beyond kMaxDenseLcsState (see there).

@@ -25,8 +25,19 @@ using IndexSet = std::vector<int>;
 
 // kStick: a frictional contact's sliding velocity reached zero and it
 // sticks; kSlip: a frictional contact starts to slide (its stick force
-// reached the edge of the friction cone, or it reverses).
-enum class EventType { kImpact, kRelease, kContact, kAccumulation, kStart, kStick, kSlip };
+// reached the edge of the friction cone, or it reverses). kSchedule: a
+// breakpoint of an input (a step, a pulse's edge, a PWL point; docs/inputs.md),
+// where the exact method re-initialises the input's exosystem.
+enum class EventType {
+  kImpact,
+  kRelease,
+  kContact,
+  kAccumulation,
+  kStart,
+  kStick,
+  kSlip,
+  kSchedule
+};
 std::string_view to_string(EventType t);
 
 // What a closed frictional contact does in a sample (Sample::friction_mode):
@@ -266,6 +277,9 @@ struct OptionsUsed {
   // reads one triangle), so it needs D and K symmetric: check_run refuses a
   // model whose D or K is not (mech::asymmetry) rather than symmetrise it.
   bool symmetric_dk = false;
+  // The method evaluates a mechanical model's inputs (docs/inputs.md); a
+  // method without it refuses a model that has some (check_run).
+  bool inputs = false;
 };
 
 // "" when `opt.sensitivity` is empty or asks what the model and the method

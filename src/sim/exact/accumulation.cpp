@@ -135,6 +135,10 @@ void EventDriven::project_onto(const std::vector<int>& rows, VectorXd& xa, bool 
     r(i) = positions ? m.E.row(rows[i]).dot(xa.head(N_)) + m.g(rows[i])
                      : m.E.row(rows[i]).dot(xa.segment(N_, N_));
   }
+  if (moving_stops()) {  // the stops' own position or rate (schedule.cpp)
+    const VectorXd own = positions ? stop_offset(xa) : stop_rate(xa);
+    for (size_t i = 0; i < rows.size(); ++i) r(static_cast<Eigen::Index>(i)) += own(rows[i]);
+  }
   const Eigen::LLT<MatrixXd> llt(m.M);
   const MatrixXd MinvEt = llt.solve(EJ.transpose());
   const VectorXd lambda = (EJ * MinvEt).completeOrthogonalDecomposition().solve(r);

@@ -193,7 +193,8 @@ void EventDriven::record_initial_jump(RunState& r, const EventResult& ev) const 
 // The phase from r.t to its event (then take_event) or to the horizon;
 // false when the run ends.
 bool EventDriven::next_phase(RunState& r, LivelockGuard& livelock) {
-  const double t_end = *opt_.t_end;
+  // The phase ends at the horizon or at the next scheduled event.
+  const double t_end = std::min(*opt_.t_end, next_scheduled(r.t));
   // Sampling step: a quarter of the fastest time scale of the closed loop,
   // so a Bohl function changes the sign of its derivative at most once
   // between samples; first steps shorter where a monitor starts at zero.
@@ -208,8 +209,9 @@ bool EventDriven::next_phase(RunState& r, LivelockGuard& livelock) {
   if (sens_) sens_->check_phase_start(phase, r.t, pm.start.m0, ldcp_undetermined_);
   const double h_first = std::max(pm.start.h_first, 1e-15 * std::max(1.0, std::abs(r.t)));
   arm_monitors(pm);
-  march_phase(pm, h_first, h_max, r.tr);
+  march_phase(pm, h_first, h_max, t_end, r.tr);
   if (std::isfinite(pm.t_event)) return take_event(r, pm, livelock);
+  if (t_end < *opt_.t_end) return take_scheduled(r, pm, t_end);
   // Reached the horizon.
   const VectorXd xend = pm.state_at(t_end);
   record(r.tr, t_end, xend, phase);
@@ -220,15 +222,15 @@ bool EventDriven::next_phase(RunState& r, LivelockGuard& livelock) {
 
 // March over the samples of a phase, doubling the step up to h_max, until a
 // monitor's root (pm.t_event) or the horizon; the output samples on the way.
-void EventDriven::march_phase(PhaseMarch& pm, double h_first, double h_max, Trajectory& tr) const {
-  const double t_end = *opt_.t_end;
+void EventDriven::march_phase(PhaseMarch& pm, double h_first, double h_max, double t_stop,
+                              Trajectory& tr) const {
   double ta = pm.t0;
   VectorXd xa_a = pm.xstart;
   MatrixXd Phi;
   double h_phi = -1.0;
   double h = h_first;
-  while (ta < t_end) {
-    const double tb = std::min(ta + h, t_end);
+  while (ta < t_stop) {
+    const double tb = std::min(ta + h, t_stop);
     VectorXd xa_b;
     if (!pm.phase.dense_exp()) {
       xa_b = pm.phase.expv(tb - ta, xa_a);
@@ -242,7 +244,7 @@ void EventDriven::march_phase(PhaseMarch& pm, double h_first, double h_max, Traj
     first_root(pm, ta, tb, xa_a, xa_b);
     if (std::isfinite(pm.t_event)) return;
     // Exact output samples inside (ta, tb].
-    while (pm.next_out <= tb && pm.next_out < t_end) {
+    while (pm.next_out <= tb && pm.next_out < t_stop) {
       record(tr, pm.next_out, pm.sampler.at(pm.next_out), pm.phase);
       pm.advance_out();
     }

@@ -283,7 +283,10 @@ class EventDriven {
   VectorXd augment(const VectorXd& x) const {
     if (!model_.is_mechanical()) return x;
     VectorXd xa(n_);
-    xa << x, 1.0;
+    if (model_.mechanical->has_inputs())  // the inputs' exosystems (schedule.cpp)
+      xa << x, 1.0, mech::exosystem_states(*model_.mechanical, 0.0);
+    else
+      xa << x, 1.0;
     return xa;
   }
   VectorXd user(const VectorXd& xa) const {
@@ -457,7 +460,23 @@ class EventDriven {
   bool start_run(RunState& r, const VectorXd& x0_user);
   void record_initial_jump(RunState& r, const EventResult& ev) const;
   bool next_phase(RunState& r, LivelockGuard& livelock);
-  void march_phase(PhaseMarch& pm, double h_first, double h_max, Trajectory& tr) const;
+  // t_stop: the horizon or the next scheduled event, whichever is first.
+  void march_phase(PhaseMarch& pm, double h_first, double h_max, double t_stop,
+                   Trajectory& tr) const;
+  // Scheduled events (schedule.cpp): the first breakpoint of an input after
+  // t (+inf for a model without inputs), and the event there.
+  double next_scheduled(double t) const;
+  bool take_scheduled(RunState& r, PhaseMarch& pm, double t_b);
+  // Moving stops (mechanical.gap_inputs; schedule.cpp): the part of each gap
+  // (G_w w) and of its rate (G_w S w) that the inputs give at xa, and the
+  // velocity shift delta with E_J delta = that rate on the closed rows J, so
+  // that the impact law sees the velocities relative to the stops.
+  bool moving_stops() const {
+    return model_.is_mechanical() && !model_.mechanical->gap_inputs.empty();
+  }
+  VectorXd stop_offset(const VectorXd& xa) const;
+  VectorXd stop_rate(const VectorXd& xa) const;
+  VectorXd stop_shift(const std::vector<int>& closed, const VectorXd& xa) const;
   bool take_event(RunState& r, PhaseMarch& pm, LivelockGuard& livelock);
   bool zeno_guard(RunState& r, long events_seen) const;
   bool reinitialise(RunState& r, const VectorXd& x_minus, EventResult& ev);

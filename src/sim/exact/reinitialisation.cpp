@@ -24,7 +24,14 @@ EventDriven::ContactScan EventDriven::scan_contacts(double t, const VectorXd& xa
   s.gap = m.E * q + m.g;
   s.gap_scale = m.E.cwiseAbs() * q.cwiseAbs() + m.g.cwiseAbs();
   s.rate = m.E * v;
-  const VectorXd rate_scale = m.E.cwiseAbs() * v.cwiseAbs();
+  VectorXd rate_scale = m.E.cwiseAbs() * v.cwiseAbs();
+  if (moving_stops()) {  // the stops' own motion (schedule.cpp)
+    const VectorXd offset = stop_offset(xa), rate = stop_rate(xa);
+    s.gap += offset;
+    s.gap_scale += offset.cwiseAbs();
+    s.rate += rate;
+    rate_scale += rate.cwiseAbs();
+  }
   s.in.model = &m;
   s.in.q = q;
   s.in.v = v;
@@ -81,6 +88,9 @@ bool EventDriven::impact_round(double t, ContactScan& scan, bool limit_taken,
                                const VectorXd& time_noise, VectorXd& xa, EventResult& out) {
   impact::ImpactInput& in = scan.in;
   in.restitution = limit_taken ? VectorXd::Zero(k_) : VectorXd(restitution_);
+  // Moving stops: the law acts on the velocities relative to the stops.
+  const VectorXd shift = moving_stops() ? stop_shift(in.closed, xa) : VectorXd();
+  if (moving_stops()) in.v += shift;
   const impact::ImpactResult ir = impact_->apply(in, *solver_);
   out.lcp_solves += ir.lcp_solves;
   if (!ir.ok()) {
@@ -97,6 +107,7 @@ bool EventDriven::impact_round(double t, ContactScan& scan, bool limit_taken,
   // sliding velocity zero to the law's tolerance (friction_modes.cpp).
   if (!ir.outcome.empty()) outcome_ = ir.outcome;
   xa.segment(N_, N_) = ir.v_after;
+  if (moving_stops()) xa.segment(N_, N_) -= shift;
   out.impulse += ir.impulse;
   if (ir.friction_impulse.size() == k_)
     for (size_t f = 0; f < friction_contacts_.size(); ++f)

@@ -28,6 +28,7 @@ struct EulerFactors : OutcomeStartingAs<Status::kNumericalFailure> {
   MatrixXd Phi;   // (I - hA)^{-1}
   MatrixXd PhiB;  // h (I - hA)^{-1} B
   MatrixXd G;     // D + h C (I - hA)^{-1} B, the LCP matrix of step 4
+  double h = 0.0;
 };
 
 EulerFactors euler_factors(const lcs::Lcs& sys, double h) {
@@ -41,6 +42,7 @@ EulerFactors euler_factors(const lcs::Lcs& sys, double h) {
     f.message = "I - hA is singular at h = " + short_number(h) + " (1/h is an eigenvalue of A)";
     return f;
   }
+  f.h = h;
   f.Phi = lu.inverse();
   f.PhiB = h * (f.Phi * sys.B);
   f.G = sys.D + sys.C * f.PhiB;
@@ -68,6 +70,7 @@ class EulerRun {
   bool set_up() {
     try {  // set-up, before the loop: invalid names or data end the run cleanly
       sys_ = model_.as_lcs();
+      if (mech_ && model_.mechanical->has_inputs()) set_up_inputs();
       solver_ = lcp::make_solver(opt_.lcp_solver);
     } catch (const std::exception& e) {
       tr_.status = RunStatus::kNumericalFailure;
@@ -182,10 +185,31 @@ class EulerRun {
     return std::move(tr_);  // only ever returned from the run: no copy of the samples
   }
 
+  // A model with inputs (docs/inputs.md): the LCS without their exosystems,
+  // the force inputs evaluated per step instead (input_drive).
+  void set_up_inputs() {
+    mech::Model plain = model_;
+    plain.mechanical->inputs.clear();
+    plain.mechanical->force_inputs.clear();
+    plain.mechanical->gap_inputs.clear();
+    sys_ = plain.as_lcs();
+    Minv_ = Eigen::LLT<MatrixXd>(model_.mechanical->M.toDense()).solve(MatrixXd::Identity(N_, N_));
+    inputs_ = true;
+  }
+  // The inputs' part of x' at t: (0, M^{-1} (f(t) - f), 0).
+  VectorXd input_drive(double t) const {
+    VectorXd d = VectorXd::Zero(sys_.n());
+    d.segment(N_, N_) = Minv_ * (mech::force_at(*model_.mechanical, t) - model_.mechanical->f);
+    return d;
+  }
+
   // Steps 4 and 5 of Algorithm 7.3.1 from x (the step starting at t0) into
   // x_next_; false (failure_ says why) when the LCP fails.
   bool step(const EulerFactors& f, const VectorXd& x, double t0) {
-    xb_.noalias() = f.Phi * x;  // free step (I - hA)^{-1} x_k
+    if (inputs_)  // the inputs at the step's end, as backward Euler takes every term
+      xb_.noalias() = f.Phi * (x + f.h * input_drive(t0 + f.h));
+    else
+      xb_.noalias() = f.Phi * x;  // free step (I - hA)^{-1} x_k
     if (k_ == 0) {
       x_next_ = xb_;
       return true;
@@ -243,6 +267,8 @@ class EulerRun {
   VectorXd u_, xb_, q_, x_next_;
   std::string failure_;                         // why step() failed
   std::unique_ptr<EulerStepSensitivity> sens_;  // Options::sensitivity asked, else null
+  bool inputs_ = false;                         // force inputs evaluated per step (set_up_inputs)
+  MatrixXd Minv_;
 };
 
 }  // namespace

@@ -233,6 +233,7 @@ class MjRun {
     const double h = last ? grid_.h_last : grid_.h;
     MjIteration& f = (last && grid_.h_last != grid_.h) ? F_last_ : F_;
     const double t0 = (j - 1) * grid_.h;  // the step's start, for messages
+    ops_.set_step(t0, h, theta_);         // a model's inputs (docs/inputs.md)
     free_velocity(f, h);
     select_active(h);
     clear_step_outputs();

@@ -58,7 +58,7 @@ inline bool all_finite(const VectorXd& x) {
 class MjOperators {
  public:
   MjOperators(const mech::MechanicalModel& m, bool sparse)
-      : m_(m), sparse_(sparse), Ec_(m.E), Er_(m.E), K_(m.K), D_(m.D) {
+      : m_(m), sparse_(sparse), Ec_(m.E), Er_(m.E), K_(m.K), D_(m.D), f_(m.f) {
     Ec_.makeCompressed();
     Er_.makeCompressed();
     K_.makeCompressed();
@@ -90,6 +90,12 @@ class MjOperators {
     Gt.makeCompressed();
     return Gt;
   }
+  // A model with inputs (docs/inputs.md): the step's force from t0 to
+  // t0 + h, theta f(t0 + h) + (1 - theta) f(t0) (f alone without inputs).
+  void set_step(double t0, double h, double theta) const {
+    if (m_.has_inputs())
+      f_ = theta * mech::force_at(m_, t0 + h) + (1.0 - theta) * mech::force_at(m_, t0);
+  }
   // f - D v - K (q + h theta v): the smooth force of the step. No allocation
   // after the first call (the scratch vector is kept).
   void step_force(const VectorXd& q, const VectorXd& v, double h, double theta,
@@ -97,7 +103,7 @@ class MjOperators {
     qt_ = q + (h * theta) * v;
     out.setZero();
     add_times(K_, 1.0, qt_, out);  // = K qt
-    out = m_.f - out;
+    out = f_ - out;
     add_times(D_, -1.0, v, out);
   }
   // out = E x (out sized k).
@@ -119,6 +125,7 @@ class MjOperators {
   SparseRow Er_;         // E by rows: the gap rates E v
   SparseCol K_, D_;      // compressed copies for add_times
   SparseCol Gt_;         // [E; T]': normal and tangent rows as columns
+  mutable VectorXd f_;   // the step's force: f, or f(t) with inputs (set_step)
   mutable VectorXd qt_;  // step_force scratch: q + h theta v
 };
 

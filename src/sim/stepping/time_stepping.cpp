@@ -39,6 +39,7 @@ class EulerIntegrator : public Integrator {
     OptionsUsed u;  // every impact inelastic: Options::impact is not read
     u.h = u.lcp_solver = u.force = u.dense_lcs = true;
     u.sensitivity = true;  // the discrete map's derivative (step_sensitivity.hpp)
+    u.inputs = true;       // force inputs evaluated at each step's end (euler.cpp)
     return u;
   }
   Trajectory integrate(const mech::Model& model, const VectorXd& x0,
@@ -57,6 +58,7 @@ class MoreauJeanIntegrator : public Integrator {
     u.friction_3d = true;   // the cone's LCP in Stewart and Trinkle's form (the same)
     u.sensitivity = true;   // the discrete map's derivative, frictionless (step_sensitivity.hpp)
     u.symmetric_dk = true;  // W by Cholesky (step_kernels.hpp)
+    u.inputs = true;        // force inputs theta-weighted over each step (step_kernels.hpp)
     return u;
   }
   Trajectory integrate(const mech::Model& model, const VectorXd& x0,

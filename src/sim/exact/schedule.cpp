@@ -1,0 +1,97 @@
+// Scheduled events of the exact method (issue 29; docs/inputs.md): the
+// breakpoints of a model's inputs (a step, a pulse's edges, a PWL's points).
+// Between them each input is the output of its exosystem, appended to the
+// state (mech::to_lcs), so a phase is still one matrix exponential; at a
+// breakpoint the phase ends, the exosystem's state is re-initialised to the
+// next piece (mech::exosystem_states) and the mode is selected again, as at
+// any event (the new force may open a closed contact). The state q, v is
+// continuous there: a bounded force jump gives no impulse.
+#include <cmath>
+#include <lcsim/core/format.hpp>
+
+#include "sim/exact/event_driven_detail.hpp"
+
+namespace lcsim::sim::detail {
+
+double EventDriven::next_scheduled(double t) const {
+  if (!model_.is_mechanical() || !model_.mechanical->has_inputs())
+    return std::numeric_limits<double>::infinity();
+  return mech::next_breakpoint(*model_.mechanical, t);
+}
+
+// The event at the breakpoint t_b that ended the phase pm: the state there,
+// the exosystem re-initialised, the mode selected; false when the run ends.
+// Not counted by the Zeno or livelock guards: breakpoints are the user's,
+// finitely many in any interval, and need no guard against accumulating.
+bool EventDriven::take_scheduled(RunState& r, PhaseMarch& pm, double t_b) {
+  Trajectory& tr = r.tr;
+  const mech::MechanicalModel& m = *model_.mechanical;
+  const VectorXd x_minus = pm.state_at(t_b);
+  const bool keep = static_cast<long>(tr.events.size()) < opt_.max_recorded_events;
+  if (keep) record(tr, t_b, x_minus, r.phase);
+  std::string names;
+  for (const mech::Input& in : m.inputs)
+    if (in.next_breakpoint(pm.t0) == t_b) names += (names.empty() ? "'" : ", '") + in.name + "'";
+  r.t = t_b;
+  VectorXd x_b = x_minus;
+  const VectorXd w = mech::exosystem_states(m, t_b);
+  x_b.tail(w.size()) = w;
+  // pm refers to r.phase, which reinitialise replaces: not used below.
+  EventResult ev;
+  if (!reinitialise(r, x_b, ev)) {
+    r.xa = x_b;
+    return false;
+  }
+  if (!keep) {
+    if (tr.events_not_recorded++ == 0)
+      tr.warn("events-not-recorded", r.t,
+              "more than " + std::to_string(opt_.max_recorded_events) +
+                  " events: later events and their samples are counted, not recorded");
+    return true;
+  }
+  Event e;
+  e.t = r.t;
+  e.type = EventType::kSchedule;
+  e.state_before = user(x_minus);
+  e.state_after = user(r.xa);
+  e.mode_after = ev.mode;
+  e.impulse = ev.impulse;
+  set_friction(e, ev);
+  e.note = "breakpoint of input " + names;
+  tr.events.push_back(std::move(e));
+  record(tr, r.t, r.xa, r.phase);
+  return true;
+}
+
+// The exosystem block: its states are the last e of the augmented state,
+// after (q, v, 1) (mech::to_lcs).
+VectorXd EventDriven::stop_offset(const VectorXd& xa) const {
+  const int e = n_ - 2 * N_ - 1;
+  return sys_.C.rightCols(e) * xa.tail(e);
+}
+
+VectorXd EventDriven::stop_rate(const VectorXd& xa) const {
+  const int e = n_ - 2 * N_ - 1;
+  return sys_.C.rightCols(e) * (sys_.A.bottomRightCorner(e, e) * xa.tail(e));
+}
+
+// delta = M^{-1} E_J' (E_J M^{-1} E_J')^+ gdot_J: the M-smallest velocity
+// whose rates on J are the stops' own (a least-squares solve copes with
+// dependent rows, as project_onto). Zero when no closed stop moves.
+VectorXd EventDriven::stop_shift(const std::vector<int>& closed, const VectorXd& xa) const {
+  VectorXd delta = VectorXd::Zero(N_);
+  if (closed.empty()) return delta;
+  const mech::MechanicalModel& m = *model_.mechanical;
+  const VectorXd rate = stop_rate(xa);
+  MatrixXd EJ(closed.size(), N_);
+  VectorXd r(closed.size());
+  for (size_t i = 0; i < closed.size(); ++i) {
+    EJ.row(static_cast<Eigen::Index>(i)) = m.E.row(closed[i]);
+    r(static_cast<Eigen::Index>(i)) = rate(closed[i]);
+  }
+  if (r.isZero(0.0)) return delta;
+  const MatrixXd MinvEt = Eigen::LLT<MatrixXd>(m.M).solve(EJ.transpose());
+  return MinvEt * (EJ * MinvEt).completeOrthogonalDecomposition().solve(r);
+}
+
+}  // namespace lcsim::sim::detail
