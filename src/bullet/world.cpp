@@ -256,23 +256,14 @@ std::unique_ptr<World> build(const mech::MechanicalModel& m, const std::vector<L
 // that file gives (M, D, K, E, g, f and the names; the restitution is the
 // model's own); else nullopt.
 std::optional<scene::Scene> contact_scene_of(const mech::Model& model) {
-  try {
-    std::optional<scene::Scene> sc = scene::load_scene_details(model.source);
-    if (!sc) return std::nullopt;
-    if (!sc->base.floating && sc->base.pose.matrix() == Eigen::Matrix4d::Identity() &&
-        sc->contacts.empty())
-      return std::nullopt;
-    const mech::MechanicalModel &a = *sc->model.mechanical, &b = *model.mechanical;
-    if (a.coordinates != b.coordinates || a.constraints != b.constraints ||
-        MatrixXd(a.M) != MatrixXd(b.M) || MatrixXd(a.D) != MatrixXd(b.D) ||
-        MatrixXd(a.K) != MatrixXd(b.K) || MatrixXd(a.E) != MatrixXd(b.E) || a.g != b.g ||
-        a.f != b.f)
-      return std::nullopt;
-    sc->model.mechanical->restitution = b.restitution;
-    return sc;
-  } catch (const std::exception&) {
+  std::optional<scene::Scene> sc = scene::scene_of(model);
+  // One URDF (a scene of bodies runs as its matrices, or is refused), with a
+  // floating or placed base or contacts (else scene_setup's multibody).
+  if (!sc || !sc->bodies.empty() ||
+      (!sc->base.floating && sc->base.pose.matrix() == Eigen::Matrix4d::Identity() &&
+       sc->contacts.empty()))
     return std::nullopt;
-  }
+  return sc;
 }
 
 // Which scene runs a model: the multibody for a URDF scene whose rows are

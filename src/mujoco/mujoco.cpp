@@ -77,32 +77,15 @@ std::string settings_description(const Settings& s, double h) {
 
 namespace {
 
-// The scene `model` was loaded from, while `model` is still what the file
-// gives (else nullopt); its restitution is the model's.
-std::optional<scene::Scene> scene_of(const mech::Model& model) {
-  if (!model.is_mechanical()) return std::nullopt;
-  try {
-    std::optional<scene::Scene> sc = scene::load_scene_details(model.source);
-    if (!sc) return std::nullopt;
-    const mech::MechanicalModel &a = *sc->model.mechanical, &b = *model.mechanical;
-    if (a.coordinates != b.coordinates || a.constraints != b.constraints ||
-        MatrixXd(a.M) != MatrixXd(b.M) || MatrixXd(a.D) != MatrixXd(b.D) ||
-        MatrixXd(a.K) != MatrixXd(b.K) || MatrixXd(a.E) != MatrixXd(b.E) || a.g != b.g ||
-        a.f != b.f)
-      return std::nullopt;
-    sc->model.mechanical->restitution = b.restitution;
-    return sc;
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
-}
-
 // What check_expressible refuses, or "" (the scene found).
 std::string refusal(const mech::Model& model, std::optional<scene::Scene>& sc) {
-  sc = scene_of(model);
+  sc = scene::scene_of(model);
   if (!sc)
     return "mujoco: " + model.source +
            ": MuJoCo runs URDF scenes only (a model file with `urdf:`, unchanged since loading)";
+  if (!sc->bodies.empty())
+    return "mujoco: " + model.source +
+           ": a scene of several bodies (`bodies:`): MuJoCo runs one-URDF scenes only";
   const mech::MechanicalModel& m = *model.mechanical;
   const std::string where = "mujoco: " + model.source + ": ";
   if (m.has_friction()) return where + "MuJoCo runs frictionless contact scenes only";

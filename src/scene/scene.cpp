@@ -264,22 +264,26 @@ bool same_model(const mech::MechanicalModel& a, const mech::MechanicalModel& b) 
 
 }  // namespace
 
-std::optional<Scene> scene_setup(const mech::Model& model) {
+std::optional<Scene> scene_of(const mech::Model& model) {
   if (!model.is_mechanical()) return std::nullopt;
   try {
     std::optional<Scene> scene = load_scene_details(model.source);
     if (!scene || !same_model(*scene->model.mechanical, *model.mechanical)) return std::nullopt;
-    // Bullet's multibody (src/bullet) is built with its root fixed at the
-    // identity and no contacts: a scene with a floating or placed base, or
-    // with contacts, is not one it can build (it runs the matrices).
-    if (!scene->bodies.empty() || scene->base.floating ||
-        scene->base.pose.matrix() != Eigen::Matrix4d::Identity() || !scene->contacts.empty())
-      return std::nullopt;
     scene->model.mechanical->restitution = model.mechanical->restitution;  // the model's own
     return scene;
   } catch (const std::exception&) {
     return std::nullopt;
   }
+}
+
+std::optional<Scene> scene_setup(const mech::Model& model) {
+  std::optional<Scene> scene = scene_of(model);
+  // Joint limits only, on one URDF with its root fixed at the identity
+  // (Bullet's joint-limit multibody; its contact scenes: src/bullet/world.cpp).
+  if (!scene || !scene->bodies.empty() || scene->base.floating ||
+      scene->base.pose.matrix() != Eigen::Matrix4d::Identity() || !scene->contacts.empty())
+    return std::nullopt;
+  return scene;
 }
 
 mech::Model load_scene(const std::filesystem::path& path) {

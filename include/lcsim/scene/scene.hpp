@@ -66,6 +66,12 @@ Scene read_scene(const std::string& yaml_text, const std::string& source);
 // The scene in `path`, or nullopt when the file is a model, not a scene (no
 // top-level `urdf:` key). Errors as load_model.
 std::optional<Scene> load_scene_details(const std::filesystem::path& path);
+// The scene `model` was loaded from (model.source), while `model` is still
+// what that file gives up to the restitution (a parameter of the
+// constraints, which the Scene then takes from `model`); else nullopt (a
+// matrix model, a changed model, a file that no longer loads). What a peer
+// that rebuilds the URDF starts from.
+std::optional<Scene> scene_of(const mech::Model& model);
 // The model in `path` (as load_model) and, for a scene, the Scene: the file
 // is read and parsed once (a 10000-cart model's YAML tree is 75 MB).
 struct LoadedModel {
