@@ -50,4 +50,16 @@ TEST(PeersCli, UnknownPeerAndInexpressibleSceneExitTwoWithOneLine) {
   EXPECT_EQ(carts.err.find('\n'), carts.err.size() - 1) << carts.err;  // one line
 }
 
+// A scene of several bodies: neither peer builds it (MuJoCo once read its
+// null URDF); each says so in one line, exit 2, before anything runs.
+TEST(PeersCli, ASceneOfBodiesIsRefusedByBothPeers) {
+  const auto mj = lcsim("compare '" + kRobots + "gripper_box_scene.yaml' --peer mujoco");
+  EXPECT_EQ(mj.exit_code, 2) << mj.err;
+  EXPECT_NE(mj.err.find("several bodies"), std::string::npos) << mj.err;
+  EXPECT_EQ(mj.err.find('\n'), mj.err.size() - 1) << mj.err;
+  const auto bt = lcsim("compare '" + kRobots + "gripper_box_scene.yaml' --peer bullet");
+  EXPECT_EQ(bt.exit_code, 2) << bt.err;
+  EXPECT_EQ(bt.err.find('\n'), bt.err.size() - 1) << bt.err;
+}
+
 }  // namespace
