@@ -19,7 +19,7 @@ MODELS = ["ball.yaml", "triple_integrator.yaml", "two_carts.yaml", "two_carts_ho
           "block_on_floor_friction.yaml", "incline_friction.yaml", "mass_spring_friction.yaml",
           "spinning_disk_friction.yaml", "belt_friction.yaml",
           "box_drop_scene.yaml", "box_tip_scene.yaml", "quadruped_drop_scene.yaml",
-          "gripper_box_scene.yaml", "vision60_drop_scene.yaml"]
+          "gripper_box_scene.yaml", "vision60_drop_scene.yaml", "shaker_table.yaml", "pwl_lift.yaml"]
 HORIZON = 0.5  # s at most: 50 samples of dt_out, each model's events in that window
 
 
