@@ -91,7 +91,7 @@ std::string model_yaml(const mech::Model& model, const std::string& header) {
                               list(VectorXd(c.tangent2)) + "]" +
                               (c.edges > 0 ? ", d: " + std::to_string(c.edges) : std::string())
                         : ", tangent: " + list(VectorXd(c.tangent)))
-          << ", mu: " << format_number(c.mu)
+          << ", mu: " << format_number(c.mu) << (c.world_frame ? ", frame: world" : "")
           << (c.velocity != 0.0 ? ", velocity: " + format_number(c.velocity) : std::string())
           << "}\n";
   }

@@ -175,6 +175,16 @@ void parse_tangents(const Keys& keys, const std::string& source, const std::stri
   if (keys.count("d")) c.edges = cone_edges(keys.at("d"), source, ikey + ".d");
 }
 
+// An entry's `frame: world`: its rows are a contact frame orthonormal in the
+// world, mapped to the model's coordinates (a scene's contact written by
+// `analyze --model-out`), so the Euclidean orthogonality test does not apply
+// to them (mech::FrictionalContact::world_frame). `frame: model` is the default.
+bool world_frame(const YAML::Node& n, const std::string& source, const std::string& key) {
+  if (n.IsScalar() && (n.Scalar() == "world" || n.Scalar() == "model"))
+    return n.Scalar() == "world";
+  fail(source, key, "must be 'world' or 'model' (got " + describe(n) + ")");
+}
+
 // `friction: [{contact: <0-based row of E or its name>, tangent: [N numbers],
 // mu: <number>, velocity: <number, optional>}]`, or with `tangents: [[N
 // numbers], [N numbers]]` and `d: <whole number, optional>` in place of
@@ -190,8 +200,8 @@ std::vector<mech::FrictionalContact> parse_friction(const YAML::Node& n,
   std::vector<mech::FrictionalContact> out;
   for (std::size_t i = 0; i < n.size(); ++i) {
     const std::string ikey = key + "[" + std::to_string(i) + "]";
-    const Keys keys =
-        mapping(n[i], source, ikey, {"contact", "tangent", "tangents", "d", "mu", "velocity"});
+    const Keys keys = mapping(n[i], source, ikey,
+                              {"contact", "tangent", "tangents", "d", "mu", "velocity", "frame"});
     for (const char* k : {"contact", "mu"})
       if (!keys.count(k)) fail(source, ikey + "." + k, "missing");
     mech::FrictionalContact c;
@@ -215,6 +225,7 @@ std::vector<mech::FrictionalContact> parse_friction(const YAML::Node& n,
     c.mu = number(keys.at("mu"), source, ikey + ".mu");
     if (keys.count("velocity"))
       c.velocity = number(keys.at("velocity"), source, ikey + ".velocity");
+    if (keys.count("frame")) c.world_frame = world_frame(keys.at("frame"), source, ikey + ".frame");
     out.push_back(std::move(c));
   }
   return out;

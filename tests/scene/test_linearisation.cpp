@@ -164,7 +164,9 @@ TEST_F(Linearisation, ThresholdMustBePositiveAndFinite) {
 TEST(ModelOut, ScenesRoundTripExactly) {
   for (const char* f :
        {"two_carts_scene.yaml", "two_carts_hook_scene.yaml", "double_pendulum_scene.yaml",
-        "arm_gripper_scene.yaml", "kuka_iiwa_scene.yaml", "panda_gripper_scene.yaml"}) {
+        "arm_gripper_scene.yaml", "kuka_iiwa_scene.yaml", "panda_gripper_scene.yaml",
+        "box_drop_scene.yaml", "box_tip_scene.yaml", "quadruped_drop_scene.yaml",
+        "gripper_box_scene.yaml", "vision60_drop_scene.yaml"}) {
     const mech::Model a = scene::load_model(kRobots + f);
     const mech::Model b = scene::parse_model(io::model_yaml(a, "header"), "written.yaml");
     SCOPED_TRACE(f);
@@ -174,6 +176,50 @@ TEST(ModelOut, ScenesRoundTripExactly) {
     EXPECT_EQ(a.initial, b.initial);
     EXPECT_EQ(a.t_end, b.t_end);
     EXPECT_EQ(a.name, b.name);
+  }
+}
+
+// A scene's 3-D friction rows are a world frame mapped to coordinates, not
+// Euclidean-orthogonal there (the tipped box's corners: cosine ~5e-3); the
+// written model says so (`frame: world`) and reads back as the same contacts,
+// so it loads and runs as the scene does, bit for bit.
+TEST(ModelOut, SceneFrictionRoundTripsWithItsFrame) {
+  std::ifstream in(kRobots + "box_tip_scene.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string plain = "- {link: box, plane: floor}";
+  ASSERT_NE(text.find(plain), std::string::npos);
+  text.replace(text.find(plain), plain.size(), "- {link: box, plane: floor, friction: 0.5, d: 4}");
+  const mech::Model a = scene::parse_model(text, kRobots + "box_tip_friction.yaml");
+  const std::string written = io::model_yaml(a, "header");
+  EXPECT_NE(written.find("frame: world"), std::string::npos);
+  const mech::Model b = scene::parse_model(written, "written.yaml");
+  test_support::expect_same_matrices(*a.mechanical, *b.mechanical);
+  ASSERT_EQ(a.mechanical->friction.size(), b.mechanical->friction.size());
+  for (size_t i = 0; i < a.mechanical->friction.size(); ++i) {
+    const mech::FrictionalContact &fa = a.mechanical->friction[i], &fb = b.mechanical->friction[i];
+    EXPECT_TRUE(fa.world_frame && fb.world_frame) << i;
+    EXPECT_EQ(VectorXd(fa.tangent), VectorXd(fb.tangent)) << i;
+    EXPECT_EQ(VectorXd(fa.tangent2), VectorXd(fb.tangent2)) << i;
+    EXPECT_EQ(fa.mu, fb.mu) << i;
+    EXPECT_EQ(fa.edges, fb.edges) << i;
+  }
+  const sim::Trajectory ta = sim::simulate(a, sim::Options{}),
+                        tb = sim::simulate(b, sim::Options{});
+  ASSERT_EQ(ta.status, sim::RunStatus::kCompleted) << ta.message;
+  ASSERT_EQ(tb.status, sim::RunStatus::kCompleted) << tb.message;
+  EXPECT_EQ(ta.samples.back().x, tb.samples.back().x);
+}
+
+TEST(ModelOut, FrictionFrameIsWorldOrModel) {
+  const std::string model =
+      "mechanical:\n  M: [[1, 0], [0, 1]]\n  E: [[1, 0]]\n  g: [0]\n"
+      "  friction:\n    - {contact: 0, tangents: [[0, 1], [0, 1]], mu: 0.1, frame: ";
+  try {
+    scene::parse_model(model + "earth}\n", "bad.yaml");
+    ADD_FAILURE() << "frame: earth accepted";
+  } catch (const io::InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "bad.yaml: mechanical.friction[0].frame: must be 'world' or 'model' (got 'earth')");
   }
 }
 
