@@ -268,8 +268,18 @@ void delassus_section(Draft& d, const mech::MechanicalModel& m, const std::optio
 void mechanical_section(Draft& d, const mech::Model& model, const lcs::Lcs& sys) {
   const std::optional<Coactive> co = mass_and_rank(d, model);
   delassus_section(d, *model.mechanical, co);
-  d.out << "LCS (3.65):  augmented with a constant state for the affine terms f and g: "
-        << "x = (q, v, 1) of size 2N+1 = " << sys.n() << "\n";
+  const mech::MechanicalModel& m = *model.mechanical;
+  d.out << "LCS (3.65):  augmented with a constant state for the affine terms f and g: ";
+  if (!m.has_inputs()) {
+    d.out << "x = (q, v, 1) of size 2N+1 = " << sys.n() << "\n";
+    return;
+  }
+  // The inputs' exosystems follow (docs/inputs.md): name their states.
+  std::string sizes;
+  for (const mech::Input& in : m.inputs)
+    sizes += (sizes.empty() ? "" : ", ") + in.name + ": " + std::to_string(in.exo_size());
+  d.out << "x = (q, v, 1, w) of size " << sys.n() << ", w the inputs' exosystem states (" << sizes
+        << ")\n";
 }
 
 void lcs_section(Draft& d, const lcs::Lcs& sys) {

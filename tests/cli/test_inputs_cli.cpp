@@ -41,6 +41,16 @@ TEST(InputsCli, BreakpointsAreScheduleEvents) {
   EXPECT_NE(r.out.find("breakpoint of input 'lift'"), std::string::npos);
 }
 
+// analyze states the augmented state with the inputs' exosystem (x = (q, v,
+// 1, w): N = 1, so 2N + 1 = 3 plus the PWL's two states p, r), not 2N + 1.
+TEST(InputsCli, AnalyzeNamesTheExosystemStates) {
+  const CliRun r = lcsim_run("analyze " + std::string(LCSIM_SOURCE_DIR) + "/robots/pwl_lift.yaml");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("x = (q, v, 1, w) of size 5, w the inputs' exosystem states (lift: 2)"),
+            std::string::npos)
+      << r.out;
+}
+
 // One line, exit 2, naming each of `names`; no output file.
 void expect_refused(const std::string& model, std::initializer_list<std::string> names) {
   const fs::path f = model_file(model);
