@@ -141,10 +141,15 @@ std::vector<CollisionShape> collision_shapes(const std::vector<CollisionElement>
       for (double x : v)
         if (!(x > 0.0)) refuse(urdf, c, "<box size>: must be > 0 (got '" + it->second + "')");
       s.half = 0.5 * Vector3d(v[0], v[1], v[2]);
+    } else if (c.shape == "capsule" || c.shape == "cylinder") {  // along z
+      s.radius = length(c, "radius", urdf);
+      s.half = Vector3d(0.0, 0.0, 0.5 * length(c, "length", urdf));
     } else {
       refuse(urdf, c,
              "<" + (c.shape.empty() ? std::string("geometry") : c.shape) +
-                 ">: another body's points can touch a sphere or a box only");
+                 ">: another body's points can touch a sphere, a box, a capsule or a cylinder "
+                 "only (a mesh: give this link's points in the scene and let them touch the "
+                 "other body's primitives)");
     }
     s.index = static_cast<std::size_t>(count[s.kind]++);
     out.push_back(s);

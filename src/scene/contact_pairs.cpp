@@ -1,7 +1,9 @@
 // Contact points on a scene's bodies: against a world plane, and against
-// another body's sphere or box (docs/contacts.md, "Body against body"):
+// another body's sphere, box, capsule or cylinder (docs/contacts.md, "Body
+// against body"):
 // exact signed distances and, at a configuration, the contact frame with
 // the exact derivatives of the relative motion along its directions.
+#include <algorithm>
 #include <cmath>
 #include <lcsim/io/input_error.hpp>
 #include <lcsim/scene/bodies.hpp>
@@ -42,6 +44,33 @@ Vector3d point_at(const Bodies& b, const ContactPoint& p, const Eigen::VectorXd&
   return b.link_pose(p.body, p.link, q) * p.local;
 }
 
+// A capsule's or a cylinder's outward unit normal at the nearest feature to
+// y (the point in the shape's frame; axis z, radius s.radius, half length
+// s.half.z()) and the signed distance from its surface; a zero normal where
+// none exists (y on a capsule's axis segment, or on a cylinder's axis where
+// its side is nearest). Capsule: y less its nearest point on the axis
+// segment, less the radius. Cylinder: beyond the rim (radially out and past
+// an end) towards the rim's nearest point; else the side or the end cap,
+// whichever y is farther outside of (inside: the nearer surface).
+Vector3d round_normal(const BodyShape& s, const Vector3d& y, double& distance) {
+  const double hl = s.half.z();
+  if (s.kind == "capsule") {
+    const Vector3d d = y - Vector3d(0.0, 0.0, std::clamp(y.z(), -hl, hl));
+    distance = d.norm() - s.radius;
+    return d.norm() > 0.0 ? Vector3d(d / d.norm()) : Vector3d::Zero();
+  }
+  const double r = y.head<2>().norm();
+  const double dr = r - s.radius, dz = std::abs(y.z()) - hl;
+  const Vector3d radial = r > 0.0 ? Vector3d(y.x() / r, y.y() / r, 0.0) : Vector3d::Zero();
+  const Vector3d axial(0.0, 0.0, y.z() >= 0.0 ? 1.0 : -1.0);
+  if (dr > 0.0 && dz > 0.0) {
+    distance = std::hypot(dr, dz);
+    return (dr * radial + dz * axial) / distance;
+  }
+  distance = std::max(dr, dz);
+  return dr > dz ? radial : axial;
+}
+
 // The unit normal (shape to point), the distance of the point's centre from
 // the shape's surface along it, and the shape's material point there.
 struct Separation {
@@ -61,9 +90,16 @@ Separation separation(const Bodies& b, const ContactPoint& p, const BodyShape& s
     out.normal = d / d.norm();
     out.distance = d.norm() - s.radius;
     out.surface = X.translation() + s.radius * out.normal;
-  } else {
+  } else if (s.kind == "box") {
     out.normal = X.linear() * face_normal(s.face);
     out.distance = out.normal.dot(w - X.translation()) - s.half(s.face / 2);
+    out.surface = w - out.distance * out.normal;
+  } else {  // capsule or cylinder, along the shape frame's z
+    const Vector3d n = round_normal(s, X.inverse() * w, out.distance);
+    if (!(n.norm() > 0.0))
+      throw InputError("contact '" + p.name + "' is on the axis of " + s.kind + " '" + s.name +
+                       "': no normal");
+    out.normal = X.linear() * n;
     out.surface = w - out.distance * out.normal;
   }
   return out;

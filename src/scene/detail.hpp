@@ -54,9 +54,10 @@ std::vector<CollisionElement> collision_elements(const std::string& xml);
 std::vector<ContactPoint> collision_points(const std::vector<CollisionElement>& elements,
                                            const std::string& link, const std::string& prefix,
                                            const std::string& urdf);
-// The sphere and box <collision> primitives of `link` as shapes (its frame
-// in the link's, a sphere's radius or a box's half sizes, m; index counted
-// per kind); InputError naming the link and the element for another shape.
+// The sphere, box, capsule and cylinder <collision> primitives of `link` as
+// shapes (its frame in the link's; a radius, a box's half sizes or a
+// capsule's and cylinder's half length as half.z(), m; index counted per
+// kind); InputError naming the link and the element for another shape.
 struct CollisionShape {
   std::string kind;
   std::size_t index = 0;

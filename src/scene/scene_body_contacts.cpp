@@ -1,7 +1,7 @@
 // Contacts between two bodies of a scene (docs/contacts.md, "Body against
 // body"): a contact entry's `link:` and `against:` name links of two
-// bodies ("<body>/<link>"); the points of the first touch the spheres and
-// boxes of the second.
+// bodies ("<body>/<link>"); the points of the first touch the spheres,
+// boxes, capsules and cylinders of the second.
 #include <urdf_model/model.h>
 
 #include <algorithm>
@@ -49,8 +49,8 @@ std::vector<BodyShape> body_shapes(const std::vector<ContactBody>& bodies, const
   const std::vector<CollisionShape> shapes = collision_shapes(u.collisions, ref.link, u.path);
   if (shapes.empty())
     fail(source, key,
-         "link '" + ref.label + "' has no <collision> sphere or box in " + u.path +
-             " (another body's points touch those)");
+         "link '" + ref.label + "' has no <collision> sphere, box, capsule or cylinder in " +
+             u.path + " (another body's points touch those)");
   std::vector<BodyShape> out;
   for (const CollisionShape& c : shapes) {
     BodyShape s;

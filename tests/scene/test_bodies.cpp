@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <lcsim/io/io.hpp>
 #include <lcsim/mech/mech.hpp>
 #include <lcsim/scene/bodies.hpp>
@@ -12,7 +13,9 @@
 #include <lcsim/scene/linearisation.hpp>
 #include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
+#include <map>
 #include <random>
+#include <sstream>
 
 #include "scene/scene_files.hpp"
 
@@ -119,27 +122,23 @@ q0: {j1: 0.4}
 // truncation h^2/6 |phi'''| <= 2e-11 (lever arms and distances below 2 m)
 // plus rounding eps |phi| / h <= 5e-10 (|phi| < 2 m), so 1e-8 leaves a
 // margin of 20. The tangent rows are checked as the derivatives of the
-// relative position of the two material points along t1, t2.
-TEST_F(BodyScenes, PairJacobiansAreTheExactGradientWithRespectToBothBodies) {
-  const scene::Scene s = load(kTwoBodies);
+// relative position of the two material points along t1, t2. Every pair
+// contact of `s`, at `draws` random configurations; the number of rows
+// checked per shape kind.
+std::map<std::string, int> expect_exact_pair_rows(const scene::Scene& s, int draws, unsigned seed,
+                                                  double spread = 0.3) {
   const scene::Bodies dyn = scene::scene_bodies(s);
-  // tool: sphere + box (9 points) on blk's box and sphere: 18; rev: blk's
-  // 8 corners and sphere on tool's sphere and box: 18; pt: 2; floor: 9.
-  ASSERT_EQ(s.contacts.size(), 18u + 18u + 2u + 9u);
-  EXPECT_EQ(s.contacts[0].point.name, "arm.tool.sphere0_box0");
-  EXPECT_EQ(s.contacts[0].plane, "blk/block.box0");
-  EXPECT_EQ(s.contacts[36].point.name, "pt.point0_box0");
   const VectorXd q0 = dyn.reference();
-  std::mt19937 rng(26);
-  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-spread, spread);
   const double h = 1e-5;
-  int box_rows = 0, sphere_rows = 0;
-  for (int d = 0; d < 4; ++d) {
+  std::map<std::string, int> rows;
+  for (int d = 0; d < draws; ++d) {
     VectorXd q = q0;
     for (Eigen::Index i = 0; i < q.size(); ++i) q(i) += u(rng);
     for (const scene::ContactFrame& c0 : s.contacts) {
       if (!c0.against) continue;
-      (c0.against->kind == "box" ? box_rows : sphere_rows) += 1;
+      rows[c0.against->kind] += 1;
       const scene::ContactFrame c = scene::contact_frame(dyn, c0.point, *c0.against, q);
       EXPECT_NEAR(c.gap, scene::signed_distance(dyn, c0, s.planes, q), 1e-15);
       const scene::BodyShape& o = *c0.against;
@@ -171,8 +170,168 @@ TEST_F(BodyScenes, PairJacobiansAreTheExactGradientWithRespectToBothBodies) {
       EXPECT_NEAR(F.determinant(), 1.0, 1e-15);
     }
   }
-  EXPECT_GT(box_rows, 0);
-  EXPECT_GT(sphere_rows, 0);
+  return rows;
+}
+
+TEST_F(BodyScenes, PairJacobiansAreTheExactGradientWithRespectToBothBodies) {
+  const scene::Scene s = load(kTwoBodies);
+  // tool: sphere + box (9 points) on blk's box and sphere: 18; rev: blk's
+  // 8 corners and sphere on tool's sphere and box: 18; pt: 2; floor: 9.
+  ASSERT_EQ(s.contacts.size(), 18u + 18u + 2u + 9u);
+  EXPECT_EQ(s.contacts[0].point.name, "arm.tool.sphere0_box0");
+  EXPECT_EQ(s.contacts[0].plane, "blk/block.box0");
+  EXPECT_EQ(s.contacts[36].point.name, "pt.point0_box0");
+  const std::map<std::string, int> rows = expect_exact_pair_rows(s, 4, 26);
+  EXPECT_GT(rows.at("box"), 0);
+  EXPECT_GT(rows.at("sphere"), 0);
+}
+
+// A third body: a capsule and a cylinder on rotated, shifted origins.
+const std::string kPill = R"(<robot name="pill">
+  <link name="pill">
+    <inertial><mass value="2"/>
+      <inertia ixx="0.02" ixy="0" ixz="0" iyy="0.03" iyz="0" izz="0.01"/></inertial>
+    <collision><origin xyz="0.05 -0.02 0.1" rpy="0.4 -0.3 0.2"/>
+      <geometry><capsule radius="0.08" length="0.5"/></geometry></collision>
+    <collision><origin xyz="-0.1 0.05 -0.05" rpy="-0.2 0.5 0.1"/>
+      <geometry><cylinder radius="0.15" length="0.3"/></geometry></collision>
+  </link>
+</robot>)";
+
+// The arm's tool (its sphere and box corners) and explicit points on its
+// base against the pill's capsule and cylinder, at q0 facing the capsule's
+// side and cap and the cylinder's side, end and rim (the points below are
+// placed in the pill's frame through the base's pose at q0).
+const std::string kRound = R"(bodies:
+  - name: arm
+    urdf: arm.urdf
+    base: {type: floating, pose: {xyz: [0.1, -0.2, 0.5], rpy: [0.3, -0.1, 0.7]}}
+    joints: [j1]
+    q0: {j1: 0.4}
+  - name: pill
+    urdf: pill.urdf
+    base: {type: floating, pose: {xyz: [1.2, 0.3, 0.6], rpy: [-0.2, 0.4, 0.1]}}
+contacts:
+  - {link: arm/tool, against: pill/pill}
+  - {link: arm/base, against: pill/pill, points: [[1.0, 0.6, 0.3], [1.4, 0.2, 0.1], [0.9, 0.1, -0.2], [1.5, 0.9, 0.8]], radius: 0.01, name: pt}
+)";
+
+// kRound with one more contact: two points on the arm's base, computed from
+// the poses at q0, 0.2 m beyond the cylinder's +z end on its axis and beyond
+// its rim (0.1 m out radially, 0.1 m past the -z end), so that q0 itself
+// visits the end cap and the rim.
+class RoundScenes : public BodyScenes {
+ protected:
+  scene::Scene load_round() {
+    write("pill.urdf", kPill);
+    const scene::Scene first = load(kRound);
+    const scene::Bodies dyn = scene::scene_bodies(first);
+    const VectorXd q0 = dyn.reference();
+    const auto cyl = std::find_if(first.contacts.begin(), first.contacts.end(), [](const auto& c) {
+      return c.against && c.against->kind == "cylinder";
+    });
+    EXPECT_NE(cyl, first.contacts.end());
+    const Eigen::Isometry3d X =
+        dyn.link_pose(cyl->against->body, cyl->against->link, q0) * cyl->against->local;
+    const Eigen::Isometry3d base = dyn.link_pose(0, "base", q0);
+    const auto at = [&](const Vector3d& y) {
+      const Vector3d b = base.inverse() * (X * y);
+      std::ostringstream o;
+      o << std::setprecision(17) << "[" << b.x() << ", " << b.y() << ", " << b.z() << "]";
+      return o.str();
+    };
+    return load(kRound + "  - {link: arm/base, against: pill/pill, points: [" +
+                at(Vector3d(0, 0, 0.35)) + ", " + at(Vector3d(0.25, 0, -0.25)) + "], name: far}\n");
+  }
+};
+
+// Capsules and cylinders as the other body's shapes: the same central
+// differences as above (same step and tolerance: lever arms and distances
+// below 2 m), at configurations up to 0.05 rad or m from q0 that put points
+// on the cylinder's side, its end caps and beyond its rim (counted: each
+// region must be visited).
+TEST_F(RoundScenes, CapsuleAndCylinderRowsAreTheExactGradient) {
+  const scene::Scene s = load_round();
+  const std::map<std::string, int> rows = expect_exact_pair_rows(s, 6, 27, 0.05);
+  EXPECT_GT(rows.at("capsule"), 0);
+  EXPECT_GT(rows.at("cylinder"), 0);
+  // The regions of the cylinder visited at q0 and the draws.
+  const scene::Bodies dyn = scene::scene_bodies(s);
+  std::mt19937 rng(27);
+  std::uniform_real_distribution<double> u(-0.05, 0.05);
+  int side = 0, end = 0, rim = 0;
+  for (int d = 0; d < 6; ++d) {
+    VectorXd q = dyn.reference();
+    for (Eigen::Index i = 0; i < q.size(); ++i) q(i) += u(rng);
+    for (const scene::ContactFrame& c0 : s.contacts) {
+      if (!c0.against || c0.against->kind != "cylinder") continue;
+      const Eigen::Isometry3d X =
+          dyn.link_pose(c0.against->body, c0.against->link, q) * c0.against->local;
+      const Vector3d y =
+          X.inverse() * (dyn.link_pose(c0.point.body, c0.point.link, q) * c0.point.local);
+      const double dr = y.head<2>().norm() - 0.15, dz = std::abs(y.z()) - 0.15;
+      (dr > 0 && dz > 0 ? rim : dr > dz ? side : end) += 1;
+    }
+  }
+  EXPECT_GT(side, 0);
+  EXPECT_GT(end, 0);
+  EXPECT_GT(rim, 0);
+}
+
+// The capsule's and cylinder's gaps at q0 against closed forms computed here
+// from the poses (the distance to the capsule's axis segment; the cylinder's
+// by its regions), for every pair: sums of O(1) m terms, rounding 1e-14.
+TEST_F(RoundScenes, CapsuleAndCylinderGapsAtQ0AreTheClosedFormDistances) {
+  const scene::Scene s = load_round();
+  const mech::MechanicalModel& m = *s.model.mechanical;
+  const scene::Bodies dyn = scene::scene_bodies(s);
+  const VectorXd q0 = dyn.reference();
+  const Eigen::Isometry3d pill = dyn.link_pose(1, "pill", q0);
+  const auto pose = [](double x, double y, double z, double r, double p, double w) {
+    return Eigen::Isometry3d(
+        Eigen::Translation3d(x, y, z) * Eigen::AngleAxisd(w, Vector3d::UnitZ()) *
+        Eigen::AngleAxisd(p, Vector3d::UnitY()) * Eigen::AngleAxisd(r, Vector3d::UnitX()));
+  };
+  const Eigen::Isometry3d cap = pill * pose(0.05, -0.02, 0.1, 0.4, -0.3, 0.2);
+  const Eigen::Isometry3d cyl = pill * pose(-0.1, 0.05, -0.05, -0.2, 0.5, 0.1);
+  int checked = 0;
+  for (Eigen::Index r = 0; r < static_cast<Eigen::Index>(s.contacts.size()); ++r) {
+    const scene::ContactFrame& c = s.contacts[static_cast<size_t>(r)];
+    const Vector3d w = dyn.link_pose(c.point.body, c.point.link, q0) * c.point.local;
+    double phi = 0.0;
+    if (c.against->kind == "capsule") {
+      const Vector3d y = cap.inverse() * w;
+      const double z = std::min(0.25, std::max(-0.25, y.z()));
+      phi = std::sqrt(y.x() * y.x() + y.y() * y.y() + (y.z() - z) * (y.z() - z)) - 0.08;
+    } else {
+      const Vector3d y = cyl.inverse() * w;
+      const double dr = std::sqrt(y.x() * y.x() + y.y() * y.y()) - 0.15;
+      const double dz = std::abs(y.z()) - 0.15;
+      phi = dr > 0 && dz > 0 ? std::sqrt(dr * dr + dz * dz) : std::max(dr, dz);
+    }
+    const auto it = std::find(m.constraints.begin(), m.constraints.end(), c.point.name);
+    ASSERT_NE(it, m.constraints.end()) << c.point.name;
+    const Eigen::Index row = it - m.constraints.begin();
+    EXPECT_NEAR(m.E.row(row).dot(q0) + m.g(row), phi - c.point.radius, 1e-14) << c.point.name;
+    ++checked;
+  }
+  EXPECT_EQ(checked, static_cast<int>(s.contacts.size()));
+}
+
+// A mesh of the other link is refused naming the link and the element.
+TEST_F(BodyScenes, AMeshCannotBeTouched) {
+  write("pill.urdf", R"(<robot name="pill"><link name="pill">
+    <inertial><mass value="2"/><inertia ixx="0.02" ixy="0" ixz="0" iyy="0.03" iyz="0" izz="0.01"/></inertial>
+    <collision><geometry><mesh filename="pill.stl"/></geometry></collision>
+  </link></robot>)");
+  try {
+    load(kRound);
+    ADD_FAILURE() << "a mesh was touched";
+  } catch (const io::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("pill"), std::string::npos) << what;
+    EXPECT_NE(what.find("<mesh>"), std::string::npos) << what;
+  }
 }
 
 // Closed forms of the two geometries at q0, independent of the code's:

@@ -49,17 +49,22 @@ struct BodyShape {
   std::string name;  // "<body>/<link>" (and ".<kind><k>" when the link has several)
   std::size_t body = 0;
   std::string link;
-  std::string kind;                                         // "sphere" or "box"
+  std::string kind;  // "sphere", "box", "capsule" or "cylinder" (the last two along z)
   Eigen::Isometry3d local = Eigen::Isometry3d::Identity();  // its frame in the link's
-  double radius = 0.0;                                      // sphere: m
-  Eigen::Vector3d half = Eigen::Vector3d::Zero();           // box: half sizes (m)
+  double radius = 0.0;                                      // sphere, capsule, cylinder: m
+  Eigen::Vector3d half =
+      Eigen::Vector3d::Zero();  // box: half sizes; capsule, cylinder: (0, 0, l/2) (m)
   int face = -1;  // box: axis face / 2 of its frame, outward along + (face odd) or - (even)
 };
 // The exact signed distances at the scene's coordinates q (m):
 //   plane:  phi = normal . (X_link(q) local - plane.point) - radius;
 //   sphere: phi = |w - c| - R - radius (w the point, c the sphere's centre, world);
 //   box:    phi = n_f . (w - X_box(q) (h_f n_f^box)) - radius, n_f = R_box(q) n_f^box,
-//           the face `face` (h_f its half size along its axis).
+//           the face `face` (h_f its half size along its axis);
+//   capsule: phi = |y - (0, 0, clamp(y_z, -l/2, l/2))| - R - radius, y = X_shape(q)^-1 w;
+//   cylinder: with dr = |(y_x, y_y)| - R and dz = |y_z| - l/2, hypot(dr, dz)
+//           beyond the rim (dr, dz > 0), else max(dr, dz), less radius.
+//   The feature nearest at q is used at every q (the box's face is fixed).
 double signed_distance(const Bodies& bodies, const ContactPoint& p, const Plane& plane,
                        const Eigen::VectorXd& q);
 double signed_distance(const Bodies& bodies, const ContactPoint& p, const BodyShape& s,
