@@ -135,8 +135,11 @@ struct SceneJoints {
 };
 // Revolute, continuous or prismatic: a joint with a position.
 bool has_position(const urdf::Joint& j);
+// `obstacle`: a body of a scene of bodies, which may have no coordinates at
+// all (a fixed base and no `joints:`: a table, a wall, a fixture that other
+// bodies touch); a one-URDF scene's robot must have one.
 SceneJoints read_joints(const Keys& keys, const std::string& source, const SceneUrdf& urdf,
-                        const BasePose& base);
+                        const BasePose& base, bool obstacle = false);
 // The check of a joint named where only simulated joints may be (springs,
 // constraints, initial): "" for a simulated joint, else why not.
 NameCheck simulated(const SceneJoints& joints, const SceneUrdf& urdf);

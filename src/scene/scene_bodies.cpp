@@ -56,7 +56,7 @@ BodyPart read_body(const YAML::Node& n, const std::string& source, const std::st
   b.urdf = read_urdf(bk, bsource);
   b.base = read_base(bk, bsource, b.urdf);
   b.base.name = b.name;
-  b.joints = read_joints(bk, bsource, b.urdf, b.base);
+  b.joints = read_joints(bk, bsource, b.urdf, b.base, true);
   b.q0 = read_q0(bk, bsource, b.urdf, b.joints);
   const UrdfDynamics exact(*b.urdf.model, b.joints.urdf_joints(), b.q0, gravity, b.urdf.path,
                            b.base);
@@ -131,6 +131,10 @@ Scene read_bodies_scene(const YAML::Node& root, const std::string& source) {
   std::vector<BodyPart> parts = read_parts(keys, source, gravity);
   Eigen::Index N = 0;
   for (const BodyPart& b : parts) N += b.joints.size();
+  if (N == 0)
+    fail(source, "bodies",
+         "no body has a coordinate (each has a fixed base and no joints): nothing moves; give "
+         "a body a floating base or joints");
   const UrdfLinearisation lin = stacked(parts, N);
   SceneJoints joints;  // the scene's coordinates, by name (no base of its own)
   joints.names = lin.joints;

@@ -48,14 +48,15 @@ void read_joint(const YAML::Node& n, const std::string& source, const std::strin
 }  // namespace
 
 SceneJoints read_joints(const Keys& keys, const std::string& source, const SceneUrdf& urdf,
-                        const BasePose& base) {
+                        const BasePose& base, bool obstacle) {
   SceneJoints out;
   out.names = base_coordinates(base);
   out.base = out.names.size();
   out.stops.assign(out.base, {});
   out.mimic_stops.assign(out.base, {});
-  // A floating body may have no joints at all (a box); a fixed one must.
-  if (!keys.count("joints") && out.base > 0) {
+  // A floating body may have no joints at all (a box); a fixed one must,
+  // unless it is an obstacle in a scene of bodies (no coordinates).
+  if (!keys.count("joints") && (out.base > 0 || obstacle)) {
     out.mimics = mimic_joints(*urdf.model, urdf.path, out.names);
     return out;
   }

@@ -361,6 +361,60 @@ TEST_F(BodyScenes, PairGapsAtQ0AreTheClosedFormDistances) {
   EXPECT_NEAR(gap("arm.tool.sphere0_box0"), face - 0.07, 1e-14);
 }
 
+// An obstacle: a body with a fixed base and no joints has no coordinates
+// (a table top, 1 m x 1 m x 0.1 m, its top face at z = 0.55 m); a floating
+// ball (m = 1 kg, radius 0.1 m) dropped from z = 0.9 m meets it when its
+// centre reaches 0.65 m: at t* = sqrt(2 h / g), h = 0.25 m, with speed g t*;
+// the inelastic impact stops it there, and the energy falls by exactly the
+// kinetic energy at impact, m g h. Event times are roots found to rounding
+// (1e-12 s); positions are sums of O(1) m terms (1e-12 m).
+const std::string kTable = R"(<robot name="table"><link name="top">
+  <inertial><mass value="10"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+  <collision><geometry><box size="1 1 0.1"/></geometry></collision>
+</link></robot>)";
+const std::string kBall = R"(<robot name="ball"><link name="ball">
+  <inertial><mass value="1"/><inertia ixx="0.004" ixy="0" ixz="0" iyy="0.004" iyz="0" izz="0.004"/></inertial>
+  <collision><geometry><sphere radius="0.1"/></geometry></collision>
+</link></robot>)";
+
+TEST_F(BodyScenes, ABodyWithoutCoordinatesIsAnObstacle) {
+  write("table.urdf", kTable);
+  write("ball.urdf", kBall);
+  const mech::Model model = scene::load_model(write("s.yaml", R"(bodies:
+  - {name: table, urdf: table.urdf, base: {type: fixed, pose: {xyz: [0, 0, 0.5]}}}
+  - {name: ball, urdf: ball.urdf, base: {type: floating, pose: {xyz: [0, 0, 0.7]}}}
+contacts:
+  - {link: ball/ball, against: table/top}
+initial:
+  q: {ball.z: 0.9}
+t_end: 0.5
+)"));
+  const mech::MechanicalModel& m = *model.mechanical;
+  ASSERT_EQ(m.coordinates.size(), 6u);  // the ball's alone
+  EXPECT_EQ(m.coordinates[2], "ball.z");
+  sim::Options opt;
+  opt.t_end = model.t_end;
+  const sim::Trajectory tr = sim::simulate_event_driven(model, model.initial, opt);
+  ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
+  ASSERT_FALSE(tr.events.empty());
+  const double h = 0.25, t_star = std::sqrt(2 * h / kG);
+  EXPECT_NEAR(tr.events.front().t, t_star, 1e-12);
+  EXPECT_NEAR(tr.events.front().state_before(8), -kG * t_star, 1e-12);
+  EXPECT_NEAR(tr.final_state(2), 0.65, 1e-12);
+  EXPECT_LE(tr.final_state.tail(6).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_NEAR(tr.energy_initial - tr.energy_final, 1.0 * kG * h, 1e-12);
+}
+
+TEST_F(BodyScenes, AllBodiesFixedIsRefused) {
+  write("table.urdf", kTable);
+  const std::string e = error("", R"(bodies:
+  - {name: a, urdf: table.urdf, base: {type: fixed}}
+  - {name: b, urdf: table.urdf, base: {type: fixed, pose: {xyz: [0, 0, 1]}}}
+t_end: 1
+)");
+  EXPECT_NE(e.find("s.yaml: bodies: no body has a coordinate"), std::string::npos) << e;
+}
+
 // The gripper (robots/gripper_box_scene.yaml): each finger (m = 0.1 kg,
 // spring k = 40 N/m to rest 0.05 m, from 0.15 m) follows q(t) = 0.05 + 0.1
 // cos(w t), w = 20 rad/s, and meets the box's face (q = 0.11 m: the face at
