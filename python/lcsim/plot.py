@@ -56,36 +56,82 @@ def _number(cell, path, row, column):
             f"{path}: row {row}, column '{column}': '{cell}' is not a number") from None
 
 
-def split_columns(header):
-    """Split the header into (kind, position, velocity, force, gap) column-index lists.
+class Layout:
+    """Where each kind of column of a trajectory CSV is (indices into the header).
 
-    kind is 'mechanical' (positions and velocities) or 'lcs' (one list of states, returned
-    as the position list, velocities empty).
-    """
+    kind: 'mechanical' (positions `pos`, velocities `vel`) or 'lcs' (its states in `pos`,
+    `vel` empty); `force` the multipliers u_<pair>, `gap` the y_<pair>; `friction` the
+    tangential multipliers ut_ / ut2_ (numbers); `text` the friction modes fm_ (words, not
+    drawn); `outputs` a list of (panel label, indices) for a circuit's V(node) and
+    I(element) columns (and any other named output)."""
+
+    def __init__(self, kind, pos, vel, force, gap):
+        self.kind, self.pos, self.vel, self.force, self.gap = kind, pos, vel, force, gap
+        self.friction, self.text, self.outputs = [], [], []
+
+    def __iter__(self):  # (kind, pos, vel, force, gap), as before
+        return iter((self.kind, self.pos, self.vel, self.force, self.gap))
+
+
+def _pairs(names, start):
+    """The pairs u_<c>... y_<c>... from names[start]: their count k (0 if none there)."""
+    k = 0
+    while start + k < len(names) and names[start + k].startswith("u_"):
+        k += 1
+    while k > 0 and names[start + k:start + 2 * k] != ["y_" + n[2:] for n in names[start:start + k]]:
+        k -= 1
+    return k
+
+
+def split_columns(header):
+    """The columns of a trajectory CSV by kind (a Layout; iterating it gives the tuple
+    (kind, position, velocity, force, gap) of column indices).
+
+    The header is t, the state (coordinates then v_<coordinate>, or an LCS's states: x1..xn
+    or a circuit's C1.v, L1.i, ...), the pairs u_<c> then y_<c>, a frictional model's ut_ /
+    ut2_ / fm_ columns, a circuit's outputs V(node), I(element), and mode."""
     if len(header) < 3 or header[0] != "t" or header[-1] != "mode":
         raise TrajectoryError("header must start with 't' and end with 'mode', got "
                               f"{header[:2]}...{header[-1:]}")
-    body = list(range(1, len(header) - 1))
     names = header[1:-1]
+    index = lambda i: i + 1  # names[i] is header[i + 1]
+    layout = None
     # Mechanical: the first n names are coordinates, the next n are v_<coordinate>.
     for n in range(1, len(names) // 2 + 1):
         if names[n:2 * n] == ["v_" + c for c in names[:n]]:
-            rest = body[2 * n:]
-            if len(rest) % 2 != 0:
-                raise TrajectoryError(f"after {n} coordinates and their velocities, "
-                                      f"{len(rest)} columns remain; expected u_ and y_ pairs")
-            k = len(rest) // 2
-            return "mechanical", body[:n], body[n:2 * n], rest[:k], rest[k:]
-    # General LCS: x1..xn, u1..uk, y1..yk.
-    n = 0
-    while n < len(names) and re.fullmatch(r"x\d+", names[n]):
-        n += 1
-    rest = body[n:]
-    if n == 0 or len(rest) % 2 != 0:
-        raise TrajectoryError("cannot recognise the state columns: expected coordinates "
-                              "followed by v_<coordinate>, or x1..xn")
-    k = len(rest) // 2
-    return "lcs", body[:n], [], rest[:k], rest[k:]
+            k = _pairs(names, 2 * n)
+            layout = Layout("mechanical", [index(i) for i in range(n)],
+                            [index(i) for i in range(n, 2 * n)],
+                            [index(i) for i in range(2 * n, 2 * n + k)],
+                            [index(i) for i in range(2 * n + k, 2 * n + 2 * k)])
+            rest = range(2 * n + 2 * k, len(names))
+            break
+    if layout is None:  # an LCS: its states up to the first pairs (or outputs)
+        n = 0
+        while n < len(names) and not (names[n].startswith("u_") and _pairs(names, n) > 0) \
+                and not re.fullmatch(r"[VI]\(.+\)", names[n]):
+            n += 1
+        if n == 0:
+            raise TrajectoryError("cannot recognise the state columns: expected coordinates "
+                                  "followed by v_<coordinate>, or the states of an LCS")
+        k = _pairs(names, n)
+        layout = Layout("lcs", [index(i) for i in range(n)], [],
+                        [index(i) for i in range(n, n + k)],
+                        [index(i) for i in range(n + k, n + 2 * k)])
+        rest = range(n + 2 * k, len(names))
+    panels = {}
+    for i in rest:
+        name = names[i]
+        if name.startswith(("ut_", "ut2_")):
+            layout.friction.append(index(i))
+        elif name.startswith("fm_"):
+            layout.text.append(index(i))
+        else:
+            label = ("voltage (V)" if name.startswith("V(") else
+                     "current (A)" if name.startswith("I(") else "output")
+            panels.setdefault(label, []).append(index(i))
+    layout.outputs = list(panels.items())
+    return layout
 
 
 def read_trajectory(path, text=None):
@@ -100,6 +146,7 @@ def read_trajectory(path, text=None):
     except TrajectoryError as e:
         raise TrajectoryError(f"{path}: {e}") from None
     data = {name: [] for name in header[:-1]}
+    words = set(layout.text)  # the friction modes: kept as they are written
     modes = []
     for r, row in enumerate(rows[1:], start=2):
         if not row:
@@ -108,7 +155,7 @@ def read_trajectory(path, text=None):
             raise TrajectoryError(f"{path}: row {r} has {len(row)} cells, header has "
                                   f"{len(header)}")
         for j, name in enumerate(header[:-1]):
-            data[name].append(_number(row[j], path, r, name))
+            data[name].append(row[j].strip() if j in words else _number(row[j], path, r, name))
         modes.append(row[-1].strip())
     if not modes:
         raise TrajectoryError(f"{path}: no samples after the header")
@@ -148,9 +195,12 @@ def _draw_trajectory(header, layout, data, events, title, with_gaps, output):
     else:
         panels.append(("state x", pos))
     if force:
-        panels.append(("force u", force))
+        panels.append(("force u" if kind == "mechanical" else "pair u", force))
+    if layout.friction:
+        panels.append(("friction ut", layout.friction))
     if with_gaps and gap:
-        panels.append(("gap y", gap))
+        panels.append(("gap y" if kind == "mechanical" else "pair y", gap))
+    panels.extend(layout.outputs)
 
     fig, axes = plt.subplots(len(panels), 1, sharex=True,
                              figsize=(9, 2.2 * len(panels) + 1.0), squeeze=False)

@@ -30,6 +30,46 @@ def test_trajectory_from_python_and_from_cli_files(robots, lcsim_binary, tmp_pat
     assert_png(tmp_path / "files.png")
 
 
+def test_circuit_waveforms_are_labelled_by_what_they_are(robots, lcsim_binary, tmp_path):
+    """A circuit's CSV (its states by name, the diode's pair, then V(node) and I(element))
+    draws voltage and current panels, from Python and from the files the CLI writes."""
+    netlist = robots.parent / "circuits" / "half_wave_rlc.cir"
+    run = lcsim.simulate(lcsim.load(netlist), dt_out=1e-4)
+    header = run.to_csv().splitlines()[0].split(",")
+    layout = lcsim.plot.split_columns(header)
+    named = lambda cols: [header[j] for j in cols]
+    assert layout.kind == "lcs"
+    assert named(layout.pos) == ["C1.v", "L1.i", "1"]
+    assert named(layout.force) == ["u_D1"] and named(layout.gap) == ["y_D1"]
+    assert [(label, named(cols)) for label, cols in layout.outputs] == [
+        ("voltage (V)", ["V(a)", "V(m)"]),
+        ("current (A)", ["I(C1)", "I(L1)", "I(D1)", "I(R1)"])]
+    lcsim.plot.trajectory(run, tmp_path / "py.png", gaps=True)
+    assert_png(tmp_path / "py.png")
+    cli = subprocess.run([str(lcsim_binary), "simulate", str(netlist), "--dt-out", "1e-4",
+                          "--out", str(tmp_path / "c.csv"), "--json"],
+                         capture_output=True, text=True)
+    assert cli.returncode == 0, cli.stderr
+    (tmp_path / "c.json").write_text(cli.stdout)
+    assert lcsim.plot.main(["trajectory", str(tmp_path / "c.csv"), "--events",
+                            str(tmp_path / "c.json"), "-o", str(tmp_path / "cli.png")]) == 0
+    assert_png(tmp_path / "cli.png")
+
+
+def test_friction_columns_are_drawn_and_modes_kept_as_words(robots, tmp_path):
+    """A frictional model's CSV has ut_ (numbers) and fm_ (words such as 'slip+')
+    after the pairs: the tangential force gets a panel, the modes are not parsed as
+    numbers."""
+    run = lcsim.simulate(lcsim.load(robots / "block_on_floor_friction.yaml"))
+    run.to_csv(tmp_path / "f.csv")
+    header, layout, data, _ = lcsim.plot.read_trajectory(tmp_path / "f.csv")
+    assert [header[j] for j in layout.friction] == ["ut_floor"]
+    assert [header[j] for j in layout.text] == ["fm_floor"]
+    assert "slip+" in data["fm_floor"]
+    lcsim.plot.trajectory(tmp_path / "f.csv", tmp_path / "f.png")
+    assert_png(tmp_path / "f.png")
+
+
 def test_impact_map_python_and_cli(robots, lcsim_binary, tmp_path):
     model = lcsim.load(robots / "two_carts_hook.yaml")
     grid = lcsim.impact_map(model, v1=(-1, 1), v2=(-1, 1), n=5)
