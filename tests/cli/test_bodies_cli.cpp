@@ -8,6 +8,7 @@
 #include <fstream>
 #include <string>
 
+#include "cli/scene_cli.hpp"
 #include "support/run_lcsim.hpp"
 
 namespace {
@@ -16,37 +17,12 @@ namespace fs = std::filesystem;
 
 const std::string kRobots = std::string(LCSIM_SOURCE_DIR) + "/robots/";
 
-std::string quote(const fs::path& p) { return "'" + p.string() + "'"; }
+using lcsim::cli_test::expect_refused;
+using lcsim::cli_test::quote;
+using lcsim::cli_test::write_file;
 
 fs::path fresh_dir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path d = fs::path(::testing::TempDir()) / ("lcsim_bodies_" + std::string(info->name()) +
-                                                       "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d / "out");
-  fs::copy_file(kRobots + "box.urdf", d / "box.urdf");
-  fs::copy_file(kRobots + "two_finger_gripper.urdf", d / "two_finger_gripper.urdf");
-  return d;
-}
-
-fs::path write_file(const fs::path& dir, const std::string& name, const std::string& text) {
-  const fs::path p = dir / name;
-  std::ofstream(p) << text;
-  return p;
-}
-
-// `simulate` and `analyze` on `scene`: exit 2, one line "lcsim: error:
-// <scene>: <what>", nothing in dir/out.
-void expect_refused(const fs::path& dir, const fs::path& scene, const std::string& what) {
-  for (const char* c : {"simulate", "analyze"}) {
-    std::string args = std::string(c) + " " + quote(scene);
-    if (std::string(c) == "simulate") args += " --out " + quote(dir / "out" / "t.csv");
-    const auto r = lcsim::cli_test::run_lcsim(args, dir / "stderr.txt");
-    EXPECT_EQ(r.exit_code, 2) << c << ": " << r.err;
-    EXPECT_EQ(lcsim::cli_test::count_lines(r.err), 1) << r.err;
-    EXPECT_EQ(r.err.rfind("lcsim: error: " + scene.string() + ": " + what, 0), 0u) << r.err;
-    EXPECT_TRUE(fs::is_empty(dir / "out")) << c;
-  }
+  return lcsim::cli_test::fresh_scene_dir("bodies", {"box.urdf", "two_finger_gripper.urdf"});
 }
 
 // The gripper (fingers open at 0.15 m) and the box on the floor, as the
