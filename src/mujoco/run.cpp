@@ -9,6 +9,7 @@
 #include <lcsim/core/format.hpp>
 #include <lcsim/mujoco/mujoco.hpp>
 #include <lcsim/scene/scene.hpp>
+#include <lcsim/scene/so3.hpp>
 #include <optional>
 #include <stdexcept>
 
@@ -22,27 +23,6 @@ using Eigen::Matrix3d;
 using Eigen::MatrixXd;
 using Eigen::Vector3d;
 using Eigen::VectorXd;
-
-Matrix3d skew(const Vector3d& r) {
-  Matrix3d K;
-  K << 0, -r.z(), r.y(), r.z(), 0, -r.x(), -r.y(), r.x(), 0;
-  return K;
-}
-
-// The left Jacobian of SO(3) (omega = J_l(r) r'); its coefficients by their
-// series below 1e-4 rad (next terms below 1e-17).
-Matrix3d left_jacobian(const Vector3d& r) {
-  const double t = r.norm();
-  const double a = t < 1e-4 ? 0.5 - t * t / 24.0 : (1.0 - std::cos(t)) / (t * t);
-  const double b = t < 1e-4 ? 1.0 / 6.0 - t * t / 120.0 : (t - std::sin(t)) / (t * t * t);
-  const Matrix3d K = skew(r);
-  return Matrix3d::Identity() + a * K + b * K * K;
-}
-
-Matrix3d exp_so3(const Vector3d& r) {
-  const double th = r.norm();
-  return th > 0.0 ? Eigen::AngleAxisd(th, r / th).toRotationMatrix() : Matrix3d::Identity();
-}
 
 // Where each lcsim coordinate lives in MuJoCo, and the scene's forces.
 struct Run {
@@ -147,14 +127,14 @@ void set_state(Run& r, const VectorXd& q, const VectorXd& v) {
   mjData* d = r.d.get();
   if (r.nb > 0) {
     const Vector3d rv = q.segment<3>(3);
-    const Matrix3d R = exp_so3(rv) * r.R0;
+    const Matrix3d R = scene::exp_so3(rv) * r.R0;
     const Eigen::Quaterniond quat(R);
     for (int i = 0; i < 3; ++i) d->qpos[r.free_q + i] = q(i);
     d->qpos[r.free_q + 3] = quat.w();
     d->qpos[r.free_q + 4] = quat.x();
     d->qpos[r.free_q + 5] = quat.y();
     d->qpos[r.free_q + 6] = quat.z();
-    const Vector3d omega_local = R.transpose() * (left_jacobian(rv) * v.segment<3>(3));
+    const Vector3d omega_local = R.transpose() * (scene::left_jacobian(rv) * v.segment<3>(3));
     for (int i = 0; i < 3; ++i) {
       d->qvel[r.free_v + i] = v(i);
       d->qvel[r.free_v + 3 + i] = omega_local(i);
@@ -172,15 +152,14 @@ void get_state(const Run& r, VectorXd& q, VectorXd& v) {
     const Eigen::Quaterniond quat(d->qpos[r.free_q + 3], d->qpos[r.free_q + 4],
                                   d->qpos[r.free_q + 5], d->qpos[r.free_q + 6]);
     const Matrix3d R = quat.normalized().toRotationMatrix();
-    const Eigen::AngleAxisd aa(R * r.R0.transpose());
-    const Vector3d rv = aa.angle() * aa.axis();
+    const Vector3d rv = scene::log_so3(R * r.R0.transpose());
     const Vector3d omega_local(d->qvel[r.free_v + 3], d->qvel[r.free_v + 4], d->qvel[r.free_v + 5]);
     for (int i = 0; i < 3; ++i) {
       q(i) = d->qpos[r.free_q + i];
       v(i) = d->qvel[r.free_v + i];
     }
     q.segment<3>(3) = rv;
-    v.segment<3>(3) = left_jacobian(rv).lu().solve(R * omega_local);
+    v.segment<3>(3) = scene::left_jacobian(rv).lu().solve(R * omega_local);
   }
   for (std::size_t c = 0; c < r.qadr.size(); ++c) {
     q(r.nb + static_cast<int>(c)) = d->qpos[r.qadr[c]];
@@ -196,8 +175,8 @@ void apply_forces(Run& r, const VectorXd& q, const VectorXd& tau) {
   mju_zero(d->qfrc_applied, r.m->nv);
   if (r.nb > 0) {
     const Vector3d rv = q.segment<3>(3);
-    const Matrix3d R = exp_so3(rv) * r.R0;
-    const Vector3d t_world = left_jacobian(rv).transpose().lu().solve(tau.segment<3>(3));
+    const Matrix3d R = scene::exp_so3(rv) * r.R0;
+    const Vector3d t_world = scene::left_jacobian(rv).transpose().lu().solve(tau.segment<3>(3));
     const Vector3d t_local = R.transpose() * t_world;
     for (int i = 0; i < 3; ++i) {
       d->qfrc_applied[r.free_v + i] = tau(i);
