@@ -30,7 +30,9 @@
 #include <cmath>
 #include <lcsim/core/format.hpp>
 #include <lcsim/scene/so3.hpp>
+#include <map>
 #include <stdexcept>
+#include <string>
 
 #include "bullet/multibody_scene.hpp"
 #include "bullet/urdf_multibody.hpp"
@@ -112,9 +114,24 @@ void add_floating_base_force(btMultiBody& b, const UrdfMultiBody& mb, const scen
   b.addBaseTorque(bt(Vector3d(tau + (p - c).cross(F))));
 }
 
+namespace {
+
+// Each contact row's mu (0 without friction) and whether any has friction.
+std::vector<double> row_friction(const mech::MechanicalModel& m, bool& any) {
+  std::vector<double> mu(static_cast<std::size_t>(m.num_constraints()), 0.0);
+  any = m.has_friction();
+  for (const mech::FrictionalContact& f : m.friction)
+    mu[static_cast<std::size_t>(f.contact)] = f.mu;
+  return mu;
+}
+
+}  // namespace
+
 ContactColliders make_contact_colliders(const scene::Scene& setup, const UrdfMultiBody& mb,
                                         const mech::MechanicalModel& m) {
   ContactColliders out;
+  const std::vector<double> mu_of_row = row_friction(m, out.friction);
+  std::map<int, std::string> first_of;  // Bullet link -> its first contact's name
   for (const scene::ContactFrame& cf : setup.contacts) {
     const auto own = mb.owner.find(cf.point.link);
     if (own == mb.owner.end())
@@ -136,14 +153,23 @@ ContactColliders make_contact_colliders(const scene::Scene& setup, const UrdfMul
     out.shapes.push_back(std::move(sphere));
     double& e = out.restitution_of[own->second];
     e = std::max(e, m.restitution(static_cast<int>(cf.row)));
+    const double mu = mu_of_row[static_cast<std::size_t>(cf.row)];
+    if (const auto [first, fresh] = first_of.emplace(own->second, cf.point.name); fresh)
+      out.friction_of[own->second] = mu;
+    else if (out.friction_of[own->second] != mu)
+      throw std::invalid_argument("bullet: contact '" + cf.point.name +
+                                  "' has friction mu = " + short_number(mu) + " but contact '" +
+                                  first->second + "' of the same link '" + cf.point.link +
+                                  "' has mu = " + short_number(out.friction_of[own->second]) +
+                                  ": Bullet's friction is per collider (one mu per link)");
     ++out.rows;
   }
   for (const scene::Plane& pl : setup.planes) {
     auto shape = std::make_unique<btStaticPlaneShape>(bt(pl.normal), pl.normal.dot(pl.point));
     auto obj = std::make_unique<btCollisionObject>();
     obj->setCollisionShape(shape.get());
-    obj->setRestitution(1.0);  // Bullet multiplies it with the link's
-    obj->setFriction(0.0);
+    obj->setRestitution(1.0);                    // Bullet multiplies it with the link's
+    obj->setFriction(out.friction ? 1.0 : 0.0);  // so does it the friction
     obj->setRollingFriction(0.0);
     obj->setSpinningFriction(0.0);
     out.shapes.push_back(std::move(shape));
