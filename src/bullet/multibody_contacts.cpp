@@ -127,6 +127,23 @@ std::vector<double> row_friction(const mech::MechanicalModel& m, bool& any) {
 
 }  // namespace
 
+std::string link_friction_error(const scene::Scene& setup, const mech::MechanicalModel& m) {
+  bool any = false;
+  const std::vector<double> mu_of_row = row_friction(m, any);
+  std::map<std::string, const scene::ContactFrame*> first_of;  // URDF link -> its first contact
+  for (const scene::ContactFrame& cf : setup.contacts) {
+    const auto [first, fresh] = first_of.emplace(cf.point.link, &cf);
+    const double mu = mu_of_row[static_cast<std::size_t>(cf.row)];
+    const double mu0 = mu_of_row[static_cast<std::size_t>(first->second->row)];
+    if (!fresh && mu != mu0)
+      return "contact '" + cf.point.name + "' has friction mu = " + short_number(mu) +
+             " but contact '" + first->second->point.name + "' of the same link '" + cf.point.link +
+             "' has mu = " + short_number(mu0) +
+             ": Bullet's friction is per collider (one mu per link)";
+  }
+  return "";
+}
+
 ContactColliders make_contact_colliders(const scene::Scene& setup, const UrdfMultiBody& mb,
                                         const mech::MechanicalModel& m) {
   ContactColliders out;

@@ -94,6 +94,11 @@ constexpr int kContactLinkGroup = 1 << 6, kPlaneGroup = 1 << 7;
 // (Bullet's friction is per collider).
 ContactColliders make_contact_colliders(const scene::Scene& setup, const UrdfMultiBody& mb,
                                         const mech::MechanicalModel& m);
+// "" when every link's contact points have one friction coefficient (mu,
+// or none), else why not, naming the two contacts and their mu (Bullet's
+// friction belongs to a link's collider): the input check of a contact
+// scene, before Bullet builds anything.
+std::string link_friction_error(const scene::Scene& setup, const mech::MechanicalModel& m);
 // Adds the step's normal impulses of every contact point (N s) to `impulse`
 // (size k, by row of E), from the dispatcher's manifolds.
 void contact_impulses(btCollisionDispatcher& d, const ContactColliders& c,

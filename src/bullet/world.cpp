@@ -284,6 +284,8 @@ Plan plan_of(const mech::Model& model, const WorldSettings& s) {
     // scene::scene_setup hands over scenes with a fixed root at the identity
     // and no contacts only; the multibody builds the others too.
     if (std::optional<scene::Scene> c = contact_scene_of(model)) {
+      if (std::string why = link_friction_error(*c, *model.mechanical); !why.empty())
+        throw std::invalid_argument("bullet: " + model.source + ": " + why);
       p.joint_limits = joint_limits_of(*model.mechanical, model.source, &*c);
       p.scene = std::move(c);
       return p;

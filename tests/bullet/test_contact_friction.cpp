@@ -99,5 +99,23 @@ TEST(BulletFriction, TheSettingsAreReportedAndBadNamesRefused) {
   }
 }
 
+TEST(BulletFriction, ALinkWithTwoCoefficientsIsRefusedInOneLine) {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("lcsim_bullet_two_mu_" + std::to_string(::getpid()));
+  const std::string path = test_support::write_two_mu_scene(dir);
+  const mech::Model m = scene::load_model(path);
+  try {
+    check_expressible(m);
+    ADD_FAILURE() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), ("bullet: " + path +
+                            ": contact 'box_wall.corner1' has friction mu = 0.5 but contact "
+                            "'box.corner0' of the same link 'box' has mu = 0.3: Bullet's "
+                            "friction is per collider (one mu per link)")
+                               .c_str());
+  }
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace lcsim::bullet

@@ -100,5 +100,23 @@ TEST(MujocoFriction, TheSettingsAreReportedAndBadNamesRefused) {
   }
 }
 
+TEST(MujocoFriction, ALinkWithTwoCoefficientsIsRefusedInOneLine) {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("lcsim_mujoco_two_mu_" + std::to_string(::getpid()));
+  const std::string path = test_support::write_two_mu_scene(dir);
+  const mech::Model m = scene::load_model(path);
+  try {
+    check_expressible(m);
+    ADD_FAILURE() << "no error";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("mujoco: " + path + ": contact 'box_wall.corner", 0), 0u) << what;
+    EXPECT_NE(what.find("MuJoCo's friction is per geom (one mu per link)"), std::string::npos)
+        << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace lcsim::mujoco

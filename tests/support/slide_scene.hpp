@@ -35,6 +35,25 @@ inline std::string write_slide_scene(const std::filesystem::path& dir, double ps
   return p.string();
 }
 
+// The box of write_slide_scene at rest against the floor (mu 0.3) and a wall
+// at its +x face (mu 0.5): one link with two coefficients, which neither
+// peer can hold (each has one friction per collider or geom).
+inline std::string write_two_mu_scene(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  fs::create_directories(dir);
+  fs::copy_file(fs::path(LCSIM_SOURCE_DIR) / "robots" / "box.urdf", dir / "box.urdf",
+                fs::copy_options::overwrite_existing);
+  const fs::path p = dir / "two_mu.yaml";
+  std::ofstream(p) << "name: box_two_mu\nurdf: box.urdf\n"
+                      "base: {type: floating, pose: {xyz: [0, 0, 0.05]}}\n"
+                      "planes:\n  - {name: floor, point: [0, 0, 0], normal: [0, 0, 1]}\n"
+                      "  - {name: wall, point: [0.15, 0, 0], normal: [-1, 0, 0]}\n"
+                      "contacts:\n  - {link: box, plane: floor, friction: 0.3}\n"
+                      "  - {link: box, plane: wall, friction: 0.5, name: box_wall}\n"
+                      "contact_options: {max_distance: 0.05}\nt_end: 0.1\n";
+  return p.string();
+}
+
 // What a run of the sliding box shows.
 struct SlideMeasure {
   double t_stop = NAN;    // first sample from which the horizontal speed stays <= v_stop
