@@ -15,7 +15,12 @@ so every ratio compares runs made on the same machine at the same time:
    per-step cost from runs to T and 2T, MuJoCo's mj_step timed alone);
 4. the exact method's cost per event with 4, 16 and 64 contact points: a box
    (robots/box.urdf) with explicit points on its bottom face (2x2, 4x4, 8x8),
-   dropped flat, wall time / events, median of REPEAT runs.
+   dropped flat, wall time / events, median of REPEAT runs;
+5. friction (issue 27 item 6): the box sliding at the headings 0, pi/8, pi/4
+   (mu = 0.3, 1 m/s) in lcsim's exact method (d = 4, 16), Moreau-Jean,
+   Bullet (cone, box, one-direction) and MuJoCo (pyramidal, elliptic)
+   beside the closed forms, from one run of build/bench/peer_friction_slide
+   (docs/contacts.md, "Friction in the peers").
 
 Timings are given as the minimum (the quietest repetition: the machine is
 shared) and the median of REPEAT runs.
@@ -136,9 +141,20 @@ def target_events_per_contacts():
                   f"per event / k relative to k = 4: {cost / (n * n) / base:.2f}")
 
 
+def friction_slide():
+    prog = os.path.join(os.path.dirname(LCSIM), "bench", "peer_friction_slide")
+    out = subprocess.run([prog, "1e-3"], capture_output=True, text=True)
+    if out.returncode != 0:
+        print(f"peer_friction_slide failed (exit {out.returncode}): {out.stderr.strip()}")
+        return
+    print(out.stdout, end="")
+
+
 if __name__ == "__main__":
     table()
     print()
     target_quadruped()
     target_moreau_jean_vs_mujoco()
     target_events_per_contacts()
+    print()
+    friction_slide()

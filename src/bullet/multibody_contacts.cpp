@@ -29,7 +29,10 @@
 #include <algorithm>
 #include <cmath>
 #include <lcsim/core/format.hpp>
+#include <lcsim/scene/so3.hpp>
+#include <map>
 #include <stdexcept>
+#include <string>
 
 #include "bullet/multibody_scene.hpp"
 #include "bullet/urdf_multibody.hpp"
@@ -56,34 +59,6 @@ Matrix3d eig(const btMatrix3x3& R) {
   return out;
 }
 
-Matrix3d skew(const Vector3d& r) {
-  Matrix3d K;
-  K << 0, -r.z(), r.y(), r.z(), 0, -r.x(), -r.y(), r.x(), 0;
-  return K;
-}
-
-Matrix3d exp_so3(const Vector3d& r) {
-  const double th = r.norm();
-  return th > 0.0 ? Eigen::AngleAxisd(th, r / th).toRotationMatrix() : Matrix3d::Identity();
-}
-
-Vector3d log_so3(const Matrix3d& R) {
-  const Eigen::AngleAxisd aa(R);
-  return aa.angle() * aa.axis();
-}
-
-// The left Jacobian of SO(3): omega = J_l(r) r' for the orientation exp([r]x).
-// Its coefficients (1 - cos t) / t^2 and (t - sin t) / t^3 by their series
-// below t = 1e-4 (the closed forms lose digits there; the series' next terms
-// are below 1e-17).
-Matrix3d left_jacobian(const Vector3d& r) {
-  const double t = r.norm();
-  const double a = t < 1e-4 ? 0.5 - t * t / 24.0 : (1.0 - std::cos(t)) / (t * t);
-  const double b = t < 1e-4 ? 1.0 / 6.0 - t * t / 120.0 : (t - std::sin(t)) / (t * t * t);
-  const Matrix3d K = skew(r);
-  return Matrix3d::Identity() + a * K + b * K * K;
-}
-
 // A dispatcher whose manifolds keep their points up to `threshold` apart.
 class ThresholdDispatcher : public btCollisionDispatcher {
  public:
@@ -105,9 +80,9 @@ class ThresholdDispatcher : public btCollisionDispatcher {
 void set_floating_base(btMultiBody& b, const UrdfMultiBody& mb, const scene::BasePose& base,
                        const Vector6d& q, const Vector6d& v) {
   const Vector3d p = q.head<3>(), r = q.tail<3>();
-  const Matrix3d R = exp_so3(r) * base.pose.linear();
+  const Matrix3d R = scene::exp_so3(r) * base.pose.linear();
   const btTransform Tb = btTransform(bt(R), bt(p)) * mb.root_to_base;
-  const Vector3d omega = left_jacobian(r) * v.tail<3>();
+  const Vector3d omega = scene::left_jacobian(r) * v.tail<3>();
   const Vector3d c = eig(Tb.getOrigin());
   b.setBaseWorldTransform(Tb);
   b.setBaseVel(bt(Vector3d(v.head<3>() + omega.cross(c - p))));
@@ -119,12 +94,12 @@ void get_floating_base(const btMultiBody& b, const UrdfMultiBody& mb, const scen
   const btTransform Tb = b.getBaseWorldTransform();
   const btTransform Troot = Tb * mb.root_to_base.inverse();
   const Vector3d p = eig(Troot.getOrigin()), c = eig(Tb.getOrigin());
-  const Vector3d r = log_so3(eig(Troot.getBasis()) * base.pose.linear().transpose());
+  const Vector3d r = scene::log_so3(eig(Troot.getBasis()) * base.pose.linear().transpose());
   const Vector3d omega = eig(b.getBaseOmega());
   q.head<3>() = p;
   q.tail<3>() = r;
   v.head<3>() = eig(b.getBaseVel()) + omega.cross(p - c);
-  v.tail<3>() = left_jacobian(r).lu().solve(omega);
+  v.tail<3>() = scene::left_jacobian(r).lu().solve(omega);
 }
 
 void add_floating_base_force(btMultiBody& b, const UrdfMultiBody& mb, const scene::BasePose& base,
@@ -132,16 +107,48 @@ void add_floating_base_force(btMultiBody& b, const UrdfMultiBody& mb, const scen
   (void)base;
   const Vector3d p = q.head<3>();
   const Vector3d F = Q.head<3>();
-  const Vector3d tau = left_jacobian(q.tail<3>()).transpose().lu().solve(Q.tail<3>());
+  const Vector3d tau = scene::left_jacobian(q.tail<3>()).transpose().lu().solve(Q.tail<3>());
   const Vector3d c = eig(b.getBaseWorldTransform().getOrigin());
   (void)mb;
   b.addBaseForce(bt(F));
   b.addBaseTorque(bt(Vector3d(tau + (p - c).cross(F))));
 }
 
+namespace {
+
+// Each contact row's mu (0 without friction) and whether any has friction.
+std::vector<double> row_friction(const mech::MechanicalModel& m, bool& any) {
+  std::vector<double> mu(static_cast<std::size_t>(m.num_constraints()), 0.0);
+  any = m.has_friction();
+  for (const mech::FrictionalContact& f : m.friction)
+    mu[static_cast<std::size_t>(f.contact)] = f.mu;
+  return mu;
+}
+
+}  // namespace
+
+std::string link_friction_error(const scene::Scene& setup, const mech::MechanicalModel& m) {
+  bool any = false;
+  const std::vector<double> mu_of_row = row_friction(m, any);
+  std::map<std::string, const scene::ContactFrame*> first_of;  // URDF link -> its first contact
+  for (const scene::ContactFrame& cf : setup.contacts) {
+    const auto [first, fresh] = first_of.emplace(cf.point.link, &cf);
+    const double mu = mu_of_row[static_cast<std::size_t>(cf.row)];
+    const double mu0 = mu_of_row[static_cast<std::size_t>(first->second->row)];
+    if (!fresh && mu != mu0)
+      return "contact '" + cf.point.name + "' has friction mu = " + short_number(mu) +
+             " but contact '" + first->second->point.name + "' of the same link '" + cf.point.link +
+             "' has mu = " + short_number(mu0) +
+             ": Bullet's friction is per collider (one mu per link)";
+  }
+  return "";
+}
+
 ContactColliders make_contact_colliders(const scene::Scene& setup, const UrdfMultiBody& mb,
                                         const mech::MechanicalModel& m) {
   ContactColliders out;
+  const std::vector<double> mu_of_row = row_friction(m, out.friction);
+  std::map<int, std::string> first_of;  // Bullet link -> its first contact's name
   for (const scene::ContactFrame& cf : setup.contacts) {
     const auto own = mb.owner.find(cf.point.link);
     if (own == mb.owner.end())
@@ -163,14 +170,23 @@ ContactColliders make_contact_colliders(const scene::Scene& setup, const UrdfMul
     out.shapes.push_back(std::move(sphere));
     double& e = out.restitution_of[own->second];
     e = std::max(e, m.restitution(static_cast<int>(cf.row)));
+    const double mu = mu_of_row[static_cast<std::size_t>(cf.row)];
+    if (const auto [first, fresh] = first_of.emplace(own->second, cf.point.name); fresh)
+      out.friction_of[own->second] = mu;
+    else if (out.friction_of[own->second] != mu)
+      throw std::invalid_argument("bullet: contact '" + cf.point.name +
+                                  "' has friction mu = " + short_number(mu) + " but contact '" +
+                                  first->second + "' of the same link '" + cf.point.link +
+                                  "' has mu = " + short_number(out.friction_of[own->second]) +
+                                  ": Bullet's friction is per collider (one mu per link)");
     ++out.rows;
   }
   for (const scene::Plane& pl : setup.planes) {
     auto shape = std::make_unique<btStaticPlaneShape>(bt(pl.normal), pl.normal.dot(pl.point));
     auto obj = std::make_unique<btCollisionObject>();
     obj->setCollisionShape(shape.get());
-    obj->setRestitution(1.0);  // Bullet multiplies it with the link's
-    obj->setFriction(0.0);
+    obj->setRestitution(1.0);                    // Bullet multiplies it with the link's
+    obj->setFriction(out.friction ? 1.0 : 0.0);  // so does it the friction
     obj->setRollingFriction(0.0);
     obj->setSpinningFriction(0.0);
     out.shapes.push_back(std::move(shape));

@@ -31,8 +31,10 @@ std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m, const st
                                         const scene::Scene* setup = nullptr);
 
 // "btMultiBody from the URDF, btMultiBodyConstraintSolver (100 iterations), ..."
-// With `contacts`, the contact settings too.
-std::string multibody_description(const WorldSettings& s, bool contacts = false);
+// With `contacts`, the contact settings too; with `friction` (the scene's
+// contacts have friction:) WorldSettings::friction's.
+std::string multibody_description(const WorldSettings& s, bool contacts = false,
+                                  bool friction = false);
 
 // The scene run as a btMultiBody (multibody_world.cpp); `limits` from
 // joint_limits_of. Never throws.
@@ -78,15 +80,25 @@ struct ContactColliders {
   std::vector<std::unique_ptr<btCollisionObject>> planes;
   std::map<std::pair<int, int>, int> row_of;  // (Bullet link, compound child) -> row of E
   std::map<int, double> restitution_of;       // Bullet link -> the largest e of its points
+  std::map<int, double> friction_of;          // Bullet link -> its points' mu (one per link)
+  bool friction = false;                      // some contact has friction
   int rows = 0;                               // contact rows
 };
 // Collision filter groups of links with contacts and of planes.
 constexpr int kContactLinkGroup = 1 << 6, kPlaneGroup = 1 << 7;
 // The colliders of setup.contacts (restitution: the largest of a link's
-// points, Bullet's product with the planes' 1; friction 0). Throws
-// std::invalid_argument naming the contact whose link Bullet does not hold.
+// points, Bullet's product with the planes' 1; friction: the scene's mu of
+// the link's points, times the planes' 1, or 0 when no contact has friction).
+// Throws std::invalid_argument naming the contact whose link Bullet does not
+// hold, or a contact whose mu differs from another point's of its link
+// (Bullet's friction is per collider).
 ContactColliders make_contact_colliders(const scene::Scene& setup, const UrdfMultiBody& mb,
                                         const mech::MechanicalModel& m);
+// "" when every link's contact points have one friction coefficient (mu,
+// or none), else why not, naming the two contacts and their mu (Bullet's
+// friction belongs to a link's collider): the input check of a contact
+// scene, before Bullet builds anything.
+std::string link_friction_error(const scene::Scene& setup, const mech::MechanicalModel& m);
 // Adds the step's normal impulses of every contact point (N s) to `impulse`
 // (size k, by row of E), from the dispatcher's manifolds.
 void contact_impulses(btCollisionDispatcher& d, const ContactColliders& c,

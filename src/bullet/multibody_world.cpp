@@ -141,7 +141,8 @@ void set_state(MbWorld& w, const VectorXd& q, const VectorXd& v) {
 
 // An empty world with the scene's gravity and the pinned settings (the
 // file's header comment).
-std::unique_ptr<MbWorld> make_world(const scene::Scene& setup, const WorldSettings& s) {
+std::unique_ptr<MbWorld> make_world(const scene::Scene& setup, const WorldSettings& s,
+                                    bool friction) {
   auto w = std::make_unique<MbWorld>();
   w->config = std::make_unique<btDefaultCollisionConfiguration>();
   if (setup.contacts.empty())
@@ -168,6 +169,10 @@ std::unique_ptr<MbWorld> make_world(const scene::Scene& setup, const WorldSettin
   info.m_leastSquaresResidualThreshold = 0.0;
   info.m_linearSlop = 0.0;  // Bullet's default; contacts: penetration = distance + slop
   info.m_solverMode = SOLVER_USE_WARMSTARTING | SOLVER_SIMD;  // no articulated warm start
+  if (friction && s.friction != WorldSettings::Friction::kOneDirection)
+    info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
+  if (friction && s.friction == WorldSettings::Friction::kBox)
+    info.m_solverMode |= SOLVER_DISABLE_IMPLICIT_CONE_FRICTION;
   return w;
 }
 
@@ -188,7 +193,7 @@ std::unique_ptr<btMultiBodyLinkCollider> make_collider(MbWorld& w, int link) {
   }
   col->setCollisionShape(contact->second);
   col->setRestitution(w.contacts.restitution_of.at(link));
-  col->setFriction(0.0);
+  col->setFriction(w.contacts.friction_of.at(link));
   col->setRollingFriction(0.0);
   col->setSpinningFriction(0.0);
   w.world->addCollisionObject(col.get(), kContactLinkGroup, kPlaneGroup);
@@ -270,7 +275,7 @@ void add_limits(MbWorld& w, const std::vector<JointLimit>& limits, const WorldSe
 std::unique_ptr<MbWorld> build(const scene::Scene& setup, const mech::MechanicalModel& m,
                                const std::vector<JointLimit>& limits, const VectorXd& q0,
                                const VectorXd& v0, const WorldSettings& s) {
-  std::unique_ptr<MbWorld> w = make_world(setup, s);
+  std::unique_ptr<MbWorld> w = make_world(setup, s, m.has_friction());
   add_multibody(*w, setup, m);
   set_state(*w, q0, v0);
   add_gears(*w);
@@ -404,12 +409,31 @@ std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m, const st
   return out;
 }
 
-std::string multibody_description(const WorldSettings& s, bool contacts) {
+// Bullet's friction at contacts as WorldSettings::friction sets it.
+std::string friction_description(const WorldSettings& s) {
+  switch (s.friction) {
+    case WorldSettings::Friction::kBox:
+      return "friction mu (link) x 1 (plane), SOLVER_USE_2_FRICTION_DIRECTIONS and "
+             "SOLVER_DISABLE_IMPLICIT_CONE_FRICTION: two fixed tangents (btPlaneSpace1), each "
+             "bounded by mu N alone (a square)";
+    case WorldSettings::Friction::kOneDirection:
+      return "friction mu (link) x 1 (plane), one friction row along the fixed first tangent "
+             "(btPlaneSpace1), none across it";
+    case WorldSettings::Friction::kCone:
+      break;
+  }
+  return "friction mu (link) x 1 (plane), SOLVER_USE_2_FRICTION_DIRECTIONS with implicit cone "
+         "friction: two fixed tangents (btPlaneSpace1), their impulse scaled back onto the "
+         "circle mu N (a circular cone)";
+}
+
+std::string multibody_description(const WorldSettings& s, bool contacts, bool friction) {
   const std::string planes =
       contacts ? ", contact points as btSphereShape (radius 0 at a corner) against "
-                 "btStaticPlaneShape planes (friction 0, contact ERP " +
-                     short_number(s.limit_erp) + ", slop 0, speculative within " +
-                     short_number(s.contact_threshold) + " m)"
+                 "btStaticPlaneShape planes (" +
+                     (friction ? friction_description(s) : std::string("friction 0")) +
+                     ", contact ERP " + short_number(s.limit_erp) +
+                     ", slop 0, speculative within " + short_number(s.contact_threshold) + " m)"
                : std::string();
   return std::string("btMultiBody from the URDF, ") +
          (s.multibody_mlcp ? "btMultiBodyMLCPConstraintSolver (btDantzigSolver)"
@@ -423,7 +447,8 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene&
                                    const std::vector<JointLimit>& limits, const VectorXd& x0,
                                    const sim::Options& opt, const WorldSettings& s) {
   sim::Trajectory tr;
-  tr.method = "bullet " + multibody_description(s, !setup.contacts.empty());
+  tr.method = "bullet " +
+              multibody_description(s, !setup.contacts.empty(), model.mechanical->has_friction());
   tr.dynamics = "the URDF's nonlinear multibody (Bullet)";
   tr.t_end = *opt.t_end;
   tr.final_state = x0;

@@ -284,10 +284,8 @@ Plan plan_of(const mech::Model& model, const WorldSettings& s) {
     // scene::scene_setup hands over scenes with a fixed root at the identity
     // and no contacts only; the multibody builds the others too.
     if (std::optional<scene::Scene> c = contact_scene_of(model)) {
-      if (model.mechanical->has_friction())
-        throw std::invalid_argument(
-            "bullet: " + model.source +
-            ": a contact scene with friction: Bullet runs contact scenes frictionless only");
+      if (std::string why = link_friction_error(*c, *model.mechanical); !why.empty())
+        throw std::invalid_argument("bullet: " + model.source + ": " + why);
       p.joint_limits = joint_limits_of(*model.mechanical, model.source, &*c);
       p.scene = std::move(c);
       return p;
@@ -324,7 +322,9 @@ std::string rb6_description(const WorldSettings& s) {
 
 std::string solver_description(const mech::Model& model, const WorldSettings& s) {
   const Plan p = plan_of(model, s);
-  return p.scene ? multibody_description(s, !p.scene->contacts.empty()) : rb6_description(s);
+  return p.scene ? multibody_description(s, !p.scene->contacts.empty(),
+                                         model.mechanical->has_friction())
+                 : rb6_description(s);
 }
 
 void check_expressible(const mech::Model& model) { (void)plan_of(model, WorldSettings{}); }
@@ -469,6 +469,26 @@ std::string settings_error(const WorldSettings& s) {
   return "";
 }
 
+std::string friction_name(WorldSettings::Friction f) {
+  switch (f) {
+    case WorldSettings::Friction::kBox:
+      return "box";
+    case WorldSettings::Friction::kOneDirection:
+      return "one-direction";
+    case WorldSettings::Friction::kCone:
+      break;
+  }
+  return "cone";
+}
+
+WorldSettings::Friction parse_friction(const std::string& name) {
+  for (auto f : {WorldSettings::Friction::kCone, WorldSettings::Friction::kBox,
+                 WorldSettings::Friction::kOneDirection})
+    if (friction_name(f) == name) return f;
+  throw std::invalid_argument("bullet: unknown friction model '" + name +
+                              "' (cone, box, one-direction)");
+}
+
 namespace {
 sim::OptionsUsed bullet_options_used() {
   sim::OptionsUsed u;  // Bullet's own contact solver and restitution
@@ -481,7 +501,14 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
                                 const sim::Options& options, const WorldSettings& s) {
   // The library's one check of a run's input, as sim::Integrator::run makes.
   sim::Options opt = options;
-  if (auto refused = sim::refuse_invalid_run(model, x0, opt, "bullet", bullet_options_used()))
+  // Friction at a contact scene's contacts is Bullet's own (WorldSettings::
+  // friction). The "bullet" integrator's options_used states none, so
+  // `--method bullet` still refuses it (and the methods that take friction
+  // are listed without Bullet, which takes it on contact scenes only).
+  sim::OptionsUsed used = bullet_options_used();
+  if (model.is_mechanical() && model.mechanical->has_friction() && contact_scene_of(model))
+    used.friction = used.friction_3d = true;
+  if (auto refused = sim::refuse_invalid_run(model, x0, opt, "bullet", used))
     return std::move(*refused);
   if (std::string why = settings_error(s); !why.empty()) {
     sim::Trajectory tr;

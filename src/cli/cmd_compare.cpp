@@ -14,7 +14,9 @@
 //   bullet_solver  which Bullet constraint solver ran.
 // `--peer mujoco` runs a contact scene in MuJoCo instead (mujoco::simulate_mujoco),
 // compared the same way.
-// A model with friction must be a block on a floor (bullet::friction_block_of):
+// A contact scene with friction at its contacts runs with the peer's own
+// friction (--bullet-friction, --mujoco-cone; reported in bullet_solver).
+// Any other model with friction must be a block on a floor (bullet::friction_block_of):
 // Bullet's box on a plane runs beside the exact run, and the stick times and
 // slide distances of the closed form, the exact run and Bullet are printed.
 #include <cmath>
@@ -51,6 +53,10 @@ struct CompareArgs {
   double stop_erp = bullet::WorldSettings{}.stop_erp;
   int iterations = bullet::WorldSettings{}.solver_iterations;
   std::string peer = "bullet";  // or "mujoco"
+  // Friction at a contact scene's contacts: Bullet's model
+  // (bullet::parse_friction) and MuJoCo's cone (mujoco::parse_cone).
+  std::string bullet_friction = "cone";
+  std::string mujoco_cone = "pyramidal";
 };
 
 // A block on a floor with friction: Bullet's box beside the exact run
@@ -195,6 +201,7 @@ void compare_bullet(const scene::LoadedModel& loaded, const CompareArgs& a, app:
   bullet::WorldSettings ws;
   ws.stop_erp = a.stop_erp;
   ws.solver_iterations = a.iterations;
+  ws.friction = bullet::parse_friction(a.bullet_friction);
   if (std::string why = bullet::settings_error(ws); !why.empty()) throw io::InputError(why);
   const std::string bullet_solver = bullet::solver_description(model, ws);
   req.runner = [&ws](const mech::Model& m, const Eigen::VectorXd& x0, const sim::Options& opt) {
@@ -220,15 +227,18 @@ void compare_bullet(const scene::LoadedModel& loaded, const CompareArgs& a, app:
 void compare_mujoco(const scene::LoadedModel& loaded, const CompareArgs& a, app::RunRequest req,
                     const sim::Trajectory& exact) {
   const mech::Model& model = loaded.model;
-  req.runner = [](const mech::Model& m, const Eigen::VectorXd& x0, const sim::Options& opt) {
-    return mujoco::simulate_mujoco(m, x0, opt);
+  mujoco::Settings ms;
+  ms.cone = mujoco::parse_cone(a.mujoco_cone);
+  req.runner = [&ms](const mech::Model& m, const Eigen::VectorXd& x0, const sim::Options& opt) {
+    return mujoco::simulate_mujoco(m, x0, opt, ms);
   };
   req.check_linearisation = false;  // the exact run's states are checked
   const sim::Trajectory mj = compare_run(loaded, req, "MuJoCo");
   const bullet::Comparison c = bullet::compare_trajectories(exact, mj, 1e-9 * a.h);
   print_warnings(mj);
   const sim::ReferenceLaw law = sim::reference_law("mujoco", req.options.impact, model);
-  const BulletRun run{mj, mujoco::version_string(), mujoco::settings_description({}, a.h), 0.0,
+  const BulletRun run{mj, mujoco::version_string(),
+                      mujoco::settings_description(ms, a.h, model.mechanical->has_friction()), 0.0,
                       *req.options.t_end};
   if (a.json)
     print_comparison_json(model, a, run, law, c);
@@ -241,7 +251,8 @@ void compare_mujoco(const scene::LoadedModel& loaded, const CompareArgs& a, app:
 void run_compare_mujoco(const scene::LoadedModel& loaded, const CompareArgs& a) {
 #ifdef LCSIM_HAS_MUJOCO
   const mech::Model& model = loaded.model;
-  mujoco::check_expressible(model);  // invalid_argument naming it: exit 2
+  mujoco::check_expressible(model);         // invalid_argument naming it: exit 2
+  (void)mujoco::parse_cone(a.mujoco_cone);  // before anything runs
   app::RunRequest req;
   req.x0 = resolve_initial_state(model, a.model, a.x0);
   req.options = compare_options(a, model);
@@ -263,7 +274,11 @@ void run_compare(const CompareArgs& a) {
   const scene::LoadedModel loaded = scene::load_model_and_scene(a.model);
   if (a.peer == "mujoco") return run_compare_mujoco(loaded, a);
   const mech::Model& model = loaded.model;
-  const bool friction = model.is_mechanical() && !model.mechanical->friction.empty();
+  // A block on a floor with friction (a matrix model) runs as Bullet's box on
+  // a plane; a contact scene with friction at its contacts as its multibody.
+  const bool friction =
+      model.is_mechanical() && !model.mechanical->friction.empty() && !loaded.scene;
+  (void)bullet::parse_friction(a.bullet_friction);  // before anything runs
   if (!friction) bullet::check_expressible(model);  // invalid_argument naming it: exit 2
   app::RunRequest req;
   req.x0 = resolve_initial_state(model, a.model, a.x0);
@@ -297,6 +312,13 @@ void setup(CLI::App& app) {
   cmd->add_option("--iterations", a->iterations, "Bullet solver iterations; default 100");
   cmd->add_option("--peer", a->peer,
                   "The peer: bullet (default) or mujoco (contact scenes; MuJoCo's soft contacts)");
+  cmd->add_option("--bullet-friction", a->bullet_friction,
+                  "Bullet's friction at a contact scene's contacts: cone (default: two "
+                  "directions, implicit cone), box (two directions, each bounded alone) or "
+                  "one-direction (Bullet's default single row)");
+  cmd->add_option("--mujoco-cone", a->mujoco_cone,
+                  "MuJoCo's friction cone at a contact scene's contacts: pyramidal (default, "
+                  "MuJoCo's) or elliptic");
   cmd->add_flag("--json", a->json, "Print the comparison as JSON");
   cmd->callback([a, t_end] {
     a->t_end_given = t_end->count() > 0;

@@ -12,7 +12,8 @@
 // Contacts: the geoms of the links the scene's contacts name (the URDF's
 // <collision> primitives: a box collides as a box, up to 4 contacts on a
 // plane) collide with the scene's planes and nothing else (contype 1 /
-// conaffinity 0 against 0 / 1), condim 1 (frictionless), solref
+// conaffinity 0 against 0 / 1), condim 1 (frictionless; with the scene's
+// friction: condim 3, the link's mu on its geoms, Settings::cone), solref
 // (time constant, damping ratio) and solimp from Settings. MuJoCo's contacts
 // are soft by design: a contact force exists only with penetration (or
 // within solimp's width), set by a spring-damper reference acceleration
@@ -32,6 +33,7 @@
 #include <lcsim/core/format.hpp>
 #include <lcsim/mujoco/mujoco.hpp>
 #include <lcsim/scene/scene.hpp>
+#include <map>
 #include <optional>
 #include <regex>
 #include <stdexcept>
@@ -67,15 +69,58 @@ double time_constant(const Settings& s, double h) {
 
 }  // namespace
 
-std::string settings_description(const Settings& s, double h) {
-  return "mj_step (Euler integrator, Newton solver, 100 iterations, tolerance 1e-8), condim 1 "
-         "(frictionless), solref (" +
-         short_number(time_constant(s, h)) + " s, " + short_number(s.damping_ratio) +
+std::string cone_name(Settings::Cone c) {
+  return c == Settings::Cone::kElliptic ? "elliptic" : "pyramidal";
+}
+
+Settings::Cone parse_cone(const std::string& name) {
+  if (name == "pyramidal") return Settings::Cone::kPyramidal;
+  if (name == "elliptic") return Settings::Cone::kElliptic;
+  throw std::invalid_argument("mujoco: unknown friction cone '" + name + "' (pyramidal, elliptic)");
+}
+
+std::string settings_description(const Settings& s, double h, bool friction) {
+  const std::string contact =
+      !friction ? "condim 1 (frictionless)"
+      : s.cone == Settings::Cone::kElliptic
+          ? "condim 3 (sliding friction, mu the scene's on the link's geoms, 0 on the planes: "
+            "MuJoCo takes the larger), elliptic cone (|f_t| <= mu f_n), impratio 1"
+          : "condim 3 (sliding friction, mu the scene's on the link's geoms, 0 on the planes: "
+            "MuJoCo takes the larger), pyramidal cone (edges n +- mu t1, n +- mu t2), impratio 1";
+  return "mj_step (Euler integrator, Newton solver, 100 iterations, tolerance 1e-8), " + contact +
+         ", solref (" + short_number(time_constant(s, h)) + " s, " + short_number(s.damping_ratio) +
          "), solimp (" + short_number(s.dmin) + ", " + short_number(s.dmax) + ", " +
          short_number(s.width) + " m)";
 }
 
 namespace {
+
+// Why MuJoCo cannot hold the scene's friction, or "": a frictional row that
+// is not a scene contact's (or a moving surface), or a link whose contact
+// points differ in mu (MuJoCo's friction is per geom: every geom of the link
+// gets it).
+std::string friction_refusal(const mech::MechanicalModel& m, const scene::Scene& sc) {
+  std::map<int, double> mu_of_row;
+  for (const mech::FrictionalContact& f : m.friction) {
+    if (f.velocity != 0.0 || !f.is_3d())
+      return "constraint '" + m.constraints[static_cast<std::size_t>(f.contact)] +
+             "' has friction that is not a scene contact's: MuJoCo runs the friction of "
+             "contacts: only";
+    mu_of_row[f.contact] = f.mu;
+  }
+  std::map<std::string, std::pair<double, std::string>> mu_of_link;  // link -> (mu, first contact)
+  for (const auto& cf : sc.contacts) {
+    const auto it = mu_of_row.find(static_cast<int>(cf.row));
+    const double mu = it == mu_of_row.end() ? 0.0 : it->second;
+    const auto [seen, fresh] = mu_of_link.emplace(cf.point.link, std::make_pair(mu, cf.point.name));
+    if (!fresh && seen->second.first != mu)
+      return "contact '" + cf.point.name + "' has friction mu = " + short_number(mu) +
+             " but contact '" + seen->second.second + "' of the same link '" + cf.point.link +
+             "' has mu = " + short_number(seen->second.first) +
+             ": MuJoCo's friction is per geom (one mu per link)";
+  }
+  return "";
+}
 
 // What check_expressible refuses, or "" (the scene found).
 std::string refusal(const mech::Model& model, std::optional<scene::Scene>& sc) {
@@ -88,9 +133,9 @@ std::string refusal(const mech::Model& model, std::optional<scene::Scene>& sc) {
            ": a scene of several bodies (`bodies:`): MuJoCo runs one-URDF scenes only";
   const mech::MechanicalModel& m = *model.mechanical;
   const std::string where = "mujoco: " + model.source + ": ";
-  if (m.has_friction()) return where + "MuJoCo runs frictionless contact scenes only";
   std::vector<bool> contact(static_cast<std::size_t>(m.num_constraints()), false);
   for (const auto& cf : sc->contacts) contact[static_cast<std::size_t>(cf.row)] = true;
+  if (std::string why = friction_refusal(m, *sc); !why.empty()) return where + why;
   for (int i = 0; i < m.num_constraints(); ++i)
     if (!contact[static_cast<std::size_t>(i)])
       return where + "constraint '" + m.constraints[static_cast<std::size_t>(i)] +

@@ -9,6 +9,7 @@
 #include <lcsim/core/format.hpp>
 #include <lcsim/mujoco/mujoco.hpp>
 #include <lcsim/scene/scene.hpp>
+#include <lcsim/scene/so3.hpp>
 #include <optional>
 #include <stdexcept>
 
@@ -22,27 +23,6 @@ using Eigen::Matrix3d;
 using Eigen::MatrixXd;
 using Eigen::Vector3d;
 using Eigen::VectorXd;
-
-Matrix3d skew(const Vector3d& r) {
-  Matrix3d K;
-  K << 0, -r.z(), r.y(), r.z(), 0, -r.x(), -r.y(), r.x(), 0;
-  return K;
-}
-
-// The left Jacobian of SO(3) (omega = J_l(r) r'); its coefficients by their
-// series below 1e-4 rad (next terms below 1e-17).
-Matrix3d left_jacobian(const Vector3d& r) {
-  const double t = r.norm();
-  const double a = t < 1e-4 ? 0.5 - t * t / 24.0 : (1.0 - std::cos(t)) / (t * t);
-  const double b = t < 1e-4 ? 1.0 / 6.0 - t * t / 120.0 : (t - std::sin(t)) / (t * t * t);
-  const Matrix3d K = skew(r);
-  return Matrix3d::Identity() + a * K + b * K * K;
-}
-
-Matrix3d exp_so3(const Vector3d& r) {
-  const double th = r.norm();
-  return th > 0.0 ? Eigen::AngleAxisd(th, r / th).toRotationMatrix() : Matrix3d::Identity();
-}
 
 // Where each lcsim coordinate lives in MuJoCo, and the scene's forces.
 struct Run {
@@ -68,25 +48,42 @@ int id_or_throw(const mjModel* m, int type, const std::string& name, const char*
   return id;
 }
 
-// Geoms: the contact links' collide with the planes only; frictionless,
-// soft per Settings. Joints: no damping, armature, friction loss, stiffness
-// or range of MuJoCo's own.
-void configure(Run& r, const scene::Scene& setup, const Settings& s, double h) {
+// Geoms: the contact links' collide with the planes only, with the link's
+// friction mu (condim 3; frictionless: condim 1 as before), soft per
+// Settings. Joints: no damping, armature, friction loss, stiffness or range
+// of MuJoCo's own.
+// It is one piece: each geom's and each joint's settings, pinned in one pass.
+void configure(Run& r, const scene::Scene& setup, const mech::MechanicalModel& mm,
+               const Settings& s, double h) {
   mjModel* m = r.m.get();
   m->opt.timestep = h;
   m->opt.integrator = mjINT_EULER;
   for (int i = 0; i < 3; ++i) m->opt.gravity[i] = setup.gravity(i);
   std::vector<bool> contact_body(static_cast<std::size_t>(m->nbody), false);
-  for (const auto& cf : setup.contacts)
-    contact_body[static_cast<std::size_t>(
-        id_or_throw(m, mjOBJ_BODY, cf.point.link, "body for link"))] = true;
+  // Each contact body's mu (check_expressible: one per link), -1 without friction.
+  std::vector<double> body_mu(static_cast<std::size_t>(m->nbody), -1.0);
+  std::vector<double> row_mu(static_cast<std::size_t>(mm.num_constraints()), -1.0);
+  for (const mech::FrictionalContact& f : mm.friction)
+    row_mu[static_cast<std::size_t>(f.contact)] = f.mu;
+  for (const auto& cf : setup.contacts) {
+    const auto b =
+        static_cast<std::size_t>(id_or_throw(m, mjOBJ_BODY, cf.point.link, "body for link"));
+    contact_body[b] = true;
+    body_mu[b] = row_mu[static_cast<std::size_t>(cf.row)];
+  }
+  if (mm.has_friction()) {
+    m->opt.cone = s.cone == Settings::Cone::kElliptic ? mjCONE_ELLIPTIC : mjCONE_PYRAMIDAL;
+    m->opt.impratio = 1.0;
+    m->opt.noslip_iterations = 0;
+  }
   const double tc = s.time_constant > 0.0 ? std::max(s.time_constant, 2.0 * h) : 2.0 * h;
   for (int g = 0; g < m->ngeom; ++g) {
     const bool plane = m->geom_type[g] == mjGEOM_PLANE && m->geom_bodyid[g] == 0;
     const bool link = contact_body[static_cast<std::size_t>(m->geom_bodyid[g])];
     m->geom_contype[g] = link ? 1 : 0;
     m->geom_conaffinity[g] = plane ? 1 : 0;
-    m->geom_condim[g] = 1;
+    const double mu = body_mu[static_cast<std::size_t>(m->geom_bodyid[g])];
+    m->geom_condim[g] = link && mu >= 0.0 ? 3 : 1;
     m->geom_solref[2 * g] = tc;
     m->geom_solref[2 * g + 1] = s.damping_ratio;
     const double imp[5] = {s.dmin, s.dmax, s.width, 0.5, 2.0};
@@ -94,6 +91,7 @@ void configure(Run& r, const scene::Scene& setup, const Settings& s, double h) {
     m->geom_margin[g] = 0.0;
     m->geom_gap[g] = 0.0;
     for (int k = 0; k < 3; ++k) m->geom_friction[3 * g + k] = 0.0;
+    if (link && mu >= 0.0) m->geom_friction[3 * g] = mu;  // sliding; MuJoCo takes the larger
   }
   for (int j = 0; j < m->nv; ++j) {
     m->dof_damping[j] = 0.0;
@@ -147,14 +145,14 @@ void set_state(Run& r, const VectorXd& q, const VectorXd& v) {
   mjData* d = r.d.get();
   if (r.nb > 0) {
     const Vector3d rv = q.segment<3>(3);
-    const Matrix3d R = exp_so3(rv) * r.R0;
+    const Matrix3d R = scene::exp_so3(rv) * r.R0;
     const Eigen::Quaterniond quat(R);
     for (int i = 0; i < 3; ++i) d->qpos[r.free_q + i] = q(i);
     d->qpos[r.free_q + 3] = quat.w();
     d->qpos[r.free_q + 4] = quat.x();
     d->qpos[r.free_q + 5] = quat.y();
     d->qpos[r.free_q + 6] = quat.z();
-    const Vector3d omega_local = R.transpose() * (left_jacobian(rv) * v.segment<3>(3));
+    const Vector3d omega_local = R.transpose() * (scene::left_jacobian(rv) * v.segment<3>(3));
     for (int i = 0; i < 3; ++i) {
       d->qvel[r.free_v + i] = v(i);
       d->qvel[r.free_v + 3 + i] = omega_local(i);
@@ -172,15 +170,14 @@ void get_state(const Run& r, VectorXd& q, VectorXd& v) {
     const Eigen::Quaterniond quat(d->qpos[r.free_q + 3], d->qpos[r.free_q + 4],
                                   d->qpos[r.free_q + 5], d->qpos[r.free_q + 6]);
     const Matrix3d R = quat.normalized().toRotationMatrix();
-    const Eigen::AngleAxisd aa(R * r.R0.transpose());
-    const Vector3d rv = aa.angle() * aa.axis();
+    const Vector3d rv = scene::log_so3(R * r.R0.transpose());
     const Vector3d omega_local(d->qvel[r.free_v + 3], d->qvel[r.free_v + 4], d->qvel[r.free_v + 5]);
     for (int i = 0; i < 3; ++i) {
       q(i) = d->qpos[r.free_q + i];
       v(i) = d->qvel[r.free_v + i];
     }
     q.segment<3>(3) = rv;
-    v.segment<3>(3) = left_jacobian(rv).lu().solve(R * omega_local);
+    v.segment<3>(3) = scene::left_jacobian(rv).lu().solve(R * omega_local);
   }
   for (std::size_t c = 0; c < r.qadr.size(); ++c) {
     q(r.nb + static_cast<int>(c)) = d->qpos[r.qadr[c]];
@@ -196,8 +193,8 @@ void apply_forces(Run& r, const VectorXd& q, const VectorXd& tau) {
   mju_zero(d->qfrc_applied, r.m->nv);
   if (r.nb > 0) {
     const Vector3d rv = q.segment<3>(3);
-    const Matrix3d R = exp_so3(rv) * r.R0;
-    const Vector3d t_world = left_jacobian(rv).transpose().lu().solve(tau.segment<3>(3));
+    const Matrix3d R = scene::exp_so3(rv) * r.R0;
+    const Vector3d t_world = scene::left_jacobian(rv).transpose().lu().solve(tau.segment<3>(3));
     const Vector3d t_local = R.transpose() * t_world;
     for (int i = 0; i < 3; ++i) {
       d->qfrc_applied[r.free_v + i] = tau(i);
@@ -289,7 +286,7 @@ void prepare(Run& r, const mech::Model& model, const Settings& s, double h) {
   check_expressible(model);
   const std::optional<scene::Scene> setup = scene::load_scene_details(model.source);
   r.m = load_scene_model(*setup);
-  configure(r, *setup, s, h);
+  configure(r, *setup, *model.mechanical, s, h);
   map_coordinates(r, *setup, *model.mechanical);
 }
 
@@ -318,10 +315,14 @@ sim::Trajectory simulate_mujoco(const mech::Model& model, const VectorXd& x0,
   sim::Options opt = options;
   sim::OptionsUsed used;
   used.h = used.needs_mechanical = true;
+  // Friction at the scene's contacts is MuJoCo's own (Settings::cone;
+  // check_expressible refuses any other). The "mujoco" integrator's
+  // options_used states none: `--method mujoco` still refuses friction.
+  used.friction = used.friction_3d = true;
   if (auto refused = sim::refuse_invalid_run(model, x0, opt, "mujoco", used))
     return std::move(*refused);
   sim::Trajectory tr;
-  tr.method = "mujoco " + settings_description(s, opt.h);
+  tr.method = "mujoco " + settings_description(s, opt.h, model.mechanical->has_friction());
   tr.dynamics = "the URDF's nonlinear multibody (MuJoCo)";
   tr.t_end = *opt.t_end;
   tr.final_state = x0;

@@ -27,6 +27,7 @@
 #include <functional>
 #include <lcsim/core/format.hpp>
 #include <lcsim/io/text.hpp>
+#include <lcsim/scene/so3.hpp>
 #include <lcsim/scene/urdf.hpp>
 #include <set>
 #include <sstream>
@@ -49,12 +50,6 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
 [[noreturn]] void fail(const std::string& source, const std::string& element,
                        const std::string& what) {
   throw InputError(source + ": " + element + ": " + what);
-}
-
-Matrix3d skew(const Vector3d& c) {
-  Matrix3d s;
-  s << 0, -c.z(), c.y(), c.z(), 0, -c.x(), -c.y(), c.x(), 0;
-  return s;
 }
 
 Vector3d vec(const urdf::Vector3& v) { return {v.x, v.y, v.z}; }
@@ -361,30 +356,10 @@ Config positions(const Tree& t, const std::map<std::string, double>& q0, const V
   }
   if (t.nb > 0) {
     c.rot = q.segment<3>(3);
-    const double th = c.rot.norm();
-    const Matrix3d R =
-        th > 0.0 ? Eigen::AngleAxisd(th, c.rot / th).toRotationMatrix() : Matrix3d::Identity();
-    c.root.linear() = R * t.base.pose.linear();
+    c.root.linear() = exp_so3(c.rot) * t.base.pose.linear();
     c.root.translation() = q.head<3>();
   }
   return c;
-}
-
-// The left Jacobian of SO(3) at the rotation vector r: d/dt exp([r]x) =
-// [J_l(r) r']x exp([r]x), J_l = 1 + a [r]x + b [r]x^2 with
-// a = (1 - cos th)/th^2, b = (th - sin th)/th^3 (th = |r|). Below th = 1e-2
-// their series to th^4 (the next terms, th^6/40320 and th^6/362880, are
-// under 3e-17), where the closed forms lose digits to cancellation.
-Matrix3d left_jacobian(const Vector3d& r) {
-  const double th = r.norm(), t2 = th * th;
-  double a = 0.5 - t2 / 24.0 + t2 * t2 / 720.0, b = 1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0;
-  if (th >= 1e-2) {
-    const double s = std::sin(0.5 * th);
-    a = 2.0 * s * s / t2;  // 1 - cos th = 2 sin^2(th/2), without cancellation
-    b = (th - std::sin(th)) / (t2 * th);
-  }
-  const Matrix3d K = skew(r);
-  return Matrix3d::Identity() + a * K + b * K * K;
 }
 
 // World pose of every link with simulated and frozen joints at q (by name).

@@ -5,10 +5,12 @@
 // contacts at ERP 0: the rest is exact to the solver's residual, 1e-9).
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 
 #include "support/run_lcsim.hpp"
+#include "support/slide_scene.hpp"
 
 namespace {
 
@@ -60,6 +62,42 @@ TEST(PeersCli, ASceneOfBodiesIsRefusedByBothPeers) {
   const auto bt = lcsim("compare '" + kRobots + "gripper_box_scene.yaml' --peer bullet");
   EXPECT_EQ(bt.exit_code, 2) << bt.err;
   EXPECT_EQ(bt.err.find('\n'), bt.err.size() - 1) << bt.err;
+}
+
+// A contact scene with friction (the box of tests/support/slide_scene.hpp at
+// rest on the floor, mu = 0.3: the exact method runs it, sticking): each
+// peer's friction settings are in compare's report, the chosen cone among
+// them; the same bounds as the dropped box above (Bullet at rest exact to
+// its solver's residual, MuJoCo's resting sink 2.4e-5 m). A bad name is one
+// line, exit 2, before anything runs.
+TEST(PeersCli, CompareReportsEachPeersFrictionSettings) {
+  const auto dir = std::filesystem::path(lcsim::cli_test::private_temp("lcsim_peers_friction", ""));
+  const std::string scene = lcsim::test_support::write_slide_scene(dir, 0.0, 0.3, 0.0, 0.2);
+  struct Case {
+    std::string flags, setting;
+    double bound;
+  };
+  for (const Case& c :
+       {Case{"--peer bullet --bullet-friction box", "SOLVER_DISABLE_IMPLICIT_CONE_FRICTION", 1e-9},
+        Case{"--peer bullet", "with implicit cone friction", 1e-9},
+        Case{"--peer mujoco", "condim 3", 2.4e-5},
+        Case{"--peer mujoco --mujoco-cone elliptic", "elliptic cone", 2.4e-5}}) {
+    const auto r = lcsim("compare '" + scene + "' " + c.flags + " --json");
+    ASSERT_EQ(r.exit_code, 0) << c.flags << ": " << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_NE(j["bullet_solver"].get<std::string>().find(c.setting), std::string::npos)
+        << c.flags << ": " << j["bullet_solver"];
+    EXPECT_LE(j["error_final"].get<double>(), c.bound) << c.flags;
+  }
+  const auto bad = lcsim("compare '" + scene + "' --peer mujoco --mujoco-cone circular");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_EQ(bad.err,
+            "lcsim: error: mujoco: unknown friction cone 'circular' (pyramidal, elliptic)\n");
+  const auto bad2 = lcsim("compare '" + scene + "' --bullet-friction pyramid");
+  EXPECT_EQ(bad2.exit_code, 2);
+  EXPECT_EQ(bad2.err,
+            "lcsim: error: bullet: unknown friction model 'pyramid' (cone, box, one-direction)\n");
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -79,7 +79,29 @@ struct WorldSettings {
   // a point approaching at up to contact_threshold / h stops at the plane
   // without crossing it (50 m/s at h = 1e-3).
   double contact_threshold = 0.05;
+  // Friction at a contact scene's contacts with `friction:` (docs/contacts.md,
+  // "Peers on contact scenes"): Coulomb's mu on each link's collider (the
+  // scene's, one per link) times 1 on the planes (Bullet multiplies them).
+  // btMultiBodyConstraintSolver has one friction row per contact along the
+  // first of btPlaneSpace1(n)'s tangents, fixed (its velocity-aligned
+  // direction is disabled for multibodies), bounded by mu times the normal
+  // impulse; SOLVER_USE_2_FRICTION_DIRECTIONS adds the second tangent's row.
+  //  - kCone: two directions, solved together, their impulse scaled back
+  //    onto the circle of radius mu N when outside it (Bullet's "implicit
+  //    cone friction", the default with two directions): the circular cone;
+  //  - kBox: two directions, each bounded alone (SOLVER_DISABLE_IMPLICIT_CONE_
+  //    FRICTION): the square |f_1|, |f_2| <= mu N, whose corners reach
+  //    sqrt(2) mu N;
+  //  - kOneDirection: Bullet's default single row: no friction across it.
+  enum class Friction { kCone, kBox, kOneDirection };
+  Friction friction = Friction::kCone;
 };
+
+// "cone", "box", "one-direction".
+std::string friction_name(WorldSettings::Friction f);
+// The friction model named `name`; std::invalid_argument naming it and the
+// choices otherwise.
+WorldSettings::Friction parse_friction(const std::string& name);
 
 // "" when every setting is usable, else one line naming the first bad one
 // and its value (solver_iterations >= 1; stop_erp in (0, 1]; stop_cfm,

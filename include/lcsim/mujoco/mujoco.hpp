@@ -31,18 +31,35 @@ struct Settings {
   // solimp (MuJoCo's defaults): the impedance d rises from dmin to dmax over
   // `width` m of penetration; d near 1 is a hard contact.
   double dmin = 0.9, dmax = 0.95, width = 0.001;
+  // The friction cone of a scene whose contacts have `friction:` (condim 3:
+  // sliding friction in MuJoCo's two contact tangents; mjOption::cone).
+  // Pyramidal (MuJoCo's default): 4 edges n +- mu t1, n +- mu t2, so the
+  // friction force lies in the square with its corners at mu N on the
+  // tangents, lcsim's d = 2 cone. Elliptic: the circular cone |f_t| <= mu N.
+  // impratio (the friction rows' impedance relative to the normal's) is
+  // pinned at MuJoCo's default 1.
+  enum class Cone { kPyramidal, kElliptic };
+  Cone cone = Cone::kPyramidal;
 };
+
+// "pyramidal" or "elliptic" (mjOption::cone's XML names).
+std::string cone_name(Settings::Cone c);
+// The cone named `name` ("pyramidal", "elliptic"); std::invalid_argument
+// naming it and the choices otherwise.
+Settings::Cone parse_cone(const std::string& name);
 
 // "" when usable, else one line naming the first bad setting and its value.
 std::string settings_error(const Settings& s);
 
-// "mj_step (Euler), condim 1 (frictionless), solref (0.002 s, 1), ..." at step h.
-std::string settings_description(const Settings& s, double h);
+// "mj_step (Euler), condim 1 (frictionless), solref (0.002 s, 1), ..." at step h;
+// with `friction` (the scene's contacts have friction:) condim 3 and the cone.
+std::string settings_description(const Settings& s, double h, bool friction = false);
 
 // Throws std::invalid_argument naming what MuJoCo cannot run here: a model
 // that is not a URDF scene (or changed since it was loaded), a scene
 // constraint that is not a contact against a plane (a joint stop), a
-// contact with explicit points, friction, a mimic joint, a movable URDF
+// contact with explicit points, a link whose contact points differ in their
+// friction coefficient (MuJoCo's friction is per geom), a mimic joint, a movable URDF
 // joint the scene does not simulate, a fixed base at a pose other than the
 // identity.
 void check_expressible(const mech::Model& model);
