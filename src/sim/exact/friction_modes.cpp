@@ -238,6 +238,15 @@ std::string EventDriven::select_friction_and_normals(double t, const lcs::ModeSe
     return "";
   VectorXd x1 = xa;
   const std::string why = select_friction(t, sel.undetermined, x1, out);
+  // Only a slip's friction, fixed by mu, can press K shut: sticking forces
+  // are the held rows' multipliers, which balance the body on I.
+  const bool slips = std::any_of(out.friction.begin(), out.friction.end(), [](FrictionMode f) {
+    return f != FrictionMode::kOpen && f != FrictionMode::kStick;
+  });
+  if (why.empty() && !slips) {
+    xa = x1;
+    return "";
+  }
   if (why.empty()) {
     std::string err;
     const Phase ph = make_phase(out.mode, out.friction, sel.undetermined, x1, err);
