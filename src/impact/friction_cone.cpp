@@ -7,6 +7,7 @@
 #include <cmath>
 #include <lcsim/core/format.hpp>
 #include <lcsim/impact/impact.hpp>
+#include <lcsim/lcp/redundant.hpp>
 #include <limits>
 
 #include "impact/detail.hpp"
@@ -172,7 +173,13 @@ FrictionLcp cone_lcp(const MatrixXd& Wb, const VectorXd& rate_N, const VectorXd&
 // place of one sign): a contact alone with W_NN - mu max_i |W_N D_i| <= 0,
 // then the normal matrix W_NN + sum_f mu_f W_N D_(i_f) e_f' over every
 // choice of edges i_f while there are at most kMaxPatterns choices and
-// kMaxPatternNormals closed contacts. "" when there is none.
+// kMaxPatternNormals closed contacts. A choice whose normal matrix is not
+// a P-matrix only through sets of dependent normal rows (a box landing flat
+// on its four coplanar corners: W_NN of rank 3, every minor over the four
+// zero whatever the friction) is redundancy, not Painlevé: the impulse is
+// not unique there but the LCP below (Stewart and Trinkle's, which Lemke
+// solves for this class: Anitescu and Potra 1997) still gives the velocity,
+// checked on its result. "" when there is none.
 constexpr long kMaxPatterns = 256, kMaxPatternNormals = 12;
 
 std::string cone_painleve(const mech::MechanicalModel& m, const IndexSet& closed,
@@ -207,10 +214,10 @@ std::string cone_painleve(const mech::MechanicalModel& m, const IndexSet& closed
       Ns.col(c.normal_of[f]) += c.mu(static_cast<Eigen::Index>(f)) * WND.col(c.first[f] + i);
       which += text(" ", closed[static_cast<size_t>(c.normal_of[f])], " (edge ", i, ")");
     }
-    if (lcp::is_p_matrix(Ns)) continue;
+    if (lcp::is_p_matrix(Ns) || lcp::is_p_matrix_on_independent_rows(Ns, W)) continue;
     return "Painlevé-type case at contacts" + which +
-           ": with friction on these edges the normal matrix W_NN + W_ND diag(mu) is not a "
-           "P-matrix" +
+           ": with friction on these edges the normal matrix W_NN + W_ND diag(mu) has a "
+           "principal minor <= 0 on contacts of independent normal rows" +
            tail;
   }
   return "";

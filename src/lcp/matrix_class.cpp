@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <lcsim/lcp/lcp.hpp>
+#include <lcsim/lcp/redundant.hpp>
 #include <vector>
 
 namespace lcsim::lcp {
@@ -59,6 +60,31 @@ bool is_p_matrix(const MatrixXd& M, double rel_tol) {
     const double hadamard = Maa.rowwise().norm().prod();
     const double det = alpha.size() == 1 ? Maa(0, 0) : Maa.partialPivLu().determinant();
     if (!(det > rel_tol * hadamard)) return false;
+  }
+  return true;
+}
+
+}  // namespace lcsim::lcp
+
+namespace lcsim::lcp {
+
+// redundant.hpp. Enumerates the 2^k - 1 sets as is_p_matrix does.
+bool is_p_matrix_on_independent_rows(const MatrixXd& Ns, const MatrixXd& W, double rel_tol) {
+  if (!square_nonempty_finite(Ns) || W.rows() != Ns.rows() || W.cols() != Ns.cols() ||
+      Ns.rows() > kMaxPMatrixOrder)
+    return false;
+  const int k = static_cast<int>(Ns.rows());
+  std::vector<int> a;
+  const auto positive = [rel_tol](const MatrixXd& A) {
+    const double det = A.rows() == 1 ? A(0, 0) : A.partialPivLu().determinant();
+    return det > rel_tol * A.rowwise().norm().prod();
+  };
+  for (unsigned mask = 1; mask < (1u << k); ++mask) {
+    a.clear();
+    for (int i = 0; i < k; ++i)
+      if (mask & (1u << i)) a.push_back(i);
+    if (!positive(W(a, a))) continue;  // dependent rows: a redundant set
+    if (!positive(Ns(a, a))) return false;
   }
   return true;
 }

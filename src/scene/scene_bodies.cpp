@@ -169,6 +169,7 @@ Scene read_bodies_scene(const YAML::Node& root, const std::string& source) {
       add_contacts(keys, source, contact_bodies, planes, exact, q0v, constraints);
   check_unique_names(constraints, source);
   mech::MechanicalModel m = assemble(lin, dyn, constraints, joints);
+  add_contact_friction(contacts, m);  // as a one-URDF scene's (scene.cpp): it was dropped
   m.restitution = read_restitution(keys, source, m.constraints);
   check_mass_matrix(lin.M, joints, source);
   model.initial = read_initial(keys, source, check, joints, q0v);

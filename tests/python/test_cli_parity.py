@@ -18,7 +18,8 @@ MODELS = ["ball.yaml", "triple_integrator.yaml", "two_carts.yaml", "two_carts_ho
           "panda_gripper_scene.yaml", "nao_legs_scene.yaml",
           "block_on_floor_friction.yaml", "incline_friction.yaml", "mass_spring_friction.yaml",
           "spinning_disk_friction.yaml", "belt_friction.yaml",
-          "box_drop_scene.yaml", "box_tip_scene.yaml", "quadruped_drop_scene.yaml",
+          "box_drop_scene.yaml", "box_tip_scene.yaml", "box_slide_scene.yaml",
+          "quadruped_drop_scene.yaml",
           "gripper_box_scene.yaml", "vision60_drop_scene.yaml", "shaker_table.yaml", "pwl_lift.yaml"]
 HORIZON = 0.5  # s at most: 50 samples of dt_out, each model's events in that window
 

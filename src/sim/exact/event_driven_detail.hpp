@@ -315,6 +315,23 @@ class EventDriven {
   std::string painleve_phase(const Phase& ph, const MatrixXd& S, int n_stick) const;
   std::string select_friction(double t, const lcs::IndexSet& undetermined, VectorXd& xa,
                               EventResult& out);
+  // The normal mode and friction modes at a regular state after the LDCP's
+  // selection `sel` (friction_modes.cpp): sel.mode, or sel.mode with its
+  // undetermined constraints held too where friction presses them shut.
+  // "" or the failure message; undetermined gets the K the phase keeps.
+  // held: the ending phase's mode (I ∪ K is tried first when it held them).
+  std::string select_friction_and_normals(double t, const lcs::ModeSelection& sel,
+                                          const lcs::IndexSet& held, VectorXd& xa, EventResult& out,
+                                          lcs::IndexSet& undetermined);
+  // True when some constraint of `which` (outside ph.mode) has its gap leave
+  // zero downwards at the phase start (its first nonzero derivative < 0).
+  bool presses_shut(const Phase& ph, const lcs::IndexSet& which, const VectorXd& xa,
+                    double t) const;
+  // True when every monitor of `ph` (normals and friction) starts positive or
+  // leaves zero upwards.
+  bool all_consistent(const Phase& ph, const VectorXd& xa, double t) const;
+  // The normal rows of ph.mode are dependent (rank of E_I below |I|).
+  bool redundant_normals(const Phase& ph) const;
   std::vector<int> zero_sliding(const lcs::IndexSet& mode, const VectorXd& xa,
                                 std::vector<FrictionMode>& fm) const;
   void project_sliding(const lcs::IndexSet& mode, const std::vector<int>& zero, VectorXd& xa) const;
@@ -381,7 +398,8 @@ class EventDriven {
                             bool limit_taken, VectorXd& time_noise) const;
   bool impact_round(double t, ContactScan& scan, bool limit_taken, const VectorXd& time_noise,
                     VectorXd& xa, EventResult& out);
-  bool select_regular_mode(double t, const ContactScan& scan, VectorXd& xa, EventResult& out);
+  bool select_regular_mode(double t, const ContactScan& scan, const lcs::IndexSet& held,
+                           VectorXd& xa, EventResult& out);
   std::string take_accumulation_limit(int r, double t, const GeometricTail& tail,
                                       const VectorXd& gap, const VectorXd& gap_scale,
                                       const VectorXd& rate, VectorXd& xa) const;

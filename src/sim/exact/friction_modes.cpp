@@ -62,29 +62,21 @@ std::vector<int> EventDriven::zero_sliding(const lcs::IndexSet& mode, const Vect
   return zero;
 }
 
-// Sets the sliding velocities of `zero` exactly to zero, keeping E_I v = 0:
-// the M-orthogonal projection onto those rows (they are zero up to the
-// state's rounding, or to the impact law's stick tolerance).
+// Sets the sliding velocities of `zero` exactly to zero (t'v = the belt's
+// velocity), keeping E_I v = 0: project_rows (cone_modes.cpp) on their
+// tangent rows (they are zero up to the state's rounding, or to the impact
+// law's stick tolerance).
 void EventDriven::project_sliding(const lcs::IndexSet& mode, const std::vector<int>& zero,
                                   VectorXd& xa) const {
   const mech::MechanicalModel& m = *model_.mechanical;
-  const Eigen::Index nI = static_cast<Eigen::Index>(mode.size());
-  const Eigen::Index nr = nI + static_cast<Eigen::Index>(zero.size());
-  MatrixXd G(nr, N_);
-  VectorXd r(nr);
-  const VectorXd v = xa.segment(N_, N_);
-  for (Eigen::Index i = 0; i < nI; ++i) {
-    G.row(i) = m.E.row(mode[static_cast<size_t>(i)]);
-    r(i) = G.row(i).dot(v);
+  std::vector<RowVectorXd> rows;
+  std::vector<double> target;
+  for (const int f : zero) {
+    const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(f)];
+    rows.push_back(RowVectorXd(fc.tangent.transpose()));
+    target.push_back(fc.velocity);
   }
-  for (size_t z = 0; z < zero.size(); ++z) {
-    const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(zero[z])];
-    G.row(nI + static_cast<Eigen::Index>(z)) = fc.tangent.transpose();
-    r(nI + static_cast<Eigen::Index>(z)) = fc.sliding(v);
-  }
-  const MatrixXd MinvGt = Minv_ * G.transpose();
-  const VectorXd lambda = (G * MinvGt).completeOrthogonalDecomposition().solve(r);
-  xa.segment(N_, N_) -= MinvGt * lambda;
+  project_rows(mode, rows, target, xa);
 }
 
 // The acceleration-level friction LCP over the normals of `mode` and the
@@ -198,6 +190,108 @@ std::string EventDriven::select_friction(double t, const lcs::IndexSet& undeterm
         << "'";
   msg << " is consistent (each of stick, slip+, slip- leaves a friction monitor negative)";
   return msg.str();
+}
+
+// The LDCP selects the normal mode without friction: with redundant
+// contacts (a box flat on four corners) it keeps an independent subset I
+// (two diagonal corners) and leaves the others undetermined (K: gap and
+// force identically zero in the frictionless phase, so not monitored). With
+// friction that is no longer so: the friction forces' moment about I turns
+// the body, and a corner of K is pressed into the floor unseen. So when the
+// phase selected on I presses a constraint of K shut (its gap's first
+// nonzero derivative negative), or no friction mode on I is consistent, the
+// modes are selected again on I ∪ K (the redundant normals held together,
+// their forces' resultant determined: friction_feedback), and that choice is
+// taken when every one of its monitors, normal forces included, starts
+// consistently. Otherwise the selection on I stands (as before).
+std::string EventDriven::select_friction_and_normals(double t, const lcs::ModeSelection& sel,
+                                                     const lcs::IndexSet& held, VectorXd& xa,
+                                                     EventResult& out,
+                                                     lcs::IndexSet& undetermined) {
+  if (sel.undetermined.empty()) return select_friction(t, sel.undetermined, xa, out);
+  const auto in_held = [&](int r) { return std::find(held.begin(), held.end(), r) != held.end(); };
+  // I ∪ K: taken when its friction modes are selected and every monitor of
+  // its phase starts consistently.
+  const auto try_union = [&]() {
+    EventResult all = out;
+    all.mode = sel.mode;
+    all.mode.insert(all.mode.end(), sel.undetermined.begin(), sel.undetermined.end());
+    std::sort(all.mode.begin(), all.mode.end());
+    VectorXd x2 = xa;
+    const bool selected = select_friction(t, {}, x2, all).empty();
+    out.lcp_solves = all.lcp_solves;  // counted whether taken or not
+    if (!selected) return false;
+    std::string err;
+    const Phase ph = make_phase(all.mode, all.friction, {}, x2, err);
+    if (!err.empty() || !all_consistent(ph, x2, t)) return false;
+    out.mode = all.mode;
+    out.friction = all.friction;
+    undetermined.clear();
+    xa = x2;
+    return true;
+  };
+  // The ending phase held them all (the box sliding on its four corners
+  // comes to rest): keep holding them if that is consistent, so the event
+  // is the friction change it is, not a release of corners that stay shut.
+  if (std::all_of(sel.mode.begin(), sel.mode.end(), in_held) &&
+      std::all_of(sel.undetermined.begin(), sel.undetermined.end(), in_held) && try_union())
+    return "";
+  VectorXd x1 = xa;
+  const std::string why = select_friction(t, sel.undetermined, x1, out);
+  // Only a slip's friction, fixed by mu, can press K shut: sticking forces
+  // are the held rows' multipliers, which balance the body on I.
+  const bool slips = std::any_of(out.friction.begin(), out.friction.end(), [](FrictionMode f) {
+    return f != FrictionMode::kOpen && f != FrictionMode::kStick;
+  });
+  if (why.empty() && !slips) {
+    xa = x1;
+    return "";
+  }
+  if (why.empty()) {
+    std::string err;
+    const Phase ph = make_phase(out.mode, out.friction, sel.undetermined, x1, err);
+    if (err.empty() && !presses_shut(ph, sel.undetermined, x1, t)) {
+      xa = x1;
+      return "";
+    }
+  }
+  if (try_union()) return "";
+  xa = x1;
+  return why;
+}
+
+bool EventDriven::presses_shut(const Phase& ph, const lcs::IndexSet& which, const VectorXd& xa,
+                               double t) const {
+  Phase probe = ph;  // its monitors, with those of `which` added
+  for (const int r : which) {
+    Monitor mon;
+    mon.constraint = r;
+    mon.multiplier = false;
+    RowVectorXd w = sys_.C.row(r);
+    for (size_t i = 0; i < ph.mode.size(); ++i) w += sys_.D(r, ph.mode[i]) * ph.F.row(i);
+    mon.w = w.cwiseProduct(ph.D.transpose());
+    mon.wA = ph.row_times(mon.w);
+    probe.monitors.push_back(std::move(mon));
+  }
+  const MonitorStart st = monitor_start(probe, xa.cwiseQuotient(ph.D), t, 1.0);
+  for (size_t j = ph.monitors.size(); j < probe.monitors.size(); ++j)
+    if (st.m0[j] >= 0 && !(st.d0[j] > 0.0)) return true;
+  return false;
+}
+
+bool EventDriven::all_consistent(const Phase& ph, const VectorXd& xa, double t) const {
+  const MonitorStart st = monitor_start(ph, xa.cwiseQuotient(ph.D), t, 1.0);
+  for (size_t j = 0; j < ph.monitors.size(); ++j)
+    if (st.m0[j] >= 0 && !(st.d0[j] > 0.0)) return false;
+  return true;
+}
+
+bool EventDriven::redundant_normals(const Phase& ph) const {
+  const Eigen::Index nI = static_cast<Eigen::Index>(ph.mode.size());
+  MatrixXd EI(nI, N_);
+  for (Eigen::Index i = 0; i < nI; ++i)
+    EI.row(i) = model_.mechanical->E.row(ph.mode[static_cast<size_t>(i)]);
+  return Eigen::FullPivLU<MatrixXd>(EI).rank() < nI;
 }
 
 }  // namespace lcsim::sim::detail

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <lcsim/lcp/lcp.hpp>
+#include <lcsim/lcp/redundant.hpp>
 #include <limits>
 
 #include "sim/exact/event_driven_detail.hpp"
@@ -58,6 +59,15 @@ std::string EventDriven::painleve_phase(const Phase& ph, const MatrixXd& S, int 
   }
   if (lcp::is_p_matrix(Ns)) return "";
   const mech::MechanicalModel& m = *model_.mechanical;
+  // Redundant normals (a box's four coplanar corners): a set of dependent
+  // rows E_J has a zero minor whatever the friction, so only the sets of
+  // independent rows judge Painlevé (lcp/redundant.hpp); the forces'
+  // resultant is then checked by friction_feedback.
+  if (nI <= 20) {
+    MatrixXd EI(nI, N_);
+    for (Eigen::Index i = 0; i < nI; ++i) EI.row(i) = m.E.row(ph.mode[static_cast<size_t>(i)]);
+    if (lcp::is_p_matrix_on_independent_rows(Ns, EI * Minv_ * EI.transpose())) return "";
+  }
   std::string msg = "Painlevé-type phase: with contact";
   for (size_t f = 0; f < ph.friction.size(); ++f) {
     if (!slipping(ph.friction[f])) continue;
@@ -123,7 +133,8 @@ bool EventDriven::friction_feedback(Phase& ph, const VectorXd& xa, std::string& 
     F_all = -S.completeOrthogonalDecomposition().solve(H * Av);
     ph.Acl.middleRows(N_, N_) += MinvGt * F_all;
     if (!has_cone_) indeterminate_split(ph, S, stick, xa, F_all);  // forces only: H' Z = 0
-  } else if (has_cone_ && resultant_determined(S, MinvGt, H * Av, F_all)) {
+  } else if ((has_cone_ || redundant_normals(ph)) &&
+             resultant_determined(S, MinvGt, H * Av, F_all)) {
     ph.Acl.middleRows(N_, N_) += MinvGt * F_all;
   } else {
     err =

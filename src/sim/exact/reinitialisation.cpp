@@ -122,8 +122,8 @@ bool EventDriven::impact_round(double t, ContactScan& scan, bool limit_taken,
 // The regular state's mode: the closed gaps and resting rates put at exactly
 // zero, mode selection at acceleration level and above, and the friction
 // modes; false (out.message) on failure.
-bool EventDriven::select_regular_mode(double t, const ContactScan& scan, VectorXd& xa,
-                                      EventResult& out) {
+bool EventDriven::select_regular_mode(double t, const ContactScan& scan, const lcs::IndexSet& held,
+                                      VectorXd& xa, EventResult& out) {
   // Put the closed gaps and the resting rates at exactly zero: they are zero
   // up to the state's rounding, and mode selection must see them so.
   project_onto(scan.in.closed, xa, true);
@@ -137,13 +137,15 @@ bool EventDriven::select_regular_mode(double t, const ContactScan& scan, VectorX
     return false;
   }
   out.mode = sel.mode;
+  lcs::IndexSet undetermined = sel.undetermined;
   if (model_.mechanical->has_friction()) {
-    if (std::string why = select_friction(t, sel.undetermined, xa, out); !why.empty()) {
+    if (std::string why = select_friction_and_normals(t, sel, held, xa, out, undetermined);
+        !why.empty()) {
       out.message = why;
       return false;
     }
   }
-  ldcp_undetermined_ = sel.undetermined;
+  ldcp_undetermined_ = undetermined;
   return true;
 }
 
@@ -185,7 +187,7 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0,
       return out;
     }
   }
-  if (!select_regular_mode(t, scan, xa, out)) return out;
+  if (!select_regular_mode(t, scan, held, xa, out)) return out;
   out.x_plus = xa;
   out.status = Status::kOk;
   return out;
