@@ -75,10 +75,15 @@ class Sensitivity {
   void lose(double t, int contact, const std::string& reason, const std::vector<int>& cols,
             bool always = false);
   void lose_all(double t, int contact, const std::string& reason);
+  void start_on_boundary(const VectorXd& xa);
   bool impact_map(double t, const EventResult::ImpactRound& round, MatrixXd& J, MatrixXd& dR);
+  void moving_stop_columns(const std::vector<int>& A, const MatrixXd& EA,
+                           const Eigen::LDLT<MatrixXd>& Wf, const VectorXd& one_e,
+                           MatrixXd& J) const;
   // dAcl/dtheta and dF/dtheta of a mode for each parameter (mechanical).
   void mode_derivatives(const lcs::IndexSet& mode);
   std::string contact_name(int r) const;
+  bool same_event(const Monitor& other, const Monitor& mon) const;
 
   const mech::Model& model_;
   const lcs::Lcs& sys_;
@@ -113,6 +118,9 @@ class Sensitivity {
   RowVectorXd dtau_;
   int released_ = -1;  // the constraint the last event released (-1 if none)
   int trigger_ = -1;   // the constraint whose monitor ended the last phase
+  // Constraints whose monitors are the trigger's up to a positive factor
+  // (same_event): they switch with it.
+  std::vector<int> co_triggers_;
 };
 
 }  // namespace lcsim::sim::detail
