@@ -270,6 +270,89 @@ TEST(SensitivityEvents, LcsStartOnSwitchingSurfaceHasNoDerivative) {
   EXPECT_TRUE(run(m, x0, 1e-2, {"x0"}).sensitivity_losses.empty());
 }
 
+// Planar friction (x0 only): the stick / slip events of the files, to their
+// own horizons. Each starts on its floor (a zero gap: the entries that move
+// the gap or its rate, y0 and vy0, are absent), and the mass on a spring
+// starts to slip from rest (vx0, which moves its sliding velocity, is
+// absent: one side of it reverses first); the other entries are compared,
+// at x(T) and every event time. Block: one stick (slip -> stick at
+// v0/(mu g)); spring: slip reversal at pi/2 and stick at pi; incline: one
+// stick; belt: stick at 0.21 s, slip at 1.33 s (the stick force reaching the
+// cone's edge, where the sliding velocity starts with zero acceleration).
+TEST(SensitivityEvents, PlanarFrictionAgainstFiniteDifferences) {
+  struct File {
+    const char* name;
+    int columns;  // entries of x0 with a derivative
+  };
+  for (const File& f :
+       {File{"robots/block_on_floor_friction.yaml", 2}, File{"robots/mass_spring_friction.yaml", 1},
+        File{"robots/incline_friction.yaml", 2}, File{"robots/belt_friction.yaml", 2}}) {
+    const mech::Model m = load(f.name);
+    const double T = m.t_end;
+    const sim::Trajectory plain = run(m, m.initial, T);
+    ASSERT_TRUE(plain.ok()) << plain.message;
+    ASSERT_GE(plain.events.size(), 1u) << f.name;
+    const int n = static_cast<int>(m.initial.size());
+    EXPECT_EQ(expect_matches_fd(m, m.initial, T, {}, true, "at the start"),
+              f.columns * (n + static_cast<int>(plain.events.size())))
+        << f.name;
+    std::cout << f.name << ": " << plain.events.size() << " events\n";
+  }
+}
+
+// The block sliding to rest on the floor (robots/block_on_floor_friction.yaml:
+// v0 = 2 m/s, mu = 0.4, g = 9.81): it stops at t* = v0/(mu g) after
+// v0^2/(2 mu g), so dt*/dv0 = 1/(mu g), and at T = 1 > t*: dx/dx0 = 1,
+// dx/dv0 = v0/(mu g), dv/d(x0, v0) = 0; before the stop (T = 0.3 s):
+// x = x0 + v0 T - mu g T^2/2, dx/dv0 = T, dv/dv0 = 1. Tolerance 1e-13 of the
+// entries' size 1 (the run is good to ~1e-15 here: one phase per
+// exponential of a nilpotent matrix; margin 100).
+TEST(SensitivityEvents, BlockSlidingToRestClosedForm) {
+  const mech::Model m = load("robots/block_on_floor_friction.yaml");
+  const double v0 = m.initial(2), mu = 0.4, g = 9.81;
+  ASSERT_EQ(v0, 2.0);
+  ASSERT_EQ(m.mechanical->friction[0].mu, mu);
+  const sim::Trajectory tr = run(m, m.initial, 1.0, {"x0"});
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  ASSERT_EQ(tr.events.size(), 1u);
+  EXPECT_NEAR(tr.events[0].t, v0 / (mu * g), 1e-13);
+  EXPECT_NEAR(tr.final_state(0), v0 * v0 / (2 * mu * g), 1e-13);
+  ASSERT_TRUE(tr.events[0].dt_exists[2]);
+  EXPECT_NEAR(tr.events[0].dt(2), 1 / (mu * g), 1e-13);
+  EXPECT_NEAR(tr.events[0].dt(0), 0.0, 1e-13);
+  EXPECT_NEAR(tr.dx_final(0, 0), 1.0, 1e-13);
+  EXPECT_NEAR(tr.dx_final(0, 2), v0 / (mu * g), 1e-13);
+  EXPECT_NEAR(tr.dx_final(2, 0), 0.0, 1e-13);
+  EXPECT_NEAR(tr.dx_final(2, 2), 0.0, 1e-13);
+  const double Ts = 0.3;
+  const sim::Trajectory early = run(m, m.initial, Ts, {"x0"});
+  ASSERT_TRUE(early.ok()) << early.message;
+  EXPECT_NEAR(early.dx_final(0, 2), Ts, 1e-13);
+  EXPECT_NEAR(early.dx_final(2, 2), 1.0, 1e-13);
+  EXPECT_NEAR(early.dx_final(0, 0), 1.0, 1e-13);
+}
+
+// What stays refused with friction: a parameter, another method, 3-D.
+TEST(SensitivityEvents, FrictionRefusals) {
+  const mech::Model m = load("robots/block_on_floor_friction.yaml");
+  sim::Options opt;
+  opt.t_end = 0.1;
+  opt.sensitivity = {"x0", "f[1]"};
+  sim::Trajectory tr = sim::simulate(m, m.initial, opt, "event");
+  EXPECT_EQ(tr.status, Status::kInvalidInput);
+  EXPECT_NE(tr.message.find("'f[1]' is not computed with friction"), std::string::npos)
+      << tr.message;
+  opt.sensitivity = {"x0"};
+  tr = sim::simulate(m, m.initial, opt, "moreau-jean");
+  EXPECT_EQ(tr.status, Status::kInvalidInput);
+  EXPECT_NE(tr.message.find("stick / slip"), std::string::npos) << tr.message;
+  mech::Model m3 = m;
+  m3.mechanical->friction[0].tangent2 = Eigen::SparseVector<double>(2);
+  m3.mechanical->friction[0].tangent2.insert(1) = 1.0;
+  tr = sim::simulate(m3, m3.initial, opt, "event");
+  EXPECT_EQ(tr.status, Status::kInvalidInput);
+}
+
 // Methods other than the exact one refuse sensitivities with inputs.
 TEST(SensitivityEvents, SchemesRefuseInputs) {
   const mech::Model m = load("robots/pwl_lift.yaml");

@@ -110,10 +110,17 @@ void Sensitivity::start(const VectorXd& xa) {
   const VectorXd gap = m.has_inputs() ? VectorXd(sys_.C * xa) : VectorXd(m.E * q + m.g);
   const VectorXd scale = m.has_inputs() ? VectorXd(sys_.C.cwiseAbs() * xa.cwiseAbs())
                                         : VectorXd(m.E.cwiseAbs() * q.cwiseAbs() + m.g.cwiseAbs());
+  const MatrixXd E = m.has_friction() ? dense(m.E) : MatrixXd();
   for (int r = 0; r < m.num_constraints(); ++r) {
     if (std::abs(gap(r)) > 1e-9 * scale(r) + 1e-13) continue;
     std::vector<int> cols;
-    for (int c = 0; c < nx0_; ++c) cols.push_back(c);
+    // With friction (x0 columns only): an entry that moves neither the gap
+    // nor its rate (E_r e_c = 0: sliding along the floor) keeps the start on
+    // the boundary surface in the same mode, so its derivative exists (a
+    // block sliding to rest, d/dv0). Frictionless models keep the rule
+    // above for every entry (their tests count the columns it leaves).
+    for (int c = 0; c < nx0_; ++c)
+      if (E.size() == 0 || E(r, c % N_) != 0.0) cols.push_back(c);
     for (size_t p = 0; p < cols_.params.size(); ++p)
       if (cols_.params[p].kind == 'g' && cols_.params[p].i == r)
         cols.push_back(nx0_ + static_cast<int>(p));
@@ -296,7 +303,8 @@ void Sensitivity::before_event(double tau, const VectorXd& x_minus, int monitor)
   if (monitor < 0) return;
   const Monitor& mon = monitors_[static_cast<size_t>(monitor)];
   trigger_ = mon.constraint;
-  if (mon.multiplier) released_ = mon.constraint;
+  trigger_stick_ = mon.multiplier && mon.friction >= 0;
+  if (mon.multiplier && mon.friction < 0) released_ = mon.constraint;
   const double rate = mon.w.dot(xdot_minus_);
   // Grazing: the monitor reaches zero with a zero rate (to sqrt(eps) of its
   // terms); dtau/dtheta = -(...)/rate does not exist.
@@ -467,7 +475,9 @@ void Sensitivity::after_event(const EventResult& ev, const Phase& next, double t
     lose_all(t, trigger, "accumulation of impacts: the derivative of its limit is not computed");
   if (!mech_ && ev.jumped)
     lose_all(t, trigger, "a jump of a general LCS (P_I x): its derivative is not computed");
-  if (mech_ && !ev.rounds.empty()) {
+  if (mech_ && !ev.rounds.empty() && model_.mechanical->has_friction())
+    lose_all(t, trigger, "an impact with friction: its derivative is not computed");
+  else if (mech_ && !ev.rounds.empty()) {
     // Another contact closing at the same time: coinciding events.
     for (int r : ev.rounds.front().closed)
       if (r != trigger && t > 0.0 && std::find(held.begin(), held.end(), r) == held.end())
@@ -487,14 +497,20 @@ void Sensitivity::after_event(const EventResult& ev, const Phase& next, double t
 void Sensitivity::check_phase_start(const Phase& ph, double t, const std::vector<int>& m0,
                                     const lcs::IndexSet& undetermined) {
   const int released = released_, trigger = trigger_;
+  const bool stuck = trigger_stick_;
   released_ = trigger_ = -1;
+  trigger_stick_ = false;
   if (!undetermined.empty())
     lose_all(t, undetermined.front(),
              "mode selection left a constraint undetermined (its multiplier and output vanish "
              "identically)");
   for (size_t j = 0; j < ph.monitors.size() && j < m0.size(); ++j) {
     const Monitor& mon = ph.monitors[j];
-    if (mon.friction >= 0 || m0[j] == 0) continue;
+    if (m0[j] == 0) continue;
+    if (mon.friction >= 0) {
+      check_friction_start(mon, t, m0[j], trigger, stuck);
+      continue;
+    }
     // A multiplier starting at zero (with a nonzero rate for the contact
     // whose output just reached zero: a general LCS's continuous contact),
     // or a free output zero to the second derivative (third for the
@@ -512,6 +528,33 @@ void Sensitivity::check_phase_start(const Phase& ph, double t, const std::vector
                "mode selections nearby)");
   }
   co_triggers_.clear();
+}
+
+// A friction monitor starting at zero (order m0 of its first nonzero
+// derivative) at a phase start. Generic: the sliding velocity of the
+// contact whose slip just reversed (m0 = 1), or whose stick force just
+// reached the cone's edge (m0 = 2: the friction force is continuous there,
+// so is the tangential acceleration, zero). At t = 0, a contact starting to
+// slip from rest: only the entries of x0 that move its sliding velocity
+// (w e_c != 0) see another stick / slip sequence on one side. Anything else
+// (a stick force starting at the edge, a sliding velocity with zero
+// acceleration) has several stick / slip selections nearby.
+void Sensitivity::check_friction_start(const Monitor& mon, double t, int m0, int trigger,
+                                       bool stuck) {
+  if (mon.constraint == trigger && (m0 == 1 || (m0 == 2 && stuck))) return;
+  if (t == 0.0 && trigger < 0 && !mon.multiplier && m0 == 1) {
+    std::vector<int> cols;
+    for (int c = 0; c < nx0_; ++c)
+      if (mon.w(c) != 0.0) cols.push_back(c);
+    lose(t, mon.constraint,
+         "slip from rest at the start: the sliding velocity is zero, so only one-sided "
+         "derivatives exist in the entries that move it",
+         cols, true);
+    return;
+  }
+  lose_all(t, mon.constraint,
+           "degenerate stick / slip: a friction monitor starts at zero (the stick force at the "
+           "cone's edge, or a sliding velocity with zero acceleration)");
 }
 
 void Sensitivity::graze(double t, int trigger) {

@@ -84,6 +84,7 @@ class Sensitivity {
   void mode_derivatives(const lcs::IndexSet& mode);
   std::string contact_name(int r) const;
   bool same_event(const Monitor& other, const Monitor& mon) const;
+  void check_friction_start(const Monitor& mon, double t, int m0, int trigger, bool stuck);
 
   const mech::Model& model_;
   const lcs::Lcs& sys_;
@@ -121,6 +122,7 @@ class Sensitivity {
   // Constraints whose monitors are the trigger's up to a positive factor
   // (same_event): they switch with it.
   std::vector<int> co_triggers_;
+  bool trigger_stick_ = false;  // the trigger was a stick force reaching the cone's edge
 };
 
 }  // namespace lcsim::sim::detail
