@@ -129,8 +129,8 @@ std::string refuse_friction(const mech::Model& model, const Options& opt, std::s
              "] is a 3-D contact (tangent2): sensitivities through 3-D friction are not computed";
   for (const std::string& s : opt.sensitivity)
     if (s != "x0")
-      return head + "sensitivity '" + s +
-             "' is not computed with friction (through stick / slip only x0 is)";
+      return "Options::sensitivity '" + s + "': not computed with friction (model '" + model.name +
+             "' has mechanical.friction; through planar stick / slip only x0 is)";
   return "";
 }
 
