@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unsupported/Eigen/MatrixFunctions>
 
 namespace lcsim::sim::detail {
 
@@ -239,6 +240,8 @@ void Sensitivity::begin_phase(const Phase& ph, double t0, const VectorXd& xa, co
     if (!exists_[static_cast<size_t>(c)]) S0_.col(c).setZero();
   Sc_ = S0_;
   zc_ = xa.cwiseQuotient(D_);
+  dense_ = !use_sparse_ && n_ <= Phase::kDenseExpMax;
+  dense_cache_.clear();
 }
 
 // S from the cursor to t: the Taylor series of exp(tau [Ab dAb; 0 Ab]) on
@@ -256,6 +259,7 @@ const MatrixXd& Sensitivity::at(double t) {
     tc_ = t;  // every column absent: nothing to carry (Sc_ is zero)
     return Sc_;
   }
+  if (dense_) return at_dense(t, tau);
   const int P = static_cast<int>(cols_.params.size());
   const long steps = std::max(1L, static_cast<long>(std::ceil(norm1_ * tau)));
   const double dt = tau / static_cast<double>(steps);
@@ -284,6 +288,50 @@ const MatrixXd& Sensitivity::at(double t) {
   }
   Sc_ = D_.asDiagonal() * Sb;
   zc_ = z;
+  tc_ = t;
+  return Sc_;
+}
+
+// A dense phase (n <= Phase::kDenseExpMax, as the phase's own exponential):
+// over tau, S_x0 <- Phi S_x0 and, per parameter p, s_p <- Phi s_p + Psi_p z
+// with Phi = e^{Ab tau} and Psi_p the upper-right block of
+// e^{[Ab dAb_p; 0 Ab] tau} (Van Loan), by Pade with scaling and squaring:
+// O(log(|Ab| tau)) products where the Taylor substeps cost |Ab| tau (a stiff
+// contact's phase). Kept per tau within the phase (samples share dt_out).
+const MatrixXd& Sensitivity::at_dense(double t, double tau) {
+  const DenseBlock* b = nullptr;
+  for (const DenseBlock& c : dense_cache_)
+    if (c.tau == tau) b = &c;
+  DenseBlock fresh;
+  if (b == nullptr) {
+    fresh.tau = tau;
+    for (const MatrixXd& d : dAb_) {
+      if (d.size() == 0) {  // a mode without its derivatives: nothing carried
+        fresh.Psi.push_back(MatrixXd::Zero(n_, n_));
+        continue;
+      }
+      MatrixXd big = MatrixXd::Zero(2 * n_, 2 * n_);
+      big.topLeftCorner(n_, n_) = Ab_;
+      big.topRightCorner(n_, n_) = d;
+      big.bottomRightCorner(n_, n_) = Ab_;
+      const MatrixXd e = (big * tau).exp();
+      fresh.Psi.push_back(e.topRightCorner(n_, n_));
+      if (fresh.Phi.size() == 0) fresh.Phi = e.topLeftCorner(n_, n_);  // e^{Ab tau}
+    }
+    if (fresh.Phi.size() == 0) fresh.Phi = (Ab_ * tau).exp();
+    if (dense_cache_.size() < 4) {
+      dense_cache_.push_back(std::move(fresh));
+      b = &dense_cache_.back();
+    } else {
+      b = &fresh;
+    }
+  }
+  const MatrixXd Sb = D_.cwiseInverse().asDiagonal() * Sc_;
+  MatrixXd next = b->Phi * Sb;
+  for (size_t p = 0; p < b->Psi.size(); ++p)
+    next.col(nx0_ + static_cast<Eigen::Index>(p)) += b->Psi[p] * zc_;
+  Sc_ = D_.asDiagonal() * next;
+  zc_ = b->Phi * zc_;
   tc_ = t;
   return Sc_;
 }

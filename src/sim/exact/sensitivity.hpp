@@ -76,6 +76,7 @@ class Sensitivity {
             bool always = false);
   void lose_all(double t, int contact, const std::string& reason);
   void start_on_boundary(const VectorXd& xa);
+  const MatrixXd& at_dense(double t, double tau);
   bool impact_map(double t, const EventResult::ImpactRound& round, MatrixXd& J, MatrixXd& dR);
   void moving_stop_columns(const std::vector<int>& A, const MatrixXd& EA,
                            const Eigen::LDLT<MatrixXd>& Wf, const VectorXd& one_e,
@@ -109,6 +110,14 @@ class Sensitivity {
   std::vector<MatrixXd> dF_;   // dF_I/dtheta per parameter (unbalanced)
   lcs::IndexSet mode_;
   std::vector<Monitor> monitors_;  // unbalanced w
+  // A dense phase's exponentials per step length (at_dense).
+  struct DenseBlock {
+    double tau = 0.0;
+    MatrixXd Phi;
+    std::vector<MatrixXd> Psi;  // per parameter
+  };
+  bool dense_ = false;
+  std::vector<DenseBlock> dense_cache_;
   // The cursor: S and the balanced state at tc_.
   double tc_ = 0.0;
   MatrixXd Sc_;
