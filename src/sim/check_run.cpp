@@ -184,7 +184,8 @@ std::string refuse_friction_law(const mech::Model& model, const Options& opt,
 }  // namespace
 
 // A model with inputs (docs/inputs.md) needs a method that evaluates them;
-// a moving stop (gap_inputs) and sensitivities are not simulated yet.
+// a moving stop (gap_inputs) is the exact method's only, and so are
+// sensitivities with inputs.
 std::string refuse_inputs(const mech::Model& model, const Options& opt, std::string_view method,
                           const OptionsUsed& used) {
   if (!model.is_mechanical() || !model.mechanical->has_inputs()) return "";
@@ -200,8 +201,11 @@ std::string refuse_inputs(const mech::Model& model, const Options& opt, std::str
   if (!m.gap_inputs.empty() && m.has_friction())
     return text("model '", model.name,
                 "': mechanical.gap_inputs (a moving stop) with friction is not simulated yet");
-  if (!opt.sensitivity.empty())
-    return text("model '", model.name, "' has inputs: sensitivities are not computed with inputs");
+  // Sensitivities through scheduled events: the exact method's
+  // (docs/sensitivities.md); the schemes' step maps with inputs are not done.
+  if (!opt.sensitivity.empty() && !used.event_search)
+    return text("model '", model.name, "' has inputs: method '", method,
+                "' does not compute sensitivities with inputs (method 'event' does)");
   return "";
 }
 

@@ -10,6 +10,7 @@
 #include <lcsim/core/format.hpp>
 
 #include "sim/exact/event_driven_detail.hpp"
+#include "sim/exact/sensitivity.hpp"
 
 namespace lcsim::sim::detail {
 
@@ -33,15 +34,20 @@ bool EventDriven::take_scheduled(RunState& r, PhaseMarch& pm, double t_b) {
   for (const mech::Input& in : m.inputs)
     if (in.next_breakpoint(pm.t0) == t_b) names += (names.empty() ? "'" : ", '") + in.name + "'";
   r.t = t_b;
+  // Sensitivities: a fixed time (dt_b/dtheta = 0), q and v continuous, w a
+  // function of t alone (docs/sensitivities.md).
+  if (sens_) sens_->before_event(t_b, x_minus, -1);
   VectorXd x_b = x_minus;
   const VectorXd w = mech::exosystem_states(m, t_b);
   x_b.tail(w.size()) = w;
   // pm refers to r.phase, which reinitialise replaces: not used below.
   EventResult ev;
+  const lcs::IndexSet old_mode = r.phase.mode;
   if (!reinitialise(r, x_b, ev)) {
     r.xa = x_b;
     return false;
   }
+  if (sens_) sens_->after_event(ev, r.phase, r.t, r.xa, old_mode, -1);
   if (!keep) {
     if (tr.events_not_recorded++ == 0)
       tr.warn("events-not-recorded", r.t,
@@ -58,6 +64,7 @@ bool EventDriven::take_scheduled(RunState& r, PhaseMarch& pm, double t_b) {
   e.impulse = ev.impulse;
   set_friction(e, ev);
   e.note = "breakpoint of input " + names;
+  if (sens_) sens_->fill_event(e);
   tr.events.push_back(std::move(e));
   record(tr, r.t, r.xa, r.phase);
   return true;

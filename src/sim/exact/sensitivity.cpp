@@ -15,12 +15,29 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unsupported/Eigen/MatrixFunctions>
 
 namespace lcsim::sim::detail {
 
 namespace {
 
 MatrixXd dense(const Eigen::SparseMatrix<double>& A) { return MatrixXd(A); }
+
+// The exosystem columns of H = [-K -D f H_w] (docs/inputs.md): a force input
+// enters the v rows of A as M^{-1} gain times its output row, so H_w is gain
+// times that row at the input's exosystem states (after (q, v, 1)).
+void add_input_forces(const mech::MechanicalModel& m, MatrixXd& H) {
+  std::vector<int> at;
+  int next = 2 * m.dofs() + 1;
+  for (const mech::Input& in : m.inputs) {
+    at.push_back(next);
+    next += in.exo_size();
+  }
+  for (const mech::InputUse& use : m.force_inputs) {
+    const mech::Input& in = m.inputs[static_cast<size_t>(use.input)];
+    H.middleCols(at[static_cast<size_t>(use.input)], in.exo_size()) += use.gain * in.exo_output();
+  }
+}
 
 }  // namespace
 
@@ -80,25 +97,58 @@ void Sensitivity::start(const VectorXd& xa) {
   dtau_ = RowVectorXd::Zero(m_);
   S_minus_ = S;
   xdot_minus_ = VectorXd::Zero(n_);
-  if (!mech_) return;
+  if (!mech_) {
+    start_on_boundary(xa);
+    return;
+  }
   // A zero gap at the start: x0 lies on the boundary of the admissible set
   // E q + g >= 0, where x(t) has one-sided derivatives only (a perturbation
   // that closes the gap is inadmissible, one that opens it changes the
   // events); the zero test of infeasible_start (sim.hpp).
   const mech::MechanicalModel& m = *model_.mechanical;
   const VectorXd q = xa.head(N_);
-  const VectorXd gap = m.E * q + m.g;
-  const VectorXd scale = m.E.cwiseAbs() * q.cwiseAbs() + m.g.cwiseAbs();
+  // With gap inputs (a moving stop) the gap is C x: E q + g + the stops' terms.
+  const VectorXd gap = m.has_inputs() ? VectorXd(sys_.C * xa) : VectorXd(m.E * q + m.g);
+  const VectorXd scale = m.has_inputs() ? VectorXd(sys_.C.cwiseAbs() * xa.cwiseAbs())
+                                        : VectorXd(m.E.cwiseAbs() * q.cwiseAbs() + m.g.cwiseAbs());
+  const MatrixXd E = m.has_friction() ? dense(m.E) : MatrixXd();
   for (int r = 0; r < m.num_constraints(); ++r) {
     if (std::abs(gap(r)) > 1e-9 * scale(r) + 1e-13) continue;
     std::vector<int> cols;
-    for (int c = 0; c < nx0_; ++c) cols.push_back(c);
+    // With friction (x0 columns only): an entry that moves neither the gap
+    // nor its rate (E_r e_c = 0: sliding along the floor) keeps the start on
+    // the boundary surface in the same mode, so its derivative exists (a
+    // block sliding to rest, d/dv0). Frictionless models keep the rule
+    // above for every entry (their tests count the columns it leaves).
+    for (int c = 0; c < nx0_; ++c)
+      if (E.size() == 0 || E(r, c % N_) != 0.0) cols.push_back(c);
     for (size_t p = 0; p < cols_.params.size(); ++p)
       if (cols_.params[p].kind == 'g' && cols_.params[p].i == r)
         cols.push_back(nx0_ + static_cast<int>(p));
     lose(0.0, r,
          "zero gap at the start: the initial state is on the boundary of the admissible set, "
          "where only one-sided derivatives exist",
+         cols, true);
+  }
+}
+
+// A general LCS's start with y_i = C_i x0 = 0 on a row i without
+// feedthrough (row i of D zero): x0 is on the surface C_i x = 0, whose one
+// side has the constraint free and the other a jump P_I x (or a different
+// event sequence: a rectifier started at the zero of its source), so only
+// one-sided derivatives exist (the zero test of the mechanical start's gaps).
+// A row with feedthrough has y_i = 0 held by its multiplier, which moves
+// with x0 (the half-wave RLC's diode).
+void Sensitivity::start_on_boundary(const VectorXd& xa) {
+  const VectorXd y = sys_.C * xa;
+  const VectorXd scale = sys_.C.cwiseAbs() * xa.cwiseAbs();
+  for (Eigen::Index r = 0; r < y.size(); ++r) {
+    if (!sys_.D.row(r).isZero(0.0) || std::abs(y(r)) > 1e-9 * scale(r) + 1e-13) continue;
+    std::vector<int> cols;
+    for (int c = 0; c < nx0_; ++c) cols.push_back(c);
+    lose(0.0, static_cast<int>(r),
+         "zero output at the start on a row without feedthrough: the initial state is on a "
+         "switching surface, where only one-sided derivatives exist",
          cols, true);
   }
 }
@@ -133,8 +183,9 @@ void Sensitivity::mode_derivatives(const lcs::IndexSet& mode) {
     WinvEG = W.ldlt().solve(EI * G_);
     Q = G_ - G_ * EI.transpose() * WinvEG;
   }
-  MatrixXd H(N_, n_);
-  H << -dense(m.K), -dense(m.D), m.f;
+  MatrixXd H = MatrixXd::Zero(N_, n_);
+  H.leftCols(2 * N_ + 1) << -dense(m.K), -dense(m.D), m.f;
+  add_input_forces(m, H);
   const MatrixXd QH = Q * H;
   for (int p = 0; p < P; ++p) {
     const SensParam& sp = cols_.params[static_cast<size_t>(p)];
@@ -149,7 +200,7 @@ void Sensitivity::mode_derivatives(const lcs::IndexSet& mode) {
         dF += WinvEG.col(sp.j) * QH.row(sp.i);
       }
     } else {
-      const int col = sp.kind == 'f' ? n_ - 1 : sp.kind == 'K' ? sp.j : N_ + sp.j;
+      const int col = sp.kind == 'f' ? 2 * N_ : sp.kind == 'K' ? sp.j : N_ + sp.j;
       const double sign = sp.kind == 'f' ? 1.0 : -1.0;
       if (sp.kind == 'f' || sp.kind == 'K' || sp.kind == 'D') {
         dAv.col(col) = sign * Q.col(sp.i);
@@ -189,6 +240,8 @@ void Sensitivity::begin_phase(const Phase& ph, double t0, const VectorXd& xa, co
     if (!exists_[static_cast<size_t>(c)]) S0_.col(c).setZero();
   Sc_ = S0_;
   zc_ = xa.cwiseQuotient(D_);
+  dense_ = !use_sparse_ && n_ <= Phase::kDenseExpMax;
+  dense_cache_.clear();
 }
 
 // S from the cursor to t: the Taylor series of exp(tau [Ab dAb; 0 Ab]) on
@@ -206,6 +259,7 @@ const MatrixXd& Sensitivity::at(double t) {
     tc_ = t;  // every column absent: nothing to carry (Sc_ is zero)
     return Sc_;
   }
+  if (dense_) return at_dense(t, tau);
   const int P = static_cast<int>(cols_.params.size());
   const long steps = std::max(1L, static_cast<long>(std::ceil(norm1_ * tau)));
   const double dt = tau / static_cast<double>(steps);
@@ -238,6 +292,50 @@ const MatrixXd& Sensitivity::at(double t) {
   return Sc_;
 }
 
+// A dense phase (n <= Phase::kDenseExpMax, as the phase's own exponential):
+// over tau, S_x0 <- Phi S_x0 and, per parameter p, s_p <- Phi s_p + Psi_p z
+// with Phi = e^{Ab tau} and Psi_p the upper-right block of
+// e^{[Ab dAb_p; 0 Ab] tau} (Van Loan), by Pade with scaling and squaring:
+// O(log(|Ab| tau)) products where the Taylor substeps cost |Ab| tau (a stiff
+// contact's phase). Kept per tau within the phase (samples share dt_out).
+const MatrixXd& Sensitivity::at_dense(double t, double tau) {
+  const DenseBlock* b = nullptr;
+  for (const DenseBlock& c : dense_cache_)
+    if (c.tau == tau) b = &c;
+  DenseBlock fresh;
+  if (b == nullptr) {
+    fresh.tau = tau;
+    for (const MatrixXd& d : dAb_) {
+      if (d.size() == 0) {  // a mode without its derivatives: nothing carried
+        fresh.Psi.push_back(MatrixXd::Zero(n_, n_));
+        continue;
+      }
+      MatrixXd big = MatrixXd::Zero(2 * n_, 2 * n_);
+      big.topLeftCorner(n_, n_) = Ab_;
+      big.topRightCorner(n_, n_) = d;
+      big.bottomRightCorner(n_, n_) = Ab_;
+      const MatrixXd e = (big * tau).exp();
+      fresh.Psi.push_back(e.topRightCorner(n_, n_));
+      if (fresh.Phi.size() == 0) fresh.Phi = e.topLeftCorner(n_, n_);  // e^{Ab tau}
+    }
+    if (fresh.Phi.size() == 0) fresh.Phi = (Ab_ * tau).exp();
+    if (dense_cache_.size() < 4) {
+      dense_cache_.push_back(std::move(fresh));
+      b = &dense_cache_.back();
+    } else {
+      b = &fresh;
+    }
+  }
+  const MatrixXd Sb = D_.cwiseInverse().asDiagonal() * Sc_;
+  MatrixXd next = b->Phi * Sb;
+  for (size_t p = 0; p < b->Psi.size(); ++p)
+    next.col(nx0_ + static_cast<Eigen::Index>(p)) += b->Psi[p] * zc_;
+  Sc_ = D_.asDiagonal() * next;
+  zc_ = b->Phi * zc_;
+  tc_ = t;
+  return Sc_;
+}
+
 void Sensitivity::fill(double t, MatrixXd& dx, std::vector<char>& exists) {
   const MatrixXd& S = at(t);
   dx = S.topRows(mech_ ? 2 * N_ : n_);
@@ -253,7 +351,8 @@ void Sensitivity::before_event(double tau, const VectorXd& x_minus, int monitor)
   if (monitor < 0) return;
   const Monitor& mon = monitors_[static_cast<size_t>(monitor)];
   trigger_ = mon.constraint;
-  if (mon.multiplier) released_ = mon.constraint;
+  trigger_stick_ = mon.multiplier && mon.friction >= 0;
+  if (mon.multiplier && mon.friction < 0) released_ = mon.constraint;
   const double rate = mon.w.dot(xdot_minus_);
   // Grazing: the monitor reaches zero with a zero rate (to sqrt(eps) of its
   // terms); dtau/dtheta = -(...)/rate does not exist.
@@ -266,9 +365,14 @@ void Sensitivity::before_event(double tau, const VectorXd& x_minus, int monitor)
   // Another monitor at zero too: coinciding events (an impact as a held
   // contact's force vanishes, two gaps closing at once), where the event
   // sequence of nearby runs differs on either side.
+  co_triggers_.clear();
   for (size_t j = 0; j < monitors_.size(); ++j) {
     const Monitor& other = monitors_[j];
     if (static_cast<int>(j) == monitor || other.friction >= 0) continue;
+    if (same_event(other, mon)) {
+      co_triggers_.push_back(other.constraint);
+      continue;
+    }
     // Zero to sqrt(eps) of its row times the state's size (a held force's
     // own terms may all vanish there: springs relaxed, no load).
     if (std::abs(other.w.dot(x_minus)) <=
@@ -291,6 +395,36 @@ void Sensitivity::before_event(double tau, const VectorXd& x_minus, int monitor)
   dtau_ = -dh / rate;
   for (int c = 0; c < m_; ++c)
     if (!exists_[static_cast<size_t>(c)]) dtau_(c) = 0.0;
+}
+
+// Two monitors of a general LCS that are one function up to a positive
+// factor (w_o = c w, the diodes of a bridge switching together at a zero of
+// one voltage): they reach zero at the same time for every x0 (a general
+// LCS takes x0 only), so that is no coincidence of two events but one event
+// of two constraints. Parallel to sqrt(eps) of |w_o|.
+bool Sensitivity::same_event(const Monitor& other, const Monitor& mon) const {
+  if (mech_) return false;  // a parameter (g[c], f[i]) could move one alone
+  const double ww = mon.w.squaredNorm();
+  if (ww == 0.0) return false;
+  const double c = other.w.dot(mon.w) / ww;
+  return c > 0.0 && (other.w - c * mon.w).norm() <= kSqrtEps * other.w.norm();
+}
+
+// Moving stops (docs/inputs.md): the law acts on v + delta with
+// E_J delta = gdot_J = (C_w A_w w)_J, so E_A v_rel = E_A v + gdot_A and
+// v+ = v + G E_A' mu(v_rel): J_vw = G E_A' Tc (C_w A_w)_A with T = Tc E_A
+// (Tc = -W^{-1} (1 + e) for moreau-restitution, -(1 + e) W^{-1} for newton).
+void Sensitivity::moving_stop_columns(const std::vector<int>& A, const MatrixXd& EA,
+                                      const Eigen::LDLT<MatrixXd>& Wf, const VectorXd& one_e,
+                                      MatrixXd& J) const {
+  const int a = static_cast<int>(A.size()), ne = n_ - 2 * N_ - 1;
+  const MatrixXd rate = sys_.C.rightCols(ne) * sys_.A.bottomRightCorner(ne, ne);
+  MatrixXd rateA(a, ne);
+  for (int i = 0; i < a; ++i) rateA.row(i) = rate.row(A[static_cast<size_t>(i)]);
+  const MatrixXd Tc = law_ == 'r'
+                          ? MatrixXd(Wf.solve(-MatrixXd(one_e.asDiagonal())))
+                          : MatrixXd(-(one_e.asDiagonal() * Wf.solve(MatrixXd::Identity(a, a))));
+  J.block(N_, 2 * N_ + 1, N_, ne) = G_ * EA.transpose() * Tc * rateA;
 }
 
 // One round of the impact law at its fixed active set A (the closed
@@ -347,6 +481,7 @@ bool Sensitivity::impact_map(double t, const EventResult::ImpactRound& rd, Matri
                                  : MatrixXd(-(one_e.asDiagonal() * Wf.solve(EA)));
   J = MatrixXd::Identity(n_, n_);
   J.block(N_, N_, N_, N_) += G_ * EA.transpose() * T;
+  if (!m.gap_inputs.empty()) moving_stop_columns(A, EA, Wf, one_e, J);
   dR = MatrixXd::Zero(n_, m_);
   for (size_t p = 0; p < cols_.params.size(); ++p) {
     const SensParam& sp = cols_.params[p];
@@ -388,7 +523,9 @@ void Sensitivity::after_event(const EventResult& ev, const Phase& next, double t
     lose_all(t, trigger, "accumulation of impacts: the derivative of its limit is not computed");
   if (!mech_ && ev.jumped)
     lose_all(t, trigger, "a jump of a general LCS (P_I x): its derivative is not computed");
-  if (mech_ && !ev.rounds.empty()) {
+  if (mech_ && !ev.rounds.empty() && model_.mechanical->has_friction())
+    lose_all(t, trigger, "an impact with friction: its derivative is not computed");
+  else if (mech_ && !ev.rounds.empty()) {
     // Another contact closing at the same time: coinciding events.
     for (int r : ev.rounds.front().closed)
       if (r != trigger && t > 0.0 && std::find(held.begin(), held.end(), r) == held.end())
@@ -408,27 +545,64 @@ void Sensitivity::after_event(const EventResult& ev, const Phase& next, double t
 void Sensitivity::check_phase_start(const Phase& ph, double t, const std::vector<int>& m0,
                                     const lcs::IndexSet& undetermined) {
   const int released = released_, trigger = trigger_;
+  const bool stuck = trigger_stick_;
   released_ = trigger_ = -1;
+  trigger_stick_ = false;
   if (!undetermined.empty())
     lose_all(t, undetermined.front(),
              "mode selection left a constraint undetermined (its multiplier and output vanish "
              "identically)");
   for (size_t j = 0; j < ph.monitors.size() && j < m0.size(); ++j) {
     const Monitor& mon = ph.monitors[j];
-    if (mon.friction >= 0 || m0[j] == 0) continue;
+    if (m0[j] == 0) continue;
+    if (mon.friction >= 0) {
+      check_friction_start(mon, t, m0[j], trigger, stuck);
+      continue;
+    }
     // A multiplier starting at zero (with a nonzero rate for the contact
     // whose output just reached zero: a general LCS's continuous contact),
     // or a free output zero to the second derivative (third for the
     // contact just released): the multiplier and the gap's acceleration
     // both vanish.
+    const bool triggered =
+        mon.constraint == trigger ||
+        std::find(co_triggers_.begin(), co_triggers_.end(), mon.constraint) != co_triggers_.end();
     const bool degenerate =
-        mon.multiplier ? !(m0[j] == 1 && mon.constraint == trigger)
+        mon.multiplier ? !(m0[j] == 1 && triggered)
                        : m0[j] < 0 || m0[j] > 3 || (m0[j] == 3 && mon.constraint != released);
     if (degenerate)
       lose_all(t, mon.constraint,
                "degenerate mode: the multiplier and the gap's acceleration both vanish (several "
                "mode selections nearby)");
   }
+  co_triggers_.clear();
+}
+
+// A friction monitor starting at zero (order m0 of its first nonzero
+// derivative) at a phase start. Generic: the sliding velocity of the
+// contact whose slip just reversed (m0 = 1), or whose stick force just
+// reached the cone's edge (m0 = 2: the friction force is continuous there,
+// so is the tangential acceleration, zero). At t = 0, a contact starting to
+// slip from rest: only the entries of x0 that move its sliding velocity
+// (w e_c != 0) see another stick / slip sequence on one side. Anything else
+// (a stick force starting at the edge, a sliding velocity with zero
+// acceleration) has several stick / slip selections nearby.
+void Sensitivity::check_friction_start(const Monitor& mon, double t, int m0, int trigger,
+                                       bool stuck) {
+  if (mon.constraint == trigger && (m0 == 1 || (m0 == 2 && stuck))) return;
+  if (t == 0.0 && trigger < 0 && !mon.multiplier && m0 == 1) {
+    std::vector<int> cols;
+    for (int c = 0; c < nx0_; ++c)
+      if (mon.w(c) != 0.0) cols.push_back(c);
+    lose(t, mon.constraint,
+         "slip from rest at the start: the sliding velocity is zero, so only one-sided "
+         "derivatives exist in the entries that move it",
+         cols, true);
+    return;
+  }
+  lose_all(t, mon.constraint,
+           "degenerate stick / slip: a friction monitor starts at zero (the stick force at the "
+           "cone's edge, or a sliding velocity with zero acceleration)");
 }
 
 void Sensitivity::graze(double t, int trigger) {

@@ -75,10 +75,17 @@ class Sensitivity {
   void lose(double t, int contact, const std::string& reason, const std::vector<int>& cols,
             bool always = false);
   void lose_all(double t, int contact, const std::string& reason);
+  void start_on_boundary(const VectorXd& xa);
+  const MatrixXd& at_dense(double t, double tau);
   bool impact_map(double t, const EventResult::ImpactRound& round, MatrixXd& J, MatrixXd& dR);
+  void moving_stop_columns(const std::vector<int>& A, const MatrixXd& EA,
+                           const Eigen::LDLT<MatrixXd>& Wf, const VectorXd& one_e,
+                           MatrixXd& J) const;
   // dAcl/dtheta and dF/dtheta of a mode for each parameter (mechanical).
   void mode_derivatives(const lcs::IndexSet& mode);
   std::string contact_name(int r) const;
+  bool same_event(const Monitor& other, const Monitor& mon) const;
+  void check_friction_start(const Monitor& mon, double t, int m0, int trigger, bool stuck);
 
   const mech::Model& model_;
   const lcs::Lcs& sys_;
@@ -103,6 +110,14 @@ class Sensitivity {
   std::vector<MatrixXd> dF_;   // dF_I/dtheta per parameter (unbalanced)
   lcs::IndexSet mode_;
   std::vector<Monitor> monitors_;  // unbalanced w
+  // A dense phase's exponentials per step length (at_dense).
+  struct DenseBlock {
+    double tau = 0.0;
+    MatrixXd Phi;
+    std::vector<MatrixXd> Psi;  // per parameter
+  };
+  bool dense_ = false;
+  std::vector<DenseBlock> dense_cache_;
   // The cursor: S and the balanced state at tc_.
   double tc_ = 0.0;
   MatrixXd Sc_;
@@ -113,6 +128,10 @@ class Sensitivity {
   RowVectorXd dtau_;
   int released_ = -1;  // the constraint the last event released (-1 if none)
   int trigger_ = -1;   // the constraint whose monitor ended the last phase
+  // Constraints whose monitors are the trigger's up to a positive factor
+  // (same_event): they switch with it.
+  std::vector<int> co_triggers_;
+  bool trigger_stick_ = false;  // the trigger was a stick force reaching the cone's edge
 };
 
 }  // namespace lcsim::sim::detail

@@ -112,6 +112,28 @@ std::string refuse_for_scheme(const detail::SensColumns& c, std::string_view met
   return "";
 }
 
+// Friction: the exact method through planar stick / slip, x0 only (its
+// phases' dAcl/dtheta for a parameter would need the friction's columns);
+// "" or why not.
+std::string refuse_friction(const mech::Model& model, const Options& opt, std::string_view method,
+                            const OptionsUsed& used) {
+  const std::string head =
+      "Options::sensitivity: model '" + model.name + "' has mechanical.friction; ";
+  if (!used.event_search)
+    return head + "method '" + std::string(method) +
+           "' does not compute sensitivities through stick / slip (method 'event' does, x0 only)";
+  const mech::MechanicalModel& m = *model.mechanical;
+  for (size_t f = 0; f < m.friction.size(); ++f)
+    if (m.friction[f].is_3d())
+      return head + "mechanical.friction[" + std::to_string(f) +
+             "] is a 3-D contact (tangent2): sensitivities through 3-D friction are not computed";
+  for (const std::string& s : opt.sensitivity)
+    if (s != "x0")
+      return "Options::sensitivity '" + s + "': not computed with friction (model '" + model.name +
+             "' has mechanical.friction; through planar stick / slip only x0 is)";
+  return "";
+}
+
 }  // namespace
 
 std::string check_sensitivity(const mech::Model& model, const Options& opt, std::string_view method,
@@ -121,12 +143,15 @@ std::string check_sensitivity(const mech::Model& model, const Options& opt, std:
     return "method '" + std::string(method) +
            "' does not compute Options::sensitivity (the methods 'event', 'euler' and "
            "'moreau-jean' do)";
-  if (model.is_mechanical() && model.mechanical->has_friction())
-    return "Options::sensitivity: model '" + model.name +
-           "' has mechanical.friction; sensitivities through stick / slip are not computed";
+  const bool friction = model.is_mechanical() && model.mechanical->has_friction();
+  if (friction) {
+    if (const std::string why = refuse_friction(model, opt, method, used); !why.empty()) return why;
+  }
   const std::string law = used.impact ? impact::make_impact_law(opt.impact)->name() : "";
-  if (used.impact && model.is_mechanical() && law != "moreau-restitution" && law != "newton" &&
-      law != "inelastic")
+  // With friction the law is a friction law: its impacts are reported
+  // absent (sensitivity.cpp), so any law is taken.
+  if (!friction && used.impact && model.is_mechanical() && law != "moreau-restitution" &&
+      law != "newton" && law != "inelastic")
     return "Options::sensitivity: impact law '" + opt.impact +
            "' has no derivative computed (moreau-restitution, newton and inelastic are linear "
            "at a fixed active set)";

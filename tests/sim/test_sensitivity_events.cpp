@@ -1,0 +1,369 @@
+// Forward sensitivities of the exact method through the events added by
+// issue 28's second round (docs/sensitivities.md): scheduled events of a
+// model's inputs (robots/pwl_lift.yaml, robots/shaker_table.yaml) and a
+// general LCS's mode changes without a jump (circuits/*.cir).
+//
+// Every derivative is compared with central differences of the exact method
+// itself, at the end state and at every event time: D(h) = (x(T; theta + h)
+// - x(T; theta - h)) / 2h with the step h = 1e-4 max(1, |theta|) per entry
+// (1e-4 of the entry's scale: the truncation c h^2 is then ~1e-8 relative,
+// far above the run's rounding). The tolerance is tests/sim/
+// test_sensitivity.cpp's: 4 |D(h) - D(h/2)| (Richardson's estimate of
+// D(h/2)'s truncation with a margin of 12) plus 64e-13 max(1, |x|) / h (the
+// run's rounding, ~1e-13 of the state, over the step, with a margin of 32).
+// Every perturbed run must have the run's events (else the difference would
+// straddle one).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <iostream>
+#include <lcsim/scene/scene.hpp>
+#include <lcsim/sim/sim.hpp>
+#include <string>
+#include <vector>
+
+namespace lcsim {
+namespace {
+
+using Eigen::VectorXd;
+
+mech::Model load(const std::string& path) {
+  return scene::load_model(std::string(LCSIM_SOURCE_DIR) + "/" + path);
+}
+
+sim::Trajectory run(const mech::Model& m, const VectorXd& x0, double T,
+                    std::vector<std::string> sens = {}) {
+  sim::Options opt;
+  opt.t_end = T;
+  opt.sensitivity = std::move(sens);
+  return sim::simulate(m, x0, opt, "event");
+}
+
+struct Perturbation {
+  std::string column;
+  double theta;  // the entry's value (the step is 1e-4 max(1, |theta|))
+  std::function<void(mech::Model&, VectorXd&, double)> apply;
+};
+
+Perturbation force(int i, double f) {
+  return {"f[" + std::to_string(i) + "]", f,
+          [i](mech::Model& m, VectorXd&, double d) { m.mechanical->f(i) += d; }};
+}
+Perturbation gap(int c, const std::string& name, double g) {
+  return {"g[" + name + "]", g,
+          [c](mech::Model& m, VectorXd&, double d) { m.mechanical->g(c) += d; }};
+}
+
+// The run's end state and event times: x(T) then t_1, t_2, ...
+VectorXd outcome(const sim::Trajectory& tr) {
+  VectorXd out(tr.final_state.size() + static_cast<Eigen::Index>(tr.events.size()));
+  out.head(tr.final_state.size()) = tr.final_state;
+  for (size_t k = 0; k < tr.events.size(); ++k)
+    out(tr.final_state.size() + static_cast<Eigen::Index>(k)) = tr.events[k].t;
+  return out;
+}
+
+// Compares every column (x0 entries when `x0`, then `ps`) against central
+// differences at T; returns the number of entries compared.
+int expect_matches_fd(const mech::Model& m, const VectorXd& x0, double T,
+                      const std::vector<Perturbation>& ps, bool x0_columns,
+                      const std::string& absent = "") {
+  std::vector<Perturbation> all;
+  if (x0_columns)
+    for (int i = 0; i < x0.size(); ++i)
+      all.push_back({"x0[" + std::to_string(i) + "]", x0(i),
+                     [i](mech::Model&, VectorXd& x, double d) { x(i) += d; }});
+  all.insert(all.end(), ps.begin(), ps.end());
+  std::vector<std::string> names;
+  if (x0_columns) names.push_back("x0");
+  for (const auto& p : ps) names.push_back(p.column);
+  const sim::Trajectory tr = run(m, x0, T, names);
+  EXPECT_TRUE(tr.ok()) << tr.message;
+  if (!tr.ok()) return 0;
+  // A loss only where `absent` says (the run's words), and none otherwise.
+  for (const auto& l : tr.sensitivity_losses)
+    if (absent.empty() || l.reason.find(absent) == std::string::npos)
+      ADD_FAILURE() << "t = " << l.t << " '" << l.contact << "': " << l.reason;
+  const VectorXd base = outcome(tr);
+  const double xs = std::max(1.0, base.cwiseAbs().maxCoeff());
+  const Eigen::Index n = tr.final_state.size();
+  int compared = 0;
+  for (size_t c = 0; c < all.size(); ++c) {
+    auto fd = [&](double h) {
+      VectorXd out[2];
+      for (int s = 0; s < 2; ++s) {
+        mech::Model mm = m;
+        VectorXd xx = x0;
+        all[c].apply(mm, xx, s == 0 ? h : -h);
+        const sim::Trajectory t2 = run(mm, xx, T);
+        EXPECT_TRUE(t2.ok()) << t2.message;
+        EXPECT_EQ(t2.events.size(), tr.events.size()) << all[c].column << ": events differ";
+        if (t2.events.size() != tr.events.size()) return VectorXd(VectorXd::Zero(base.size()));
+        out[s] = outcome(t2);
+      }
+      return VectorXd((out[0] - out[1]) / (2 * h));
+    };
+    if (!tr.dx_final_exists[c]) {  // absent (a loss above): no number
+      EXPECT_EQ(tr.dx_final.col(static_cast<Eigen::Index>(c)).cwiseAbs().maxCoeff(), 0.0);
+      continue;
+    }
+    const double h = 1e-4 * std::max(1.0, std::abs(all[c].theta));
+    const VectorXd d1 = fd(h), d2 = fd(h / 2);
+    EXPECT_EQ(tr.sensitivity_columns[c], all[c].column);
+    const auto col = static_cast<Eigen::Index>(c);
+    for (Eigen::Index i = 0; i < d2.size(); ++i) {
+      const double tol = 4 * std::abs(d1(i) - d2(i)) + 64e-13 * xs / h;
+      if (i < n) {
+        EXPECT_NEAR(tr.dx_final(i, col), d2(i), tol) << "dx[" << i << "]/d" << all[c].column;
+      } else {
+        const sim::Event& e = tr.events[static_cast<size_t>(i - n)];
+        EXPECT_TRUE(e.dt_exists[c]);
+        EXPECT_NEAR(e.dt(col), d2(i), tol)
+            << "dt of event " << i - n << " (" << sim::to_string(e.type) << " at " << e.t << ")/d"
+            << all[c].column;
+      }
+      ++compared;
+    }
+  }
+  return compared;
+}
+
+int count_type(const sim::Trajectory& tr, sim::EventType type) {
+  int k = 0;
+  for (const auto& e : tr.events) k += e.type == type;
+  return k;
+}
+
+// The block lifted by a ramp (robots/pwl_lift.yaml). From the file's start
+// (on the floor) to T = 2.5 s: the release at 0.654 s (the floor's force
+// reaching zero under the ramp: dt/df[0] = -1/30 s/N), the scheduled events
+// at 1 s (the ramp's end) and 1.5 s (the force's jump to zero), the fall and
+// the first impact at 2.466 s; x0 is absent there (a zero gap at the start:
+// one-sided derivatives only) while f[0] is compared. From a raised start
+// (0.5 m, 2 m/s up) to T = 2.45 s: the block stays in flight through both
+// scheduled events and hits the floor twice (2.150 s, 2.401 s) before its
+// bounces accumulate (2.508 s, where the derivative is not computed).
+TEST(SensitivityEvents, PwlLiftThroughScheduledEvents) {
+  const mech::Model m = load("robots/pwl_lift.yaml");
+  const sim::Trajectory plain = run(m, m.initial, 2.5);
+  ASSERT_TRUE(plain.ok()) << plain.message;
+  EXPECT_EQ(count_type(plain, sim::EventType::kSchedule), 2);
+  EXPECT_EQ(count_type(plain, sim::EventType::kRelease), 1);
+  EXPECT_EQ(count_type(plain, sim::EventType::kImpact), 1);
+  // x(T) (2 entries) and 4 event times for f[0] (g[floor] is absent with x0).
+  EXPECT_EQ(expect_matches_fd(m, m.initial, 2.5, {force(0, -19.62), gap(0, "floor", 0.0)}, true,
+                              "zero gap at the start"),
+            6);
+  VectorXd x0(2);
+  x0 << 0.5, 2.0;
+  const sim::Trajectory raised = run(m, x0, 2.45);
+  ASSERT_TRUE(raised.ok()) << raised.message;
+  EXPECT_EQ(count_type(raised, sim::EventType::kSchedule), 2);
+  EXPECT_EQ(count_type(raised, sim::EventType::kImpact), 2);
+  // 4 columns, each x(T) and 4 event times.
+  EXPECT_EQ(expect_matches_fd(m, x0, 2.45, {force(0, -19.62), gap(0, "floor", 0.0)}, true), 24);
+}
+
+// The ball on the shaker table (robots/shaker_table.yaml): impacts on a
+// moving stop (the law on the velocity relative to the table, so the
+// post-impact velocity depends on the table's state: the saltation's
+// J_vw x'- term), to T = 1.5 s: three impacts (0.230, 0.772, 1.365 s).
+TEST(SensitivityEvents, ShakerTableThroughMovingStopImpacts) {
+  const mech::Model m = load("robots/shaker_table.yaml");
+  const double T = 1.5;
+  const sim::Trajectory plain = run(m, m.initial, T);
+  ASSERT_TRUE(plain.ok()) << plain.message;
+  ASSERT_EQ(count_type(plain, sim::EventType::kImpact), 3);
+  const int n = expect_matches_fd(m, m.initial, T, {force(0, -9.81), gap(0, "table", 0.0)}, true);
+  EXPECT_EQ(n, 4 * (2 + static_cast<int>(plain.events.size())));
+  std::cout << "shaker table: " << plain.events.size() << " events, " << n << " entries\n";
+}
+
+// The circuits: general LCSs whose diode events move no state (the
+// feedthrough of a diode in series with a resistor, or the bridge's rows,
+// leave x continuous), so the saltation is the vector fields' jump alone.
+// The half-wave RLC (one diode) to T = 1 ms: 3 events; the diode bridge
+// (four diodes switching at once at each zero of V(a)) to 1 ms: 3 events,
+// each one event of four constraints whose monitors are the same function
+// of x up to positive factors (docs/sensitivities.md); the half-wave
+// rectifier to 30 ms and the diode clamp to 1.5 ms (sine sources: the
+// exosystem's states are columns x0 too): 4 events each. The rectifier's
+// own start is on its diode's switching surface (V(out) = V(in) = 0, no
+// feedthrough: only one-sided derivatives, reported below), so it starts
+// here with C1 at 1 V (blocking until the source reaches 1 V).
+TEST(SensitivityEvents, CircuitsAgainstFiniteDifferences) {
+  struct File {
+    const char* name;
+    double T, v0;  // v0: the first state's start (NaN: the file's)
+  };
+  const double file = std::nan("");
+  for (const File& f : {File{"circuits/half_wave_rlc.cir", 1e-3, file},
+                        File{"circuits/diode_bridge.cir", 1e-3, file},
+                        File{"circuits/half_wave_rectifier.cir", 3e-2, 1.0},
+                        File{"circuits/diode_clamp.cir", 1.5e-3, file}}) {
+    const char* name = f.name;
+    const mech::Model m = load(name);
+    const double T = f.T;
+    VectorXd x0 = m.initial;
+    if (!std::isnan(f.v0)) x0(0) = f.v0;
+    const sim::Trajectory plain = run(m, x0, T);
+    ASSERT_TRUE(plain.ok()) << plain.message;
+    const int n = static_cast<int>(x0.size());
+    EXPECT_EQ(expect_matches_fd(m, x0, T, {}, true),
+              n * (n + static_cast<int>(plain.events.size())))
+        << name;
+    std::cout << name << ": " << plain.events.size() << " events\n";
+  }
+}
+
+// The closed form: with I(L1) = 0 at the start and no source, both circuits
+// are homogeneous (x(t; s x0) = s x(t; x0) for s > 0: the LCS is linear and
+// its complementarity a cone), so the state is proportional to the initial
+// capacitor voltage V0 and the diode events do not move with it:
+// dx(T)/dV0 = x(T) / V0 and dt_k/dV0 = 0 at every event (t1 =
+// atan(wd/alpha)/wd, then every pi/w0 or pi/wd). Tolerance: 1e-12 of the
+// state's size (the run and its derivative are each good to ~1e-13 of it,
+// tests/circuit's closed forms; a margin of 10), and for the event times
+// 1e-12 T / V0 (a time derivative of a size T / V0 would shift the events
+// by T for a change of V0 of V0).
+TEST(SensitivityEvents, CircuitsClosedFormInInitialVoltage) {
+  for (const char* name : {"circuits/half_wave_rlc.cir", "circuits/diode_bridge.cir"}) {
+    const mech::Model m = load(name);
+    const double T = 5e-3, V0 = m.initial(0);
+    ASSERT_EQ(V0, 10.0);
+    ASSERT_EQ(m.initial(1), 0.0);
+    const sim::Trajectory tr = run(m, m.initial, T, {"x0"});
+    ASSERT_TRUE(tr.ok()) << tr.message;
+    EXPECT_TRUE(tr.sensitivity_losses.empty()) << name;
+    ASSERT_GE(tr.events.size(), 15u) << name;
+    const double xs = tr.final_state.head(2).cwiseAbs().maxCoeff();
+    for (int i = 0; i < 2; ++i)
+      EXPECT_NEAR(tr.dx_final(i, 0), tr.final_state(i) / V0, 1e-12 * xs / V0) << name << " " << i;
+    double worst = 0.0;
+    for (const sim::Event& e : tr.events) {
+      ASSERT_TRUE(e.dt_exists[0]);
+      worst = std::max(worst, std::abs(e.dt(0)));
+      EXPECT_NEAR(e.dt(0), 0.0, 1e-12 * T / V0) << name << " event at " << e.t;
+    }
+    std::cout << name << ": dx/dV0 - x/V0 = "
+              << (tr.dx_final.col(0).head(2) - tr.final_state.head(2) / V0).cwiseAbs().maxCoeff()
+              << ", max |dt_k/dV0| = " << worst << " s/V over " << tr.events.size() << " events\n";
+  }
+}
+
+// A general LCS started on a switching surface of a row without
+// feedthrough (the rectifier's file start: V(out) = V(in) = 0): x0 is
+// absent, the loss names the row; a start off it has no loss.
+TEST(SensitivityEvents, LcsStartOnSwitchingSurfaceHasNoDerivative) {
+  const mech::Model m = load("circuits/half_wave_rectifier.cir");
+  const sim::Trajectory tr = run(m, m.initial, 1e-2, {"x0"});
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  ASSERT_EQ(tr.sensitivity_losses.size(), 1u);
+  EXPECT_EQ(tr.sensitivity_losses[0].t, 0.0);
+  EXPECT_EQ(tr.sensitivity_losses[0].contact, "y0");
+  EXPECT_NE(tr.sensitivity_losses[0].reason.find("switching surface"), std::string::npos);
+  for (char e : tr.dx_final_exists) EXPECT_FALSE(e);
+  EXPECT_EQ(tr.dx_final.cwiseAbs().maxCoeff(), 0.0);
+  VectorXd x0 = m.initial;
+  x0(0) = 1.0;
+  EXPECT_TRUE(run(m, x0, 1e-2, {"x0"}).sensitivity_losses.empty());
+}
+
+// Planar friction (x0 only): the stick / slip events of the files, to their
+// own horizons. Each starts on its floor (a zero gap: the entries that move
+// the gap or its rate, y0 and vy0, are absent), and the mass on a spring
+// starts to slip from rest (vx0, which moves its sliding velocity, is
+// absent: one side of it reverses first); the other entries are compared,
+// at x(T) and every event time. Block: one stick (slip -> stick at
+// v0/(mu g)); spring: slip reversal at pi/2 and stick at pi; incline: one
+// stick; belt: stick at 0.21 s, slip at 1.33 s (the stick force reaching the
+// cone's edge, where the sliding velocity starts with zero acceleration).
+TEST(SensitivityEvents, PlanarFrictionAgainstFiniteDifferences) {
+  struct File {
+    const char* name;
+    int columns;  // entries of x0 with a derivative
+  };
+  for (const File& f :
+       {File{"robots/block_on_floor_friction.yaml", 2}, File{"robots/mass_spring_friction.yaml", 1},
+        File{"robots/incline_friction.yaml", 2}, File{"robots/belt_friction.yaml", 2}}) {
+    const mech::Model m = load(f.name);
+    const double T = m.t_end;
+    const sim::Trajectory plain = run(m, m.initial, T);
+    ASSERT_TRUE(plain.ok()) << plain.message;
+    ASSERT_GE(plain.events.size(), 1u) << f.name;
+    const int n = static_cast<int>(m.initial.size());
+    EXPECT_EQ(expect_matches_fd(m, m.initial, T, {}, true, "at the start"),
+              f.columns * (n + static_cast<int>(plain.events.size())))
+        << f.name;
+    std::cout << f.name << ": " << plain.events.size() << " events\n";
+  }
+}
+
+// The block sliding to rest on the floor (robots/block_on_floor_friction.yaml:
+// v0 = 2 m/s, mu = 0.4, g = 9.81): it stops at t* = v0/(mu g) after
+// v0^2/(2 mu g), so dt*/dv0 = 1/(mu g), and at T = 1 > t*: dx/dx0 = 1,
+// dx/dv0 = v0/(mu g), dv/d(x0, v0) = 0; before the stop (T = 0.3 s):
+// x = x0 + v0 T - mu g T^2/2, dx/dv0 = T, dv/dv0 = 1. Tolerance 1e-13 of the
+// entries' size 1 (the run is good to ~1e-15 here: one phase per
+// exponential of a nilpotent matrix; margin 100).
+TEST(SensitivityEvents, BlockSlidingToRestClosedForm) {
+  const mech::Model m = load("robots/block_on_floor_friction.yaml");
+  const double v0 = m.initial(2), mu = 0.4, g = 9.81;
+  ASSERT_EQ(v0, 2.0);
+  ASSERT_EQ(m.mechanical->friction[0].mu, mu);
+  const sim::Trajectory tr = run(m, m.initial, 1.0, {"x0"});
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  ASSERT_EQ(tr.events.size(), 1u);
+  EXPECT_NEAR(tr.events[0].t, v0 / (mu * g), 1e-13);
+  EXPECT_NEAR(tr.final_state(0), v0 * v0 / (2 * mu * g), 1e-13);
+  ASSERT_TRUE(tr.events[0].dt_exists[2]);
+  EXPECT_NEAR(tr.events[0].dt(2), 1 / (mu * g), 1e-13);
+  EXPECT_NEAR(tr.events[0].dt(0), 0.0, 1e-13);
+  EXPECT_NEAR(tr.dx_final(0, 0), 1.0, 1e-13);
+  EXPECT_NEAR(tr.dx_final(0, 2), v0 / (mu * g), 1e-13);
+  EXPECT_NEAR(tr.dx_final(2, 0), 0.0, 1e-13);
+  EXPECT_NEAR(tr.dx_final(2, 2), 0.0, 1e-13);
+  const double Ts = 0.3;
+  const sim::Trajectory early = run(m, m.initial, Ts, {"x0"});
+  ASSERT_TRUE(early.ok()) << early.message;
+  EXPECT_NEAR(early.dx_final(0, 2), Ts, 1e-13);
+  EXPECT_NEAR(early.dx_final(2, 2), 1.0, 1e-13);
+  EXPECT_NEAR(early.dx_final(0, 0), 1.0, 1e-13);
+}
+
+// What stays refused with friction: a parameter, another method, 3-D.
+TEST(SensitivityEvents, FrictionRefusals) {
+  const mech::Model m = load("robots/block_on_floor_friction.yaml");
+  sim::Options opt;
+  opt.t_end = 0.1;
+  opt.sensitivity = {"x0", "f[1]"};
+  sim::Trajectory tr = sim::simulate(m, m.initial, opt, "event");
+  EXPECT_EQ(tr.status, Status::kInvalidInput);
+  EXPECT_NE(tr.message.find("'f[1]': not computed with friction"), std::string::npos) << tr.message;
+  opt.sensitivity = {"x0"};
+  tr = sim::simulate(m, m.initial, opt, "moreau-jean");
+  EXPECT_EQ(tr.status, Status::kInvalidInput);
+  EXPECT_NE(tr.message.find("stick / slip"), std::string::npos) << tr.message;
+  mech::Model m3 = m;
+  m3.mechanical->friction[0].tangent2 = Eigen::SparseVector<double>(2);
+  m3.mechanical->friction[0].tangent2.insert(1) = 1.0;
+  tr = sim::simulate(m3, m3.initial, opt, "event");
+  EXPECT_EQ(tr.status, Status::kInvalidInput);
+}
+
+// Methods other than the exact one refuse sensitivities with inputs.
+TEST(SensitivityEvents, SchemesRefuseInputs) {
+  const mech::Model m = load("robots/pwl_lift.yaml");
+  sim::Options opt;
+  opt.t_end = 0.1;
+  opt.sensitivity = {"x0"};
+  for (const char* method : {"euler", "moreau-jean"}) {
+    const sim::Trajectory tr = sim::simulate(m, m.initial, opt, method);
+    EXPECT_EQ(tr.status, Status::kInvalidInput) << method;
+    EXPECT_NE(tr.message.find("method 'event'"), std::string::npos) << tr.message;
+  }
+}
+
+}  // namespace
+}  // namespace lcsim
