@@ -4,7 +4,9 @@
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <lcsim/circuit/circuit.hpp>
+#include <lcsim/io/yaml.hpp>
 
 namespace lcsim::circuit {
 
@@ -48,18 +50,59 @@ void tokenize(const std::string& text, std::vector<std::string>& out) {
   flush();
 }
 
-}  // namespace
+// The file named by an `.include` line's body (after the keyword at
+// `first`): the rest of the line, trimmed, without quotes.
+std::string include_name(const std::string& body, std::size_t first) {
+  std::size_t i = first;
+  while (i < body.size() && !blank(body[i])) ++i;  // the keyword
+  std::string name = body.substr(i);
+  while (!name.empty() && blank(name.front())) name.erase(name.begin());
+  while (!name.empty() && blank(name.back())) name.pop_back();
+  if (name.size() >= 2 && (name.front() == '"' || name.front() == '\'') &&
+      name.back() == name.front())
+    name = name.substr(1, name.size() - 2);
+  return name;
+}
 
-Lines split_lines(const std::string& text, const std::string& source) {
-  Lines r;
+constexpr int kMaxIncludeDepth = 16;
+
+void append_lines(const std::string& text, const std::string& source, const std::string& file,
+                  int depth, Lines& r);
+
+// `.include name` at line `number` of `source` (its own file, `file`): the
+// named file's lines, appended.
+void include(const std::string& name, const std::string& source, const std::string& file,
+             int number, int depth, Lines& r) {
+  const std::string here = (file.empty() ? source : file) + ":" + std::to_string(number);
+  if (name.empty()) throw InputError(here + ": .include: expected a file name");
+  if (depth >= kMaxIncludeDepth)
+    throw InputError(here + ": .include nested more than " + std::to_string(kMaxIncludeDepth) +
+                     " deep (a file that includes itself?)");
+  const std::filesystem::path base =
+      std::filesystem::path(file.empty() ? source : file).parent_path();
+  const std::filesystem::path path = base / name;  // an absolute name replaces base
+  std::string text;
+  try {
+    text = io::read_file(path);
+  } catch (const InputError& e) {
+    throw InputError(here + ": .include: " + e.what());
+  }
+  append_lines(text, source, path.string(), depth + 1, r);
+}
+
+// The logical lines of one file: the netlist (file empty; its first line the
+// title) or an included one.
+void append_lines(const std::string& text, const std::string& source, const std::string& file,
+                  int depth, Lines& r) {
   std::size_t pos = 0;
   int number = 0;
+  const std::string& where = file.empty() ? source : file;
   while (pos <= text.size()) {
     const std::size_t end = std::min(text.find('\n', pos), text.size());
     std::string line = text.substr(pos, end - pos);
     pos = end + 1;
     ++number;
-    if (number == 1) {  // SPICE: the first line is the title, whatever it holds
+    if (number == 1 && file.empty()) {  // SPICE: the first line is the title, whatever it holds
       while (!line.empty() && (line.back() == '\r' || blank(line.back()))) line.pop_back();
       r.title = line;
       continue;
@@ -70,16 +113,31 @@ Lines split_lines(const std::string& text, const std::string& source) {
     const std::string body = strip_comment(line);
     if (line[first] == '+') {
       if (r.lines.empty())
-        throw InputError(source + ":" + std::to_string(number) +
+        throw InputError(where + ":" + std::to_string(number) +
                          ": a continuation line ('+') with no line before it to continue");
       tokenize(body.substr(first + 1), r.lines.back().tokens);
       continue;
     }
     Line l;
     l.number = number;
+    l.file = file;
     tokenize(body, l.tokens);
-    if (!l.tokens.empty()) r.lines.push_back(std::move(l));
+    if (l.tokens.empty()) continue;
+    const std::string key = lower(l.tokens[0]);
+    if (key == ".include" || key == ".inc") {
+      include(include_name(body, first), source, file, number, depth, r);
+      continue;
+    }
+    if (key == ".end" && !file.empty()) return;  // ends the included file only
+    r.lines.push_back(std::move(l));
   }
+}
+
+}  // namespace
+
+Lines split_lines(const std::string& text, const std::string& source) {
+  Lines r;
+  append_lines(text, source, "", 0, r);
   return r;
 }
 

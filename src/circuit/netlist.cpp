@@ -19,6 +19,14 @@ struct DiodeModel {
   double von = 0.0, ron = 0.0;
 };
 
+// A PULSE's arguments as written (NaN where omitted), turned into a
+// mech::Input once .tran gives tstep and tstop (its defaults: read_pulse).
+struct PendingPulse {
+  std::size_t element = 0;
+  std::string where;
+  double v[7];
+};
+
 struct Subckt {
   std::string name;
   std::vector<std::string> ports;
@@ -35,8 +43,11 @@ struct Reader {
   std::vector<std::string> diode_model_of;  // per element (lower-case), for diodes
   std::vector<Line> top;
   std::set<std::string> element_names;  // lower-case
+  std::vector<PendingPulse> pulses;
 
-  std::string where(const Line& l) const { return source + ":" + std::to_string(l.number); }
+  std::string where(const Line& l) const {
+    return (l.file.empty() ? source : l.file) + ":" + std::to_string(l.number);
+  }
   [[noreturn]] void fail(const Line& l, const std::string& what) const {
     throw InputError(where(l) + ": " + what);
   }
@@ -91,12 +102,27 @@ void read_sine(const Reader& r, const Line& l, const std::string& name,
                " values)");
   double v[6] = {0.0, 0.0, std::nan(""), 0.0, 0.0, 0.0};
   for (std::size_t j = 0; j < args.size(); ++j) v[j] = r.number(l, name, args[j]);
-  if (v[3] != 0.0)
-    r.fail(l, name,
-           "SIN with a delay TD (got " + format_number(v[3]) +
-               " s) is not yet supported: its start needs a scheduled event; give TD = 0");
   if (!std::isnan(v[2]) && !(v[2] > 0.0))
     r.fail(l, name, "SIN frequency must be > 0 (got " + format_number(v[2]) + " Hz)");
+  if (v[3] < 0.0) r.fail(l, name, "SIN delay TD must be >= 0 (got " + format_number(v[3]) + " s)");
+  if (v[3] > 0.0 && v[5] != 0.0)
+    r.fail(l, name,
+           "SIN with both a delay TD and a PHASE is not yet supported (SPICE holds VO + VA "
+           "sin(PHASE) before TD, lcsim's delayed sine VO); give TD = 0 or PHASE = 0");
+  if (v[3] > 0.0) {  // a mech::Input: VO until TD, then the (damped) sine from TD
+    mech::Input in;
+    in.name = name;
+    in.kind = "sine";
+    in.sine = true;
+    in.offset = v[0];
+    in.amplitude = v[1];
+    in.frequency = v[2];  // NaN: 1 / tstop, filled in once .tran is read
+    in.damping = v[4];
+    in.origin = v[3];
+    w.input = in;
+    w.sine = false;
+    return;
+  }
   w.sine = true;
   w.dc = v[0];
   w.amplitude = v[1];
@@ -105,30 +131,48 @@ void read_sine(const Reader& r, const Line& l, const std::string& name,
   w.phase_deg = v[5];
 }
 
-// PULSE and PWL need scheduled events (not yet in the exact method): a PWL
-// is still checked first, so that decreasing times are named as such.
-[[noreturn]] void refuse_scheduled(const Reader& r, const Line& l, const std::string& name,
-                                   const std::string& kind, const std::vector<std::string>& args) {
-  if (kind == "pwl") {
-    if (args.size() % 2 != 0)
-      r.fail(l, name,
-             "PWL takes pairs of time and value (got " + std::to_string(args.size()) + " values)");
-    for (std::size_t j = 2; j < args.size(); j += 2) {
-      const double t0 = r.number(l, name, args[j - 2]), t1 = r.number(l, name, args[j]);
-      if (t1 < t0)
-        r.fail(
-            l, name,
-            "PWL times decrease (" + format_number(t1) + " s after " + format_number(t0) + " s)");
-    }
+// PWL(T1 V1 T2 V2 ...): V1 before T1, linear between the points, the last
+// value after the last; two points at one time are a jump.
+mech::Input read_pwl(const Reader& r, const Line& l, const std::string& name,
+                     const std::vector<std::string>& args) {
+  if (args.empty() || args.size() % 2 != 0)
+    r.fail(l, name,
+           "PWL takes pairs of time and value (got " + std::to_string(args.size()) + " values)");
+  mech::Input in;
+  in.name = name;
+  in.kind = "pwl";
+  for (std::size_t j = 0; j < args.size(); j += 2) {
+    in.times.push_back(r.number(l, name, args[j]));
+    in.values.push_back(r.number(l, name, args[j + 1]));
   }
-  for (const auto& a : args) (void)r.number(l, name, a);
-  r.fail(l, name,
-         (kind == "pwl" ? std::string("PWL") : std::string("PULSE")) +
-             " sources are not yet supported: their breakpoints need scheduled events");
+  if (std::string what = mech::check_input(in); !what.empty()) r.fail(l, name, "PWL " + what);
+  return in;
+}
+
+// PULSE(V1 V2 [TD [TR [TF [PW [PER]]]]]): its arguments, checked; the
+// mech::Input is made once .tran is read (make_pulse).
+void read_pulse(Reader& r, const Line& l, const std::string& name,
+                const std::vector<std::string>& args) {
+  if (args.size() < 2 || args.size() > 7)
+    r.fail(l, name,
+           "PULSE takes V1 V2 [TD [TR [TF [PW [PER]]]]] (got " + std::to_string(args.size()) +
+               " values)");
+  PendingPulse p;
+  p.element = r.net.elements.size();
+  p.where = r.where(l);
+  static const char* const kNames[7] = {"V1", "V2", "TD", "TR", "TF", "PW", "PER"};
+  for (std::size_t j = 0; j < 7; ++j) {
+    p.v[j] = j < args.size() ? r.number(l, name, args[j]) : std::nan("");
+    if (j >= 2 && p.v[j] < 0.0)
+      r.fail(l, name,
+             std::string("PULSE ") + kNames[j] + " must be >= 0 (got " + format_number(p.v[j]) +
+                 " s)");
+  }
+  r.pulses.push_back(p);
 }
 
 // V and I: [DC] value, SIN(...), AC ... (ignored: no AC analysis).
-Waveform read_source(const Reader& r, const Line& l, const std::string& name, std::size_t i) {
+Waveform read_source(Reader& r, const Line& l, const std::string& name, std::size_t i) {
   Waveform w;
   bool have_dc = false;
   const auto& t = l.tokens;
@@ -138,7 +182,7 @@ Waveform read_source(const Reader& r, const Line& l, const std::string& name, st
       ++i;
       if (i < t.size() && t[i] == "=") ++i;
       if (i >= t.size()) r.fail(l, name, "DC without a value");
-      if (!w.sine) w.dc = r.number(l, name, t[i]);
+      if (!w.sine && !w.input) w.dc = r.number(l, name, t[i]);
       have_dc = true;
       ++i;
     } else if (k == "ac") {
@@ -147,12 +191,20 @@ Waveform read_source(const Reader& r, const Line& l, const std::string& name, st
     } else if (k == "sin" || k == "sine") {
       ++i;
       read_sine(r, l, name, arguments(l, i), w);
-    } else if (k == "pulse" || k == "pwl") {
+    } else if (k == "pwl") {
       ++i;
-      refuse_scheduled(r, l, name, k, arguments(l, i));
+      w.input = read_pwl(r, l, name, arguments(l, i));
+      w.sine = false;
+    } else if (k == "pulse") {
+      ++i;
+      read_pulse(r, l, name, arguments(l, i));
+      w.input = mech::Input{};  // made by make_pulse once .tran is read
+      w.sine = false;
     } else if (k == "exp" || k == "sffm" || k == "am" || k == "trnoise" || k == "trrandom") {
-      r.fail(l, name, "the source function " + t[i] + " is not supported (lcsim reads DC and SIN)");
-    } else if (!have_dc && !w.sine) {
+      r.fail(
+          l, name,
+          "the source function " + t[i] + " is not supported (lcsim reads DC, SIN, PULSE and PWL)");
+    } else if (!have_dc && !w.sine && !w.input) {
       w.dc = r.number(l, name, t[i]);
       have_dc = true;
       ++i;
@@ -160,6 +212,7 @@ Waveform read_source(const Reader& r, const Line& l, const std::string& name, st
       r.fail(l, name, "unexpected '" + t[i] + "'");
     }
   }
+  if (w.input) w.dc = 0.0;  // a time function wins over DC in the transient, as SIN does
   return w;
 }
 
@@ -177,7 +230,7 @@ std::string usage(char type) {
       return "name anode cathode model";
     case 'v':
     case 'i':
-      return "name n+ n- [DC] value | SIN(VO VA FREQ TD THETA PHASE)";
+      return "name n+ n- [DC] value | SIN(VO VA FREQ TD THETA PHASE) | PULSE(...) | PWL(...)";
     default:
       return "name n+ n- value";
   }
@@ -451,6 +504,43 @@ void first_pass(Reader& r, const std::vector<Line>& lines) {
   if (open) throw InputError(r.source + ": .subckt " + open->name + " has no .ends");
 }
 
+// A PULSE as SPICE (ngspice) reads it: TD 0, and TR, TF (tstep), PW and PER
+// (tstop) taking their defaults when omitted or 0. One period's points from
+// TD, cut at PER when the pulse is longer (its value there is its value at
+// PER, and the next period starts at V1), repeated every PER.
+mech::Input make_pulse(const Reader& r, const PendingPulse& p, const std::string& name) {
+  const auto defaulted = [](double x) { return std::isnan(x) || x == 0.0; };
+  if (!r.net.tran &&
+      (defaulted(p.v[3]) || defaulted(p.v[4]) || defaulted(p.v[5]) || defaulted(p.v[6])))
+    throw InputError(p.where + ": " + name +
+                     ": PULSE without TR, TF, PW or PER (or 0) takes tstep or tstop, and there "
+                     "is no .tran");
+  const auto value = [&](int j, double fallback) { return defaulted(p.v[j]) ? fallback : p.v[j]; };
+  const double tr = value(3, r.net.tstep), tf = value(4, r.net.tstep);
+  const double pw = value(5, r.net.tstop), per = value(6, r.net.tstop);
+  mech::Input in;
+  in.name = name;
+  in.kind = "pulse";
+  in.origin = std::isnan(p.v[2]) ? 0.0 : p.v[2];
+  in.period = per;
+  const double t[4] = {0.0, tr, tr + pw, tr + pw + tf};
+  const double v[4] = {p.v[0], p.v[1], p.v[1], p.v[0]};
+  for (int j = 0; j < 4; ++j) {
+    if (t[j] <= per) {
+      in.times.push_back(t[j]);
+      in.values.push_back(v[j]);
+      continue;
+    }
+    const double a = (per - t[j - 1]) / (t[j] - t[j - 1]);  // t[j - 1] <= per < t[j]
+    in.times.push_back(per);
+    in.values.push_back(v[j - 1] + a * (v[j] - v[j - 1]));
+    break;
+  }
+  if (std::string what = mech::check_input(in); !what.empty())
+    throw InputError(p.where + ": " + name + ": PULSE " + what);
+  return in;
+}
+
 // Diodes get their model's parameters, F and H their controlling source.
 void resolve(Reader& r) {
   for (std::size_t i = 0; i < r.net.elements.size(); ++i) {
@@ -476,7 +566,15 @@ void resolve(Reader& r) {
                          ": SIN without FREQ takes 1/tstop, and there is no .tran");
       e.wave.frequency = 1.0 / r.net.tstop;
     }
+    if (e.wave.input && e.wave.input->sine && std::isnan(e.wave.input->frequency)) {
+      if (!r.net.tran)
+        throw InputError(e.where + ": " + e.name +
+                         ": SIN without FREQ takes 1/tstop, and there is no .tran");
+      e.wave.input->frequency = 1.0 / r.net.tstop;
+    }
   }
+  for (const PendingPulse& p : r.pulses)
+    r.net.elements[p.element].wave.input = make_pulse(r, p, r.net.elements[p.element].name);
 }
 
 }  // namespace

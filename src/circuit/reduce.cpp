@@ -58,6 +58,13 @@ Layout lay_out(const Netlist& net, const std::vector<DiodeForm>& forms) {
       L.exo[i] = L.nw;
       L.nw += 2;
     }
+  // Then the sources with breakpoints (PULSE, PWL, delayed SIN), last: the
+  // mech::Model::inputs, whose exosystems end the state.
+  for (std::size_t i = 0; i < ne; ++i)
+    if (const auto& in = net.elements[i].wave.input) {
+      L.exo[i] = L.nw;
+      L.nw += in->exo_size();
+    }
   return L;
 }
 
@@ -90,6 +97,7 @@ RowVector source_row(const Element& e, const Layout& L, int exo) {
   RowVector r = RowVector::Zero(L.n() + L.k);
   r(L.nc) = e.wave.dc;  // the constant state "1"
   if (e.wave.sine) r(L.nc + exo) = e.wave.amplitude;
+  if (e.wave.input) r.segment(L.nc + exo, e.wave.input->exo_size()) = e.wave.input->exo_output();
   return r;
 }
 
@@ -219,6 +227,10 @@ lcs::Lcs assemble(const Netlist& net, const Layout& L, const Quantities& q,
       const double w = 2.0 * std::numbers::pi * e.wave.frequency, th = e.wave.damping;
       AB(s, s) = -th, AB(s, s + 1) = w, AB(s + 1, s) = -w, AB(s + 1, s + 1) = -th;
     }
+    if (const auto& in = e.wave.input) {  // its own exosystem (mech::Input)
+      const int s = L.nc + L.exo[i], z = in->exo_size();
+      AB.block(s, s, z, z) = in->exo_matrix();
+    }
     if (e.kind == ElementKind::kDiode) {
       const int p = L.pair[i];
       if (forms[p] == DiodeForm::kCurrent) {  // y = von + ron u - v
@@ -256,7 +268,16 @@ void name_and_output(Circuit& c, const Layout& L, const Quantities& q) {
       m.state_names[L.state[i]] = e.name + (e.kind == ElementKind::kCapacitor ? ".v" : ".i");
       c.state_element.push_back(static_cast<int>(i));
     }
-    if (L.exo[i] >= 0) {
+    if (const auto& in = e.wave.input) {  // value and slope, or offset and sine
+      const int s = L.nc + L.exo[i];
+      const std::vector<std::string> parts = in->sine
+                                                 ? std::vector<std::string>{".o", ".sin", ".cos"}
+                                                 : std::vector<std::string>{".p", ".r"};
+      for (std::size_t j = 0; j < parts.size(); ++j)
+        m.state_names[s + static_cast<int>(j)] = e.name + parts[j];
+      m.exo_initial.segment(L.exo[i], in->exo_size()) = in->exo_state(0.0);
+      m.inputs.push_back(*in);
+    } else if (L.exo[i] >= 0) {
       m.state_names[L.nc + L.exo[i]] = e.name + ".sin";
       m.state_names[L.nc + L.exo[i] + 1] = e.name + ".cos";
       const double phi = e.wave.phase_deg * std::numbers::pi / 180.0;

@@ -342,14 +342,39 @@ std::optional<ModelProblem> check_lcs(const lcs::Lcs& s) {
 }
 
 namespace {
+// An `lcs:` model's inputs (Model::inputs): each usable, their exosystems the
+// last states of the exosystem block, each block S and initial state its own.
+std::optional<ModelProblem> check_lcs_inputs(const Model& model) {
+  const int n = model.lcs->n(), e = model.exo_states;
+  int at = e;
+  for (const Input& in : model.inputs) at -= in.exo_size();
+  if (at < 0)
+    return ModelProblem{
+        "lcs.inputs", text("their exosystems need more states than the ", e, " of the exosystem")};
+  for (std::size_t i = 0; i < model.inputs.size(); ++i) {
+    const Input& in = model.inputs[i];
+    const std::string field = text("lcs.inputs[", i, "]");
+    if (std::string what = check_input(in); !what.empty())
+      return ModelProblem{field, "input '" + in.name + "': " + what};
+    const int s = in.exo_size(), row = n - e + at;
+    if (!(model.lcs->A.block(row, row, s, s) - in.exo_matrix()).isZero(0.0) ||
+        !(model.exo_initial.segment(at, s) - in.exo_state(0.0)).isZero(0.0))
+      return ModelProblem{
+          field, "input '" + in.name + "': its exosystem block and initial state are not its own"};
+    at += s;
+  }
+  return std::nullopt;
+}
+
 // The names, exosystem and outputs of an `lcs:` model (all empty for any
 // other): sizes that agree, finite entries, an exosystem driven by itself.
 std::optional<ModelProblem> check_lcs_labels(const Model& model) {
   const bool labelled = !model.state_names.empty() || !model.pair_names.empty() ||
-                        model.exo_states != 0 || !model.output_names.empty();
+                        model.exo_states != 0 || !model.output_names.empty() ||
+                        !model.inputs.empty();
   if (!labelled) return std::nullopt;
   if (!model.lcs)
-    return ModelProblem{"model", "state names, exosystem and outputs are for LCS models"};
+    return ModelProblem{"model", "state names, exosystem, inputs and outputs are for LCS models"};
   const int n = model.lcs->n(), k = model.lcs->k(), e = model.exo_states;
   const auto size_problem = [](const char* field, std::size_t want, std::size_t got) {
     return ModelProblem{
@@ -368,6 +393,7 @@ std::optional<ModelProblem> check_lcs_labels(const Model& model) {
     return ModelProblem{"lcs.exosystem", "its states must be driven by themselves only"};
   if (auto at = non_finite_vector(model.exo_initial))
     return ModelProblem{"lcs.exosystem" + *at, "not finite"};
+  if (auto p = check_lcs_inputs(model)) return p;
   const auto m = static_cast<Eigen::Index>(model.output_names.size());
   if (model.output_x.rows() != m || model.output_u.rows() != m ||
       (m > 0 && (model.output_x.cols() != n || model.output_u.cols() != k)))

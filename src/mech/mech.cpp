@@ -67,21 +67,29 @@ void add_inputs(const MechanicalModel& m, const Eigen::LLT<MatrixXd>& llt, lcs::
 }
 }  // namespace
 
-VectorXd exosystem_states(const MechanicalModel& m, double t) {
-  VectorXd w(exosystem_size(m));
+VectorXd exosystem_states(const std::vector<Input>& inputs, double t) {
+  int size = 0;
+  for (const Input& in : inputs) size += in.exo_size();
+  VectorXd w(size);
   int at = 0;
-  for (const Input& in : m.inputs) {
+  for (const Input& in : inputs) {
     w.segment(at, in.exo_size()) = in.exo_state(t);
     at += in.exo_size();
   }
   return w;
 }
 
-double next_breakpoint(const MechanicalModel& m, double t) {
+double next_breakpoint(const std::vector<Input>& inputs, double t) {
   double next = std::numeric_limits<double>::infinity();
-  for (const Input& in : m.inputs) next = std::min(next, in.next_breakpoint(t));
+  for (const Input& in : inputs) next = std::min(next, in.next_breakpoint(t));
   return next;
 }
+
+VectorXd exosystem_states(const MechanicalModel& m, double t) {
+  return exosystem_states(m.inputs, t);
+}
+
+double next_breakpoint(const MechanicalModel& m, double t) { return next_breakpoint(m.inputs, t); }
 
 VectorXd force_at(const MechanicalModel& m, double t) {
   VectorXd f = m.f;
@@ -203,6 +211,10 @@ int Model::state_size() const {
   if (mechanical) return 2 * mechanical->dofs();
   if (lcs) return lcs->n();
   return 0;
+}
+
+const std::vector<Input>& Model::scheduled_inputs() const {
+  return mechanical ? mechanical->inputs : inputs;
 }
 
 VectorXd Model::full_state(const VectorXd& x) const {

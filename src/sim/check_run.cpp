@@ -188,6 +188,20 @@ std::string refuse_friction_law(const mech::Model& model, const Options& opt,
 // sensitivities with inputs.
 std::string refuse_inputs(const mech::Model& model, const Options& opt, std::string_view method,
                           const OptionsUsed& used) {
+  // An `lcs:` model's inputs (a circuit's PULSE, PWL or delayed SIN sources):
+  // their exosystems are re-initialised at the breakpoints by the exact
+  // method's scheduled events; the time-stepping methods would integrate the
+  // exosystem across a breakpoint, so they refuse.
+  if (!model.is_mechanical() && !model.inputs.empty()) {
+    if (!used.inputs || !used.event_search)
+      return text("method '", method, "' does not simulate inputs with breakpoints (model '",
+                  model.name, "' has ", model.inputs.size(),
+                  ": PULSE, PWL or delayed SIN sources); method 'event' does");
+    if (!opt.sensitivity.empty())
+      return text("model '", model.name,
+                  "' has inputs: sensitivities are not computed with inputs");
+    return "";
+  }
   if (!model.is_mechanical() || !model.mechanical->has_inputs()) return "";
   const mech::MechanicalModel& m = *model.mechanical;
   if (!used.inputs)

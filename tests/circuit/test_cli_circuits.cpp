@@ -43,6 +43,33 @@ TEST(CliCircuits, RefusedNetlistExitsTwoAndWritesNothing) {
   std::filesystem::remove(cir);
 }
 
+// Sources with breakpoints: a PULSE with a negative width is refused (exit 2,
+// one line, nothing written); a PWL circuit runs with the exact method (its
+// breakpoints as `schedule` events, the PWL's states as CSV columns) and is
+// refused by backward Euler (exit 2, nothing written).
+TEST(CliCircuits, SourcesWithBreakpoints) {
+  const auto cir = private_temp("src", ".cir"), csv = private_temp("src", ".csv"),
+             err = private_temp("src", ".err");
+  { std::ofstream(cir) << "t\nV1 a 0 PULSE(0 1 0 1u 1u -1m 2m)\nR1 a 0 1k\n.tran 1u 1m\n"; }
+  auto r = run_lcsim("simulate '" + cir.string() + "' --out '" + csv.string() + "'", err);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err,
+            "lcsim: error: " + cir.string() + ":2: V1: PULSE PW must be >= 0 (got -0.001 s)\n");
+  EXPECT_FALSE(std::filesystem::exists(csv));
+  { std::ofstream(cir) << "t\nV1 a 0 PWL(0 0 1m 1)\nR1 a b 1k\nC1 b 0 1u\n.tran 1u 2m uic\n"; }
+  r = run_lcsim("simulate '" + cir.string() + "' --dt-out 1e-4 --out '" + csv.string() + "'", err);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string text = slurp(csv);
+  EXPECT_EQ(text.substr(0, text.find('\n')), "t,C1.v,1,V1.p,V1.r,V(a),V(b),I(V1),I(R1),I(C1),mode");
+  EXPECT_NE(r.out.find("schedule"), std::string::npos) << r.out;
+  std::filesystem::remove(csv);
+  r = run_lcsim("simulate '" + cir.string() + "' --method euler --out '" + csv.string() + "'", err);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("does not simulate inputs with breakpoints"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(csv));
+  std::filesystem::remove(cir);
+}
+
 TEST(CliCircuits, AnalyzeSaysPassiveAndWellPosed) {
   const auto err = private_temp("an", ".err");
   const auto r = run_lcsim("analyze " + kCircuits + "half_wave_rectifier.cir --json", err);

@@ -99,11 +99,10 @@ TEST(Netlist, RefusesBadInputOnOneLineNamingLineAndElement) {
        "bad.cir:4: R2: floating node 'b': no path to ground (node 0) through any element"},
       {"t\nV1 a 0 PWL(0 0 2m 1 1m 2)\nR1 a 0 1k\n",
        "bad.cir:2: V1: PWL times decrease (0.001 s after 0.002 s)"},
-      {"t\nV1 a 0 PWL(0 0 1m 1)\nR1 a 0 1k\n",
-       "bad.cir:2: V1: PWL sources are not yet supported: their breakpoints need scheduled events"},
-      {"t\nV1 a 0 PULSE(0 1 0 1n 1n 1m 2m)\nR1 a 0 1k\n",
-       "bad.cir:2: V1: PULSE sources are not yet supported: their breakpoints need scheduled "
-       "events"},
+      // PWL and PULSE are read (test_sources.cpp); their bad values are refused.
+      {"t\nV1 a 0 PWL(0 0 1m x)\nR1 a 0 1k\n", "bad.cir:2: V1: non-numeric value 'x'"},
+      {"t\nV1 a 0 PULSE(0 1 0 -1n 1n 1m 2m)\nR1 a 0 1k\n",
+       "bad.cir:2: V1: PULSE TR must be >= 0 (got -1e-09 s)"},
       {"t\nV1 a 0 1\nS1 a 0 c 0 sw\nR1 a 0 1k\n",
        "bad.cir:3: S1: switches are not yet supported: their state changes need scheduled events"},
       {"t\nV1 a 0 1\nD1 a 0 nomodel\n", "bad.cir:3: D1: no .model 'nomodel'"},
@@ -116,9 +115,8 @@ TEST(Netlist, RefusesBadInputOnOneLineNamingLineAndElement) {
        "bad.cir:3: X1: missing node: sub has 2 ports (got 1 nodes)"},
       {"t\n+ R1 a 0 1\n",
        "bad.cir:2: a continuation line ('+') with no line before it to continue"},
-      {"t\nV1 a 0 SIN(0 1 1k 1m)\nR1 a 0 1k\n",
-       "bad.cir:2: V1: SIN with a delay TD (got 0.001 s) is not yet supported: its start needs a "
-       "scheduled event; give TD = 0"},
+      {"t\nV1 a 0 SIN(0 1 1k -1m)\nR1 a 0 1k\n",
+       "bad.cir:2: V1: SIN delay TD must be >= 0 (got -0.001 s)"},
       {"t\nV1 a 0 1\nR1 a 0 0\n", "bad.cir:3: R1: zero resistance (got 0)"},
   };
   for (const auto& c : cases) {

@@ -3,7 +3,8 @@
 # issue): for each shipped model and scene in robots/, `simulate --json` (less
 # wall_time_s), the CSV of `simulate --out`, `analyze` (text, --json, --json --full; less timings),
 # for each method that accepts the model, and `impacts --json` at the model's
-# initial state where it is mechanical.
+# initial state where it is mechanical; for each shipped circuit in
+# circuits/, `analyze` and `simulate` (JSON and CSV) with each method.
 #
 #   tests/house/snapshot_outputs.sh LCSIM_BINARY OUT_DIR     # one snapshot
 #   diff -r OUT_BEFORE OUT_AFTER                             # compare two
@@ -54,6 +55,19 @@ for model in robots/*.yaml; do
     run "$m.$method.json" "$bin" simulate "$model" --method "$method" --json --no-progress
     run "$m.$method.txt" "$bin" simulate "$model" --method "$method" --out "$out/$m.$method.csv" \
       --no-progress
+  done
+done
+# The shipped circuits (SPICE netlists, docs/circuits.md): analyze, and each
+# time-stepping method beside the exact one (a method that refuses a
+# netlist's inputs is recorded with its message).
+for netlist in circuits/*.cir; do
+  c=$(basename "$netlist" .cir)
+  run "$c.cir.analyze.json" "$bin" analyze "$netlist" --json
+  run "$c.cir.analyze.txt" "$bin" analyze "$netlist"
+  for method in event euler moreau-jean; do
+    run "$c.cir.$method.json" "$bin" simulate "$netlist" --method "$method" --json --no-progress
+    run "$c.cir.$method.txt" "$bin" simulate "$netlist" --method "$method" \
+      --out "$out/$c.cir.$method.csv" --no-progress
   done
 done
 echo "snapshot_outputs: $(ls "$out" | wc -l) files in $out"

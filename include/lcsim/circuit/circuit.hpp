@@ -33,8 +33,8 @@ enum class ElementKind {
   kResistor,       // R: value in ohm
   kCapacitor,      // C: value in F
   kInductor,       // L: value in H
-  kVoltageSource,  // V: DC or SIN
-  kCurrentSource,  // I: DC or SIN (flows from n+ through the source to n-)
+  kVoltageSource,  // V: DC, SIN, PULSE or PWL
+  kCurrentSource,  // I: as V (flows from n+ through the source to n-)
   kVcvs,           // E: v(n+, n-) = value * v(nc+, nc-)
   kCccs,           // F: i = value * I(control)
   kVccs,           // G: i = value * v(nc+, nc-)
@@ -49,6 +49,10 @@ struct Waveform {
   bool sine = false;
   double dc = 0.0;  // the constant (sine = false) or VO
   double amplitude = 0.0, frequency = 0.0, damping = 0.0, phase_deg = 0.0;
+  // PULSE, PWL and SIN with TD > 0: the signal as a mech::Input (V or A), its
+  // exosystem at the tail of the state and its breakpoints the exact
+  // method's scheduled events (mech::Model::inputs); unset otherwise.
+  std::optional<mech::Input> input;
 };
 
 struct Element {

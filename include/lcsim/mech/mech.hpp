@@ -125,6 +125,11 @@ lcs::Lcs to_lcs(const MechanicalModel& m);
 VectorXd exosystem_states(const MechanicalModel& m, double t);
 // The first breakpoint of any input after t (strictly); +inf if none.
 double next_breakpoint(const MechanicalModel& m, double t);
+// The same for a list of inputs (a mechanical model's, or an `lcs:` model's
+// Model::inputs): their exosystems' states at t, input by input, and their
+// first breakpoint after t.
+VectorXd exosystem_states(const std::vector<Input>& inputs, double t);
+double next_breakpoint(const std::vector<Input>& inputs, double t);
 // f(t) and g(t) with the inputs' values at t (the time-stepping methods).
 VectorXd force_at(const MechanicalModel& m, double t);
 VectorXd gap_at(const MechanicalModel& m, double t);
@@ -186,6 +191,15 @@ struct Model {
   VectorXd exo_initial;
   std::vector<std::string> output_names;
   MatrixXd output_x, output_u;
+  // - inputs with breakpoints (a circuit's PULSE, PWL and delayed SIN
+  //   sources; docs/inputs.md): their exosystems are the last states of the
+  //   exosystem block, input by input (Input::exo_size() each, the tail of
+  //   exo_initial their states at t = 0); the exact method re-initialises
+  //   them at each breakpoint (a scheduled event), as a mechanical model's.
+  std::vector<Input> inputs;
+  // The inputs whose breakpoints are scheduled events: mechanical->inputs
+  // for a mechanical model, else `inputs`.
+  const std::vector<Input>& scheduled_inputs() const;
   // The full state from `x`: `x` itself when of size state_size(), `x`
   // followed by exo_initial when of size state_size() - exo_states (> 0).
   VectorXd full_state(const VectorXd& x) const;

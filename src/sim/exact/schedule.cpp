@@ -14,10 +14,13 @@
 
 namespace lcsim::sim::detail {
 
+// A mechanical model's inputs, or an `lcs:` model's (a circuit's PULSE and
+// PWL sources, mech::Model::inputs): either way their exosystems are the last
+// states of the LCS, so one mechanism serves both.
 double EventDriven::next_scheduled(double t) const {
-  if (!model_.is_mechanical() || !model_.mechanical->has_inputs())
-    return std::numeric_limits<double>::infinity();
-  return mech::next_breakpoint(*model_.mechanical, t);
+  const std::vector<mech::Input>& inputs = model_.scheduled_inputs();
+  if (inputs.empty()) return std::numeric_limits<double>::infinity();
+  return mech::next_breakpoint(inputs, t);
 }
 
 // The event at the breakpoint t_b that ended the phase pm: the state there,
@@ -26,19 +29,19 @@ double EventDriven::next_scheduled(double t) const {
 // finitely many in any interval, and need no guard against accumulating.
 bool EventDriven::take_scheduled(RunState& r, PhaseMarch& pm, double t_b) {
   Trajectory& tr = r.tr;
-  const mech::MechanicalModel& m = *model_.mechanical;
+  const std::vector<mech::Input>& inputs = model_.scheduled_inputs();
   const VectorXd x_minus = pm.state_at(t_b);
   const bool keep = static_cast<long>(tr.events.size()) < opt_.max_recorded_events;
   if (keep) record(tr, t_b, x_minus, r.phase);
   std::string names;
-  for (const mech::Input& in : m.inputs)
+  for (const mech::Input& in : inputs)
     if (in.next_breakpoint(pm.t0) == t_b) names += (names.empty() ? "'" : ", '") + in.name + "'";
   r.t = t_b;
   // Sensitivities: a fixed time (dt_b/dtheta = 0), q and v continuous, w a
   // function of t alone (docs/sensitivities.md).
   if (sens_) sens_->before_event(t_b, x_minus, -1);
   VectorXd x_b = x_minus;
-  const VectorXd w = mech::exosystem_states(m, t_b);
+  const VectorXd w = mech::exosystem_states(inputs, t_b);
   x_b.tail(w.size()) = w;
   // pm refers to r.phase, which reinitialise replaces: not used below.
   EventResult ev;
