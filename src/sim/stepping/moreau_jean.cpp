@@ -104,9 +104,14 @@ FrictionMode friction_mode_after_step(const mech::FrictionalContact& fc, const V
   if (fc.is_3d()) {
     const double s2 = fc.tangent2.dot(v);
     scale += fc.tangent2.cwiseAbs().dot(v.cwiseAbs());
-    return std::hypot(s, s2) <= 1e-12 * scale + std::numeric_limits<double>::min()
-               ? FrictionMode::kStick
-               : FrictionMode::kSlip;
+    // hypot(s, s2) lies in [max, sqrt(2) max] of |s|, |s2| (and its
+    // rounding keeps it there, within 1.5 max): decided without it outside
+    // that band, the same answer with a tenth of the cost per contact.
+    const double bound = 1e-12 * scale + std::numeric_limits<double>::min();
+    const double top = std::max(std::abs(s), std::abs(s2));
+    if (top > bound) return FrictionMode::kSlip;
+    if (1.5 * top <= bound) return FrictionMode::kStick;
+    return std::hypot(s, s2) <= bound ? FrictionMode::kStick : FrictionMode::kSlip;
   }
   if (std::abs(s) <= 1e-12 * scale + std::numeric_limits<double>::min())
     return FrictionMode::kStick;
