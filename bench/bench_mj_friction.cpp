@@ -22,14 +22,14 @@
 // |A| + 2 |F| = 3 n with friction) and the peak resident memory of a
 // process that builds one of the models and runs it (KiB; peak_kib below;
 // sliding runs only).
-// Times: the fastest of the iterations (manual time: each iteration's
-// friction step).
+// Times: process CPU time (cpu_seconds), the fastest of the iterations (manual time: each
+// iteration's friction step).
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <lcsim/sim/sim.hpp>
 #include <string>
@@ -78,6 +78,15 @@ lcsim::mech::Model planar_chain(int n, bool friction, double vx) {
   return model;
 }
 
+// The process's CPU time (s), not the wall clock: at load 7-9 the
+// wall-clock difference T_S - T_1 carried other processes' time slices
+// (a 10^4 row read plain_us = 0), as in bench_mj_friction3d.cpp.
+double cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
 struct Timed {
   double seconds = 0.0;
   lcsim::sim::Trajectory tr;
@@ -91,9 +100,9 @@ Timed run(const lcsim::mech::Model& model, long steps) {
   opt.record_samples = false;
   const auto mj = lcsim::sim::make_integrator("moreau-jean");
   Timed t;
-  const auto t0 = std::chrono::steady_clock::now();
+  const double t0 = cpu_seconds();
   t.tr = mj->run(model, model.initial, opt);
-  t.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  t.seconds = cpu_seconds() - t0;
   return t;
 }
 

@@ -51,6 +51,7 @@ bool MjFriction::assemble(MjIteration& f, const IndexSet& A,
   ++version_;
   na_ = static_cast<long>(A.size());
   fric_.clear();
+  contact_.clear();
   normal_of_.clear();
   tangent_of_.assign(A.size(), -1);
   for (long a = 0; a < na_; ++a)
@@ -58,6 +59,7 @@ bool MjFriction::assemble(MjIteration& f, const IndexSet& A,
       tangent_of_[static_cast<size_t>(a)] = static_cast<int>(na_ + fric_.size());
       normal_of_.push_back(static_cast<int>(a));
       fric_.push_back(fi);
+      contact_.push_back(A[a]);
     }
   nf_ = static_cast<long>(fric_.size());
   const long ng = na_ + (cone_ ? 2 : 1) * nf_;
@@ -90,7 +92,32 @@ bool MjFriction::assemble(MjIteration& f, const IndexSet& A,
   Wg_.resize(ng, ng);
   Wg_.setFromTriplets(trip_.begin(), trip_.end());  // sums the entries
   Wg_.makeCompressed();
+  pack_columns();
   return true;
+}
+
+// gpacked_ = [W^{-1} G_0', W^{-1} G_1', ...]: the cached columns copied into
+// one compressed matrix, so that the step's update of v walks three arrays
+// rather than a heap object per column (a fifth of the sparse 3-D step, by
+// perf, at 10^4 contacts). Same entries in the same order.
+void MjFriction::pack_columns() {
+  const Eigen::Index ng = static_cast<Eigen::Index>(gcols_.size());
+  Eigen::Index nnz = 0;
+  for (const SparseCol* c : gcols_) nnz += c->nonZeros();
+  gpacked_.resize(m_.dofs(), ng);
+  gpacked_.resizeNonZeros(nnz);
+  int* outer = gpacked_.outerIndexPtr();
+  int* inner = gpacked_.innerIndexPtr();
+  double* value = gpacked_.valuePtr();
+  int at = 0;
+  for (Eigen::Index g = 0; g < ng; ++g) {
+    outer[g] = at;
+    for (SparseCol::InnerIterator it(*gcols_[static_cast<size_t>(g)], 0); it; ++it, ++at) {
+      inner[at] = static_cast<int>(it.row());
+      value[at] = it.value();
+    }
+  }
+  outer[ng] = at;
 }
 
 // The dense friction LCP (the impact law's): first the previous step's basis
@@ -257,14 +284,13 @@ bool MjFriction::solve_cone_sparse(long& solves, lcp::Result& failed) {
       &Wg_, &b_, &tangent_of_, &mu_, &d_, static_cast<int>(na_), static_cast<int>(nf_)};
   facet_.resize(static_cast<size_t>(nf_));
   for (long j = 0; j < nf_; ++j)
-    facet_[static_cast<size_t>(j)] = facet_prev_[static_cast<size_t>(
-        m_.friction[static_cast<size_t>(fric_[static_cast<size_t>(j)])].contact)];
+    facet_[static_cast<size_t>(j)] =
+        facet_prev_[static_cast<size_t>(contact_[static_cast<size_t>(j)])];
   const ConeGsResult r = solve_cone_gs(p, kGsTolerance, kGsMaxSweeps, lam_, facet_, u_);
   ++solves;
   if (r.status == lcp::Status::kSolved && all_finite(lam_)) {
     for (long j = 0; j < nf_; ++j)
-      facet_prev_[static_cast<size_t>(
-          m_.friction[static_cast<size_t>(fric_[static_cast<size_t>(j)])].contact)] =
+      facet_prev_[static_cast<size_t>(contact_[static_cast<size_t>(j)])] =
           facet_[static_cast<size_t>(j)];
     return true;
   }
@@ -325,31 +351,28 @@ bool MjFriction::step(MjIteration& f, const IndexSet& A, const std::vector<const
     b_(na_ + nf_ + j) = row_times(t2_col_ + fric_[static_cast<size_t>(j)]);
   lam_.resize(ng);
   lam_.head(na_) = lambda_N;
-  for (long j = 0; j < nf_; ++j)
-    lam_(na_ + j) =
-        lamT_prev_(m_.friction[static_cast<size_t>(fric_[static_cast<size_t>(j)])].contact);
+  for (long j = 0; j < nf_; ++j) lam_(na_ + j) = lamT_prev_(contact_[static_cast<size_t>(j)]);
   for (long j = 0; cone_ && j < nf_; ++j)  // the sparse cone path's warm start
-    lam_(na_ + nf_ + j) =
-        lamT2_(m_.friction[static_cast<size_t>(fric_[static_cast<size_t>(j)])].contact);
+    lam_(na_ + nf_ + j) = lamT2_(contact_[static_cast<size_t>(j)]);
   const bool ok = cone_                    ? solve_cone(solver, solves, failed)
                   : ng <= pivot_max_active ? solve_dense(Wd_, solver, solves, failed)
                                            : solve_sparse(solver, solves, failed, warning);
   if (!ok) return false;
+  const int* outer = gpacked_.outerIndexPtr();
+  const int* inner = gpacked_.innerIndexPtr();
+  const double* value = gpacked_.valuePtr();
   for (long g = 0; g < ng; ++g)
     if (const double x = lam_(g); x != 0.0)
-      for (SparseCol::InnerIterator it(*gcols_[static_cast<size_t>(g)], 0); it; ++it)
-        v_next(it.row()) += it.value() * x;
+      for (int at = outer[g]; at < outer[g + 1]; ++at) v_next(inner[at]) += value[at] * x;
   lambda_N = lam_.head(na_);
   lamT_prev_.setZero();
   for (long j = 0; j < nf_; ++j) {
-    const int c = m_.friction[static_cast<size_t>(fric_[static_cast<size_t>(j)])].contact;
+    const int c = contact_[static_cast<size_t>(j)];
     lambda_T(c) = lamT_prev_(c) = lam_(na_ + j);
   }
   if (cone_) {
     lamT2_.setZero();
-    for (long j = 0; j < nf_; ++j)
-      lamT2_(m_.friction[static_cast<size_t>(fric_[static_cast<size_t>(j)])].contact) =
-          lam_(na_ + nf_ + j);
+    for (long j = 0; j < nf_; ++j) lamT2_(contact_[static_cast<size_t>(j)]) = lam_(na_ + nf_ + j);
   }
   return true;
 }

@@ -78,6 +78,7 @@ class MjFriction {
 
  private:
   bool assemble(MjIteration& f, const IndexSet& A, const std::vector<const SparseCol*>& cols);
+  void pack_columns();
   bool solve_dense(const MatrixXd& Wg, const lcp::Solver& solver, long& solves,
                    lcp::Result& failed);
   bool solve_kept(bool cone, const lcp::Solver& solver, long& solves, lcp::Result& failed);
@@ -98,9 +99,11 @@ class MjFriction {
   const MjIteration* f_ = nullptr;
   long na_ = 0, nf_ = 0;
   std::vector<int> fric_;                // F: index into m.friction
+  std::vector<int> contact_;             // F: its constraint (m.friction[fric_[j]].contact)
   std::vector<int> normal_of_;           // F: position of the normal row in A
   std::vector<int> tangent_of_;          // A: position of the tangent row in G, or -1
   std::vector<const SparseCol*> gcols_;  // W^{-1} G_g' per row g of G
+  SparseCol gpacked_;                    // the same columns in one matrix (the impulses' update)
   VectorXd mu_, belt_;
   SparseRow Wg_;  // G W^{-1} G'
   MatrixXd Wd_;   // the same, dense, for |G| <= pivot_max_active
