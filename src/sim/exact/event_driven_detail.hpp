@@ -327,6 +327,13 @@ class EventDriven {
   // zero downwards at the phase start (its first nonzero derivative < 0).
   bool presses_shut(const Phase& ph, const lcs::IndexSet& which, const VectorXd& xa,
                     double t) const;
+  // The constraints of ph.mode whose normal force leaves zero downwards at
+  // the phase start (friction_modes.cpp).
+  lcs::IndexSet lifting_normals(const Phase& ph, const VectorXd& xa, double t) const;
+  // I ∪ K less one constraint of `lifting`, when that phase starts
+  // consistently (friction_modes.cpp): true and out set, else false.
+  bool release_normal(double t, const lcs::ModeSelection& sel, const lcs::IndexSet& lifting,
+                      VectorXd& xa, EventResult& out);
   // True when every monitor of `ph` (normals and friction) starts positive or
   // leaves zero upwards.
   bool all_consistent(const Phase& ph, const VectorXd& xa, double t) const;

@@ -247,17 +247,69 @@ std::string EventDriven::select_friction_and_normals(double t, const lcs::ModeSe
     xa = x1;
     return "";
   }
+  lcs::IndexSet lifting;  // constraints of I whose force leaves zero downwards
   if (why.empty()) {
     std::string err;
     const Phase ph = make_phase(out.mode, out.friction, sel.undetermined, x1, err);
+    if (err.empty()) lifting = lifting_normals(ph, x1, t);
     if (err.empty() && !presses_shut(ph, sel.undetermined, x1, t)) {
-      xa = x1;
-      return "";
+      if (lifting.empty()) {
+        xa = x1;
+        return "";
+      }
     }
   }
   if (try_union()) return "";
+  if (release_normal(t, sel, lifting, xa, out)) {
+    undetermined.clear();
+    return "";
+  }
   xa = x1;
   return why;
+}
+
+// The constraints of ph.mode whose normal force starts at zero and leaves it
+// downwards: a slip's friction (fixed by mu, not seen by the frictionless
+// LDCP) unloads them, so the phase on I would end at once, and the same
+// selection would follow again (the quadruped landing on three independent
+// feet, one of them slipping).
+lcs::IndexSet EventDriven::lifting_normals(const Phase& ph, const VectorXd& xa, double t) const {
+  const MonitorStart st = monitor_start(ph, xa.cwiseQuotient(ph.D), t, 1.0);
+  lcs::IndexSet out;
+  for (size_t j = 0; j < ph.monitors.size(); ++j) {
+    const Monitor& mon = ph.monitors[j];
+    if (mon.friction >= 0 || !mon.multiplier) continue;
+    if (st.m0[j] >= 0 && !(st.d0[j] > 0.0)) out.push_back(mon.constraint);
+  }
+  return out;
+}
+
+// I ∪ K without one constraint of `lifting` (it opens; its gap is then
+// monitored): taken when its normal rows are independent, its friction modes
+// are selected and every monitor of its phase starts consistently. The
+// first such candidate in the order of `lifting`; false when none is.
+bool EventDriven::release_normal(double t, const lcs::ModeSelection& sel,
+                                 const lcs::IndexSet& lifting, VectorXd& xa, EventResult& out) {
+  for (const int j : lifting) {
+    EventResult cand = out;
+    cand.mode.clear();
+    for (const lcs::IndexSet* part : {&sel.mode, &sel.undetermined})
+      for (const int r : *part)
+        if (r != j) cand.mode.push_back(r);
+    std::sort(cand.mode.begin(), cand.mode.end());
+    VectorXd x2 = xa;
+    const bool selected = select_friction(t, {}, x2, cand).empty();
+    out.lcp_solves = cand.lcp_solves;  // counted whether taken or not
+    if (!selected) continue;
+    std::string err;
+    const Phase ph = make_phase(cand.mode, cand.friction, {}, x2, err);
+    if (!err.empty() || redundant_normals(ph) || !all_consistent(ph, x2, t)) continue;
+    out.mode = cand.mode;
+    out.friction = cand.friction;
+    xa = x2;
+    return true;
+  }
+  return false;
 }
 
 bool EventDriven::presses_shut(const Phase& ph, const lcs::IndexSet& which, const VectorXd& xa,
