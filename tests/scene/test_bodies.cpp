@@ -457,11 +457,38 @@ TEST(BodiesRuns, GripperClosesOnTheBoxAtTheClosedFormTimeAndTheBoxStaysOnTheFloo
 // Moreau-Jean on the gripper scene, first order in h against the exact run
 // (the test above): a contact closing at speed v sinks by at most the
 // step's travel h v (the fingers close at 1.6 m/s) and never opens again
-// under the springs; the resting box sinks by 0.0143 h under Moreau-Jean
-// before any impact, alone as well (measured on robots/box.urdf at rest
-// on the floor, h = 2e-3 and 1e-3: 2.86e-5 and 1.43e-5 m), so 0.02 h bounds
-// it; the box's x and y stay 0 by symmetry (1e-12), and it tilts, as it
-// sinks, by a first-order amount (measured at most 0.024 h rad: 0.05 h).
+// under the springs; the box rests on the floor (it sank 0.0143 h before
+// Moreau-Jean's activation test allowed for rounding: the test below) and
+// 0.02 h bounds what the squeeze moves it by; the box's x and y stay 0 by
+// symmetry (1e-12), and it tilts by a first-order amount (measured at most
+// 0.024 h rad: 0.05 h).
+// Moreau-Jean holds a box resting flat on its four corners (robots/box.urdf
+// at z = 0.05 m, its corners' gaps exactly 0): the predicted gaps are zero
+// to rounding every step, and each corner stays in the active set, so the
+// box neither sinks nor tilts. Compared with exactly zero, rounding left two
+// corners at +1e-21 m at the fourth step; they dropped out for one step and
+// the box pivoted on the other two and sank 0.0143 h for good. Positions
+// are O(0.05) m: 1e-15 m is a few ulp.
+TEST_F(BodyScenes, MoreauJeanHoldsABoxRestingOnFourCorners) {
+  std::filesystem::copy_file(kRobots + "box.urdf", dir_ / "box.urdf");
+  const mech::Model model = scene::load_model(write("s.yaml", R"(urdf: box.urdf
+base: {type: floating, pose: {xyz: [0, 0, 0.05]}}
+planes: [{name: floor, normal: [0, 0, 1]}]
+contacts: [{link: box, plane: floor}]
+t_end: 0.5
+)"));
+  for (const double h : {2e-3, 1e-3}) {
+    sim::Options opt;
+    opt.t_end = model.t_end;
+    opt.h = h;
+    const sim::Trajectory tr = sim::make_integrator("moreau-jean")->run(model, model.initial, opt);
+    ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
+    EXPECT_GE(tr.max_violation, -1e-15) << h;
+    EXPECT_NEAR(tr.final_state(2), 0.05, 1e-15) << h;
+    for (int i : {3, 4, 5}) EXPECT_NEAR(tr.final_state(i), 0.0, 1e-15) << h << " " << i;
+  }
+}
+
 TEST(BodiesRuns, MoreauJeanOnTheGripperIsFirstOrder) {
   const mech::Model model = scene::load_model(kRobots + "gripper_box_scene.yaml");
   for (const double h : {1e-3, 5e-4, 2.5e-4}) {

@@ -87,7 +87,14 @@ namespace lcsim::sim::detail {
 
 namespace {
 
-constexpr double kActivationGap = 0.0;  // predicted gap (model units) at or below which i is active
+// A constraint is active when its predicted gap is at or below rounding:
+// kActivationRounding times the magnitude of the terms it is formed from,
+// |E| (|q| + h theta |v|) + |g|. Compared with exactly zero, a box resting on
+// four corners dropped two of them for a step whenever rounding left their
+// predicted gap at +1e-21 m, pivoted on the other two and sank 0.0143 h.
+// 64 eps covers the rounding of a sparse row's sum (as the exact method's
+// monitors' noise band does) and is far below any gap a model means.
+constexpr double kActivationRounding = 64 * std::numeric_limits<double>::epsilon();
 constexpr double kPgsTolerance = 1e-13;  // natural residual <= tol * (1 + ||b||_inf)
 constexpr int kPgsMaxSweeps = 5000;
 constexpr int kPivotFallbackMax = 2000;
@@ -204,6 +211,7 @@ class MjRun {
     v_next_.resize(N_);
     q_next_.resize(N_);
     Ev_.resize(k_);
+    gap_scale_.resize(k_);
     Evf_.resize(k_);
   }
 
@@ -259,14 +267,17 @@ class MjRun {
     v_next_ = v_ + h * dv_;  // v_free
   }
 
-  // Active set: predicted gap E_i (q + h theta v) + g_i <= kActivationGap.
+  // Active set: predicted gap E_i (q + h theta v) + g_i at or below its
+  // rounding (kActivationRounding).
   void select_active(double h) {
     for (int i : A_) pos_[i] = -1;
     A_.clear();
     if (k_ > 0) {
       ops_.E_times(v_, Ev_);
+      qv_abs_ = q_.cwiseAbs() + (h * theta_) * v_.cwiseAbs();
+      ops_.abs_E_times(qv_abs_, gap_scale_);
       for (int i = 0; i < k_; ++i)
-        if (y_(i) + h * theta_ * Ev_(i) <= kActivationGap) {
+        if (y_(i) + h * theta_ * Ev_(i) <= kActivationRounding * gap_scale_(i)) {
           pos_[i] = static_cast<int>(A_.size());
           A_.push_back(i);
         }
@@ -531,8 +542,9 @@ class MjRun {
   long Gd_version_ = 0;
   // v_next_ holds the free velocity v + h W^{-1} rhs until the impulses are added.
   VectorXd rhs_, dv_, v_next_, q_next_, Ev_, Evf_, b_, z_;
-  lcp::Result failed_;                       // the failed LCP
-  std::string failure_;                      // why the run ends
+  VectorXd qv_abs_, gap_scale_;  // select_active: |q| + h theta |v|, and the gaps' scales
+  lcp::Result failed_;           // the failed LCP
+  std::string failure_;          // why the run ends
   std::unique_ptr<MjStepSensitivity> sens_;  // Options::sensitivity asked, else null
 };
 

@@ -58,9 +58,18 @@ inline bool all_finite(const VectorXd& x) {
 class MjOperators {
  public:
   MjOperators(const mech::MechanicalModel& m, bool sparse)
-      : m_(m), sparse_(sparse), Ec_(m.E), Er_(m.E), K_(m.K), D_(m.D), f_(m.f) {
+      : m_(m),
+        sparse_(sparse),
+        Ec_(m.E),
+        Er_(m.E),
+        Er_abs_(m.E.cwiseAbs()),
+        g_abs_(m.g.cwiseAbs()),
+        K_(m.K),
+        D_(m.D),
+        f_(m.f) {
     Ec_.makeCompressed();
     Er_.makeCompressed();
+    Er_abs_.makeCompressed();
     K_.makeCompressed();
     D_.makeCompressed();
     Gt_ = contact_rows_transposed(m);
@@ -108,6 +117,12 @@ class MjOperators {
   }
   // out = E x (out sized k).
   void E_times(const VectorXd& x, VectorXd& out) const { times(Er_, x, out); }
+  // out = |E| x + |g| (x >= 0): the magnitude of the terms a gap is formed
+  // from, for a test that must not read rounding as a sign.
+  void abs_E_times(const VectorXd& x, VectorXd& out) const {
+    times(Er_abs_, x, out);
+    out += g_abs_;
+  }
   // W = M + h theta D + h^2 theta^2 K.
   SparseCol W_sparse(double h, double theta) const {
     SparseCol W = m_.M + (h * theta) * m_.D + (h * h * theta * theta) * m_.K;
@@ -121,8 +136,10 @@ class MjOperators {
  private:
   const mech::MechanicalModel& m_;
   bool sparse_;
-  SparseCol Ec_;         // E by columns: assembles the active Delassus matrix
-  SparseRow Er_;         // E by rows: the gap rates E v
+  SparseCol Ec_;      // E by columns: assembles the active Delassus matrix
+  SparseRow Er_;      // E by rows: the gap rates E v
+  SparseRow Er_abs_;  // |E| by rows, and |g|: the gaps' scales (abs_E_times)
+  VectorXd g_abs_;
   SparseCol K_, D_;      // compressed copies for add_times
   SparseCol Gt_;         // [E; T]': normal and tangent rows as columns
   mutable VectorXd f_;   // the step's force: f, or f(t) with inputs (set_step)
