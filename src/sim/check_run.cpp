@@ -197,9 +197,6 @@ std::string refuse_inputs(const mech::Model& model, const Options& opt, std::str
       return text("method '", method, "' does not simulate inputs with breakpoints (model '",
                   model.name, "' has ", model.inputs.size(),
                   ": PULSE, PWL or delayed SIN sources); method 'event' does");
-    if (!opt.sensitivity.empty())
-      return text("model '", model.name,
-                  "' has inputs: sensitivities are not computed with inputs");
     return "";
   }
   if (!model.is_mechanical() || !model.mechanical->has_inputs()) return "";

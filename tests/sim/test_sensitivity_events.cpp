@@ -14,8 +14,11 @@
 // Every perturbed run must have the run's events (else the difference would
 // straddle one).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <iostream>
 #include <lcsim/scene/scene.hpp>
@@ -215,6 +218,32 @@ TEST(SensitivityEvents, CircuitsAgainstFiniteDifferences) {
         << name;
     std::cout << name << ": " << plain.events.size() << " events\n";
   }
+}
+
+// A circuit with a PULSE source (an `lcs:` model with inputs): a 1000 V/s
+// ramp charging C1 (from 0.1 V) through R1 and D1 from 0.1 ms, the
+// breakpoints at 1, 2 and 3 ms scheduled events, D1 releasing at 2.197 ms on
+// the fall. The PULSE's exosystem (V1.p, V1.r) is re-set to a function of t
+// at each breakpoint, so its rows of dx/dx0 are zero from the first one on;
+// every column, the exosystem's initial state included (it moves the
+// contact until the reset), against central differences.
+TEST(SensitivityEvents, CircuitWithPulseSourceThroughScheduledEvents) {
+  const std::filesystem::path p = std::filesystem::temp_directory_path() /
+                                  ("lcsim_pulse_" + std::to_string(::getpid()) + ".cir");
+  std::ofstream(p) << "PULSE into an RC through a diode\nV1 in 0 PULSE(0 1 0 1m 1m 1m 4m)\n"
+                      "R1 in a 1k\nD1 a out ideal\nC1 out 0 1u\n.model ideal D\n"
+                      ".ic V(out)=0.1\n.tran 10u 3.5m uic\n";
+  const mech::Model m = scene::load_model(p.string());
+  std::filesystem::remove(p);
+  const double T = 3.5e-3;
+  const sim::Trajectory tr = run(m, m.initial, T, {"x0"});
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  EXPECT_EQ(count_type(tr, sim::EventType::kSchedule), 3);
+  const int n = static_cast<int>(m.initial.size());  // C1.v, 1, V1.p, V1.r
+  ASSERT_EQ(n, 4);
+  EXPECT_EQ(tr.dx_final.bottomRows(2).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(expect_matches_fd(m, m.initial, T, {}, true),
+            n * (n + static_cast<int>(tr.events.size())));
 }
 
 // The closed form: with I(L1) = 0 at the start and no source, both circuits

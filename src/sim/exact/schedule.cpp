@@ -39,10 +39,13 @@ bool EventDriven::take_scheduled(RunState& r, PhaseMarch& pm, double t_b) {
   r.t = t_b;
   // Sensitivities: a fixed time (dt_b/dtheta = 0), q and v continuous, w a
   // function of t alone (docs/sensitivities.md).
-  if (sens_) sens_->before_event(t_b, x_minus, -1);
   VectorXd x_b = x_minus;
   const VectorXd w = mech::exosystem_states(inputs, t_b);
   x_b.tail(w.size()) = w;
+  if (sens_) {
+    sens_->before_event(t_b, x_minus, -1);
+    sens_->reset_exosystem(static_cast<int>(w.size()));
+  }
   // pm refers to r.phase, which reinitialise replaces: not used below.
   EventResult ev;
   const lcs::IndexSet old_mode = r.phase.mode;

@@ -64,6 +64,10 @@ class Sensitivity {
                          const lcs::IndexSet& undetermined);
   // An event that changed no mode (a graze).
   void graze(double t, int trigger);
+  // Between before_event and after_event of a scheduled event: the last
+  // `rows` states (the inputs' exosystems) are re-set to functions of t
+  // alone, so their derivative is zero from there.
+  void reset_exosystem(int rows) { S_minus_.bottomRows(rows).setZero(); }
   // The last event's dtau/dtheta.
   void fill_event(Event& e) const;
   const std::vector<SensitivityLoss>& losses() const { return losses_; }
