@@ -82,8 +82,11 @@ VectorXd initial_state(const Circuit& c, std::string& note) {
   const MatrixXd ARR = s.A(R, R), ARG = s.A(R, G), BR = s.B(R, Eigen::all);
   const MatrixXd CR = s.C(Eigen::all, R), CG = s.C(Eigen::all, G);
   const VectorXd xG = x(G);
-  Eigen::FullPivLU<MatrixXd> lu(ARR);
+  // A resistive circuit has no free state (nr = 0): no factorisation of the
+  // empty A_RR (Eigen asserts on it, and reads past it without assertions).
+  Eigen::FullPivLU<MatrixXd> lu;
   lu.setThreshold(1e-12 * std::max(1, nr));
+  if (nr > 0) lu.compute(ARR);
   if (nr > 0 && !lu.isInvertible()) {
     // The states the first null vector moves (to 1e-9 of its largest entry).
     const VectorXd v = lu.kernel().col(0);
