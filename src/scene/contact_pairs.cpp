@@ -71,12 +71,47 @@ Vector3d round_normal(const BodyShape& s, const Vector3d& y, double& distance) {
   return dr > dz ? radial : axial;
 }
 
+// The face of box `s` whose plane y (the point in the box's frame) is
+// farthest outside of: the largest sign * y_axis - half_axis; inside the
+// box, the face it is least deep under; the first on a tie.
+int nearest_face(const BodyShape& s, const Vector3d& y) {
+  int best = 0;
+  double most = -std::numeric_limits<double>::infinity();
+  for (int f = 0; f < 6; ++f) {
+    const double d = face_normal(f).dot(y) - s.half(f / 2);
+    if (d > most) most = d, best = f;
+  }
+  return best;
+}
+
 // The unit normal (shape to point), the distance of the point's centre from
 // the shape's surface along it, and the shape's material point there.
 struct Separation {
   Vector3d normal, surface;
   double distance = 0.0;  // m, before the point's radius
 };
+
+// A point w against a box in the frame X: beyond an edge or a corner
+// (more than one coordinate of y = X^-1 w outside the half sizes), from the
+// box's nearest point, y clamped to the box; else from the nearest face's
+// plane (outside one face, or inside).
+Separation box_separation(const BodyShape& s, const Eigen::Isometry3d& X, const Vector3d& w) {
+  Separation out;
+  const Vector3d y = X.inverse() * w;
+  const Vector3d nearest = y.cwiseMax(-s.half).cwiseMin(s.half);
+  if ((y - nearest).cwiseAbs().count() > 1) {
+    out.distance = (y - nearest).norm();
+    out.normal = X.linear() * ((y - nearest) / out.distance);
+    out.surface = X * nearest;
+    return out;
+  }
+  const int f = nearest_face(s, y);
+  out.normal = X.linear() * face_normal(f);
+  out.distance = out.normal.dot(w - X.translation()) - s.half(f / 2);
+  out.surface = w - out.distance * out.normal;
+  return out;
+}
+
 Separation separation(const Bodies& b, const ContactPoint& p, const BodyShape& s,
                       const Eigen::VectorXd& q) {
   const Vector3d w = point_at(b, p, q);
@@ -91,9 +126,7 @@ Separation separation(const Bodies& b, const ContactPoint& p, const BodyShape& s
     out.distance = d.norm() - s.radius;
     out.surface = X.translation() + s.radius * out.normal;
   } else if (s.kind == "box") {
-    out.normal = X.linear() * face_normal(s.face);
-    out.distance = out.normal.dot(w - X.translation()) - s.half(s.face / 2);
-    out.surface = w - out.distance * out.normal;
+    out = box_separation(s, X, w);
   } else {  // capsule or cylinder, along the shape frame's z
     const Vector3d n = round_normal(s, X.inverse() * w, out.distance);
     if (!(n.norm() > 0.0))
@@ -115,18 +148,6 @@ double signed_distance(const Bodies& bodies, const ContactPoint& p, const Plane&
 double signed_distance(const Bodies& bodies, const ContactPoint& p, const BodyShape& s,
                        const Eigen::VectorXd& q) {
   return separation(bodies, p, s, q).distance - p.radius;
-}
-
-int nearest_face(const Bodies& bodies, const ContactPoint& p, const BodyShape& s,
-                 const Eigen::VectorXd& q) {
-  const Vector3d y = shape_pose(bodies, s, q).inverse() * point_at(bodies, p, q);
-  int best = 0;
-  double most = -std::numeric_limits<double>::infinity();
-  for (int f = 0; f < 6; ++f) {
-    const double d = face_normal(f).dot(y) - s.half(f / 2);
-    if (d > most) most = d, best = f;
-  }
-  return best;
 }
 
 ContactFrame contact_frame(const Bodies& bodies, const ContactPoint& p, const Plane& plane,

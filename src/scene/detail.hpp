@@ -247,8 +247,7 @@ std::vector<BodyShape> body_shapes(const std::vector<ContactBody>& bodies, const
 
 // The frames of `points` (on `ref`'s link) against each shape of the link
 // named at `key`.against: a point-against-shape contact each, named
-// <point> when the link has one shape, else <point>_<shape kind><k>; the
-// face of a box is the one nearest the point at q0 (nearest_face).
+// <point> when the link has one shape, else <point>_<shape kind><k>.
 // InputError when the two links are of one body.
 std::vector<ContactFrame> against_frames(const std::vector<ContactBody>& bodies, const LinkRef& ref,
                                          const YAML::Node& against, const std::string& source,

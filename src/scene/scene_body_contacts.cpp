@@ -83,11 +83,9 @@ std::vector<ContactFrame> against_frames(const std::vector<ContactBody>& bodies,
   for (const BodyShape& shape : shapes) {
     const std::string suffix = "_" + shape.kind + std::to_string(count[shape.kind]++);
     for (ContactPoint p : points) {
-      BodyShape s = shape;
-      if (s.kind == "box") s.face = nearest_face(dyn, p, s, q0);
       if (shapes.size() > 1) p.name += suffix;
       try {
-        out.push_back(contact_frame(dyn, p, s, q0));
+        out.push_back(contact_frame(dyn, p, shape, q0));
       } catch (const InputError& e) {  // a point at a sphere's centre: no normal
         fail(source, key, e.what());
       }

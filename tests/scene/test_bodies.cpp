@@ -118,20 +118,21 @@ q0: {j1: 0.4}
 
 // Central differences of the exact signed distance (scene::signed_distance
 // on the bodies) against each pair contact's normal row, at random
-// configurations about q0 (up to 0.3 rad or m away). Step h = 1e-5:
-// truncation h^2/6 |phi'''| <= 2e-11 (lever arms and distances below 2 m)
-// plus rounding eps |phi| / h <= 5e-10 (|phi| < 2 m), so 1e-8 leaves a
-// margin of 20. The tangent rows are checked as the derivatives of the
+// configurations about q0 (up to `spread` rad or m away). Step h = 1e-5:
+// truncation h^2/6 |phi'''| <= 2e-11 (lever arms and distances below 2 m,
+// and no point within 0.5 m of a box's edge or corner, where phi''' grows
+// as L^3 / d^2 with the distance d) plus rounding eps |phi| / h <= 5e-10
+// (|phi| < 2 m), so 1e-8 leaves a margin of 20; a smaller `h` where points
+// come closer to an edge. The tangent rows are checked as the derivatives of the
 // relative position of the two material points along t1, t2. Every pair
 // contact of `s`, at `draws` random configurations; the number of rows
 // checked per shape kind.
 std::map<std::string, int> expect_exact_pair_rows(const scene::Scene& s, int draws, unsigned seed,
-                                                  double spread = 0.3) {
+                                                  double spread = 0.3, double h = 1e-5) {
   const scene::Bodies dyn = scene::scene_bodies(s);
   const VectorXd q0 = dyn.reference();
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-spread, spread);
-  const double h = 1e-5;
   std::map<std::string, int> rows;
   for (int d = 0; d < draws; ++d) {
     VectorXd q = q0;
@@ -166,8 +167,11 @@ std::map<std::string, int> expect_exact_pair_rows(const scene::Scene& s, int dra
       }
       Eigen::Matrix3d F;
       F << c.normal, c.tangent1, c.tangent2;
-      EXPECT_LE((F.transpose() * F - Eigen::Matrix3d::Identity()).norm(), 1e-15);
-      EXPECT_NEAR(F.determinant(), 1.0, 1e-15);
+      // An orthonormal frame to rounding: the normal is a unit vector rotated
+      // by the shape's pose, the tangents its cross products; each entry of
+      // F'F - I and of det F - 1 carries a few eps (2.2e-16): 4e-15.
+      EXPECT_LE((F.transpose() * F - Eigen::Matrix3d::Identity()).norm(), 4e-15);
+      EXPECT_NEAR(F.determinant(), 1.0, 4e-15);
     }
   }
   return rows;
@@ -334,9 +338,97 @@ TEST_F(BodyScenes, AMeshCannotBeTouched) {
   }
 }
 
+// The signed distance of y (in a box's frame) from the box of half sizes
+// `half`, written independently of the library's: outside, the distance to
+// the nearest point sqrt(sum max(|y_a| - h_a, 0)^2); inside (or on), minus
+// the depth under the nearest face, max_a (|y_a| - h_a).
+double box_distance(const Vector3d& y, const Vector3d& half) {
+  const Vector3d out = (y.cwiseAbs() - half).cwiseMax(0.0);
+  return out.norm() > 0.0 ? out.norm() : (y.cwiseAbs() - half).maxCoeff();
+}
+
+// The region of y about a box of half sizes `half`: the number of
+// coordinates beyond the box (0 inside, 1 a face's, 2 an edge's, 3 a
+// corner's).
+int box_region(const Vector3d& y, const Vector3d& half) {
+  return static_cast<int>(((y.cwiseAbs() - half).array() > 0.0).count());
+}
+
+// kTwoBodies with points on the arm's base placed, through the poses at q0,
+// in the block's box's frame beyond a face (0.25 m), an edge and a corner
+// (0.2 m out along each axis beyond), so that q0 itself visits each region.
+class BoxScenes : public BodyScenes {
+ protected:
+  scene::Scene load_box_regions() {
+    const scene::Scene first = load(kTwoBodies);
+    const scene::Bodies dyn = scene::scene_bodies(first);
+    const VectorXd q0 = dyn.reference();
+    const auto box = std::find_if(first.contacts.begin(), first.contacts.end(), [](const auto& c) {
+      return c.against && c.against->kind == "box" && c.against->body == 1;
+    });
+    EXPECT_NE(box, first.contacts.end());
+    const Eigen::Isometry3d X =
+        dyn.link_pose(box->against->body, box->against->link, q0) * box->against->local;
+    const Eigen::Isometry3d base = dyn.link_pose(0, "base", q0);
+    const auto at = [&](const Vector3d& y) {
+      const Vector3d b = base.inverse() * (X * y);
+      std::ostringstream o;
+      o << std::setprecision(17) << "[" << b.x() << ", " << b.y() << ", " << b.z() << "]";
+      return o.str();
+    };
+    return load(kTwoBodies + "  - {link: arm/base, against: blk/block, points: [" +
+                at(Vector3d(0.45, 0.02, -0.03)) + ", " + at(Vector3d(0.4, -0.35, 0.01)) + ", " +
+                at(Vector3d(-0.4, 0.35, 0.3)) + "], name: far}\n");
+  }
+};
+
+// The box's rows beyond its faces, edges and corners: the central
+// differences of expect_exact_pair_rows at configurations up to 0.02 rad or
+// m from q0 (the points then move by at most 0.14 m relative to the box:
+// 0.035 m per base translation, 0.035 rad on lever arms up to 1.6 m), so
+// they stay 0.14 m from an edge or a corner and phi''' <= L^3 / d^2 = 400;
+// step 1e-6: truncation h^2/6 400 = 7e-11, rounding eps 2 m / h = 4.4e-10,
+// within 1e-8. Each region visited (counted); the gaps at q0 against
+// box_distance.
+TEST_F(BoxScenes, BoxRowsAreTheExactGradientBeyondFacesEdgesAndCorners) {
+  const scene::Scene s = load_box_regions();
+  const std::map<std::string, int> rows = expect_exact_pair_rows(s, 6, 28, 0.02, 1e-6);
+  EXPECT_GT(rows.at("box"), 0);
+  const scene::Bodies dyn = scene::scene_bodies(s);
+  const mech::MechanicalModel& m = *s.model.mechanical;
+  const VectorXd q0 = dyn.reference();
+  std::mt19937 rng(28);
+  std::uniform_real_distribution<double> u(-0.02, 0.02);
+  std::map<int, int> regions;
+  for (int d = 0; d <= 6; ++d) {  // d = 6: q0 itself
+    VectorXd q = q0;
+    if (d < 6)
+      for (Eigen::Index i = 0; i < q.size(); ++i) q(i) += u(rng);
+    for (const scene::ContactFrame& c : s.contacts) {
+      if (!c.against || c.against->kind != "box") continue;
+      const Eigen::Isometry3d X =
+          dyn.link_pose(c.against->body, c.against->link, q) * c.against->local;
+      const Vector3d y =
+          X.inverse() * (dyn.link_pose(c.point.body, c.point.link, q) * c.point.local);
+      regions[box_region(y, c.against->half)] += 1;
+      if (d < 6) continue;
+      // Sums of O(1) m terms: rounding 1e-14.
+      const auto it = std::find(m.constraints.begin(), m.constraints.end(), c.point.name);
+      ASSERT_NE(it, m.constraints.end()) << c.point.name;
+      const Eigen::Index row = it - m.constraints.begin();
+      EXPECT_NEAR(m.E.row(row).dot(q0) + m.g(row),
+                  box_distance(y, c.against->half) - c.point.radius, 1e-14)
+          << c.point.name;
+    }
+  }
+  EXPECT_GT(regions[1], 0);
+  EXPECT_GT(regions[2], 0);
+  EXPECT_GT(regions[3], 0);
+}
+
 // Closed forms of the two geometries at q0, independent of the code's:
-// sphere against sphere |c1 - c2| - r1 - r2; a point against a box face
-// n . (w - o) - h_f, with n the face the point is farthest outside of.
+// sphere against sphere |c1 - c2| - r1 - r2; a point against a box its
+// distance from the box (box_distance).
 TEST_F(BodyScenes, PairGapsAtQ0AreTheClosedFormDistances) {
   const scene::Scene s = load(kTwoBodies);
   const mech::MechanicalModel& m = *s.model.mechanical;
@@ -348,8 +440,7 @@ TEST_F(BodyScenes, PairGapsAtQ0AreTheClosedFormDistances) {
       blk * Eigen::Translation3d(0.1, 0, 0) * Eigen::AngleAxisd(0.5, Vector3d::UnitZ()) *
       Eigen::AngleAxisd(-0.2, Vector3d::UnitY()) * Eigen::AngleAxisd(0.3, Vector3d::UnitX());
   const Vector3d y = box.inverse() * c_tool, half(0.2, 0.15, 0.1);
-  double face = -1e9;
-  for (int a = 0; a < 3; ++a) face = std::max({face, y(a) - half(a), -y(a) - half(a)});
+  const double face = box_distance(y, half);
   const auto gap = [&](const std::string& name) {
     const auto it = std::find(m.constraints.begin(), m.constraints.end(), name);
     EXPECT_NE(it, m.constraints.end()) << name;

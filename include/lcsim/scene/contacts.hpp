@@ -42,9 +42,8 @@ double signed_distance(const UrdfDynamics& dyn, const ContactPoint& p, const Pla
                        const Eigen::VectorXd& q);
 
 // Another body's collision primitive that a contact point may touch
-// (docs/contacts.md, "Body against body"): a sphere, or a box of which one
-// face, the one nearest the point at q0 (nearest_face), is kept fixed in the
-// box's frame, so its signed distance is that of the face's plane.
+// (docs/contacts.md, "Body against body"): a sphere, a box, a capsule or a
+// cylinder.
 struct BodyShape {
   std::string name;  // "<body>/<link>" (and ".<kind><k>" when the link has several)
   std::size_t body = 0;
@@ -54,26 +53,24 @@ struct BodyShape {
   double radius = 0.0;                                      // sphere, capsule, cylinder: m
   Eigen::Vector3d half =
       Eigen::Vector3d::Zero();  // box: half sizes; capsule, cylinder: (0, 0, l/2) (m)
-  int face = -1;  // box: axis face / 2 of its frame, outward along + (face odd) or - (even)
 };
 // The exact signed distances at the scene's coordinates q (m):
 //   plane:  phi = normal . (X_link(q) local - plane.point) - radius;
 //   sphere: phi = |w - c| - R - radius (w the point, c the sphere's centre, world);
-//   box:    phi = n_f . (w - X_box(q) (h_f n_f^box)) - radius, n_f = R_box(q) n_f^box,
-//           the face `face` (h_f its half size along its axis);
+//   box:    with y = X_box(q)^-1 w and y_c = y clamped to the half sizes h:
+//           |y - y_c| - radius beyond an edge or a corner (y_c differs from
+//           y in more than one coordinate); else n_f . (w - X_box(q) (h_f
+//           n_f^box)) - radius, n_f = R_box(q) n_f^box the face whose plane
+//           y is farthest outside of (inside: least deep under; the first
+//           of -x, +x, -y, +y, -z, +z on a tie), h_f its half size;
 //   capsule: phi = |y - (0, 0, clamp(y_z, -l/2, l/2))| - R - radius, y = X_shape(q)^-1 w;
 //   cylinder: with dr = |(y_x, y_y)| - R and dz = |y_z| - l/2, hypot(dr, dz)
 //           beyond the rim (dr, dz > 0), else max(dr, dz), less radius.
-//   The feature nearest at q is used at every q (the box's face is fixed).
+//   The feature nearest at q is used at every q.
 double signed_distance(const Bodies& bodies, const ContactPoint& p, const Plane& plane,
                        const Eigen::VectorXd& q);
 double signed_distance(const Bodies& bodies, const ContactPoint& p, const BodyShape& s,
                        const Eigen::VectorXd& q);
-// The face of box `s` whose plane the point is farthest outside of at q
-// (the largest sign * y_axis - half_axis, y the point in the box's frame;
-// inside the box, the face it is least deep under); the first on a tie.
-int nearest_face(const Bodies& bodies, const ContactPoint& p, const BodyShape& s,
-                 const Eigen::VectorXd& q);
 // A contact point against a plane at q0: one row of the scene's E and g.
 // The tangents: t1 = normal x e / |normal x e| with e the world axis least
 // aligned with the normal (the first of x, y, z on a tie), t2 = normal x t1,
