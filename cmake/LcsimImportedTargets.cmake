@@ -7,6 +7,7 @@
 #                      file gives variables, not a target); needs urdfdom found.
 #   PkgConfig::BULLET  pkg-config module bullet-float64 (lcsim::bullet).
 #   PkgConfig::IPOPT   pkg-config module ipopt (lcsim::ipopt).
+#   lcsim::mujoco_library  MuJoCo's library and header (lcsim::mujoco).
 # Each function is a no-op when its target exists already (a project that made
 # PkgConfig::BULLET itself from the same module keeps it).
 
@@ -30,6 +31,28 @@ macro(lcsim_import_pkgconfig prefix module)
       pkg_check_modules(${prefix} QUIET IMPORTED_TARGET ${module})
     else()
       set(${prefix}_FOUND FALSE)
+    endif()
+  endif()
+endmacro()
+
+# Sets LCSIM_MUJOCO_FOUND in the caller; the target is lcsim::mujoco_library,
+# MuJoCo's library and header (Debian: libmujoco-dev), found by name: Debian
+# 2.2.2's CMake package (find_package(mujoco)) names a missing include folder
+# (/usr/include/libqhull_r) and fails the generate step.
+macro(lcsim_import_mujoco)
+  if(TARGET lcsim::mujoco_library)
+    set(LCSIM_MUJOCO_FOUND TRUE)
+  else()
+    find_library(LCSIM_MUJOCO_LIBRARY mujoco)
+    find_path(LCSIM_MUJOCO_INCLUDE mujoco/mujoco.h)
+    if(LCSIM_MUJOCO_LIBRARY AND LCSIM_MUJOCO_INCLUDE)
+      add_library(lcsim::mujoco_library UNKNOWN IMPORTED)
+      set_target_properties(lcsim::mujoco_library PROPERTIES
+        IMPORTED_LOCATION "${LCSIM_MUJOCO_LIBRARY}"
+        INTERFACE_INCLUDE_DIRECTORIES "${LCSIM_MUJOCO_INCLUDE}")
+      set(LCSIM_MUJOCO_FOUND TRUE)
+    else()
+      set(LCSIM_MUJOCO_FOUND FALSE)
     endif()
   endif()
 endmacro()

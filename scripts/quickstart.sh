@@ -76,12 +76,15 @@ else
   "$pkg/build/two_carts/two_carts" robots/two_carts.yaml
   "$pkg/build/impact_rules/impact_rules" robots/two_carts_hook.yaml
   ctest --test-dir "$pkg/build/invariant_test" --output-on-failure
-  "$pkg/build/registration/registered_methods"
+  # MuJoCo is installed above, so its component must be there and register.
+  "$pkg/build/registration/registered_methods" | tee "$pkg/registered.txt"
+  grep -q "^made mujoco$" "$pkg/registered.txt"
   pc_dir=$(dirname "$(find "$pkg/prefix" -name lcsim.pc)")
   # shellcheck disable=SC2046 # pkg-config's output is meant to be split
   g++ -std=c++20 -O1 -o "$pkg/registered_methods_pc" examples/registration/registered_methods.cpp \
-    $(PKG_CONFIG_PATH="$pc_dir" pkg-config --cflags --libs lcsim-bullet lcsim-ipopt)
-  "$pkg/registered_methods_pc"
+    $(PKG_CONFIG_PATH="$pc_dir" pkg-config --cflags --libs lcsim-bullet lcsim-ipopt lcsim-mujoco)
+  "$pkg/registered_methods_pc" | tee "$pkg/registered_pc.txt"
+  grep -q "^made mujoco$" "$pkg/registered_pc.txt"
   # The Python package as installed: imported by a fresh interpreter outside
   # the source tree, from <prefix>/lib/python3/dist-packages, running a tiny
   # simulation (two carts whose stop is hit at t = 0: one impact, thesis §3.7).

@@ -1,11 +1,13 @@
-// Linking the optional components lcsim::bullet and lcsim::ipopt is all it
-// takes to use their methods: no registration call. Lists the methods of
-// each registry and makes the optional ones by name (make_* throws
-// std::invalid_argument naming the known ones when a name is unknown).
+// Linking the optional components lcsim::bullet and lcsim::ipopt (and
+// lcsim::mujoco) is all it takes to use their methods: no registration call.
+// Lists the methods of each registry and makes the optional ones by name
+// (make_* throws std::invalid_argument naming the known ones when a name is
+// unknown); "mujoco" too when it is registered.
 //
-// CMake: target_link_libraries(app lcsim::bullet lcsim::ipopt)
+// CMake: target_link_libraries(app lcsim::bullet lcsim::ipopt [lcsim::mujoco])
 // pkg-config: g++ -std=c++20 registered_methods.cpp
-//                 $(pkg-config --cflags --libs lcsim-bullet lcsim-ipopt)
+//                 $(pkg-config --cflags --libs lcsim-bullet lcsim-ipopt [lcsim-mujoco])
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <lcsim/impact/impact.hpp>
@@ -30,6 +32,9 @@ int main() {
     std::printf("made %s, %s and %s\n", lcsim::sim::make_integrator("bullet")->name().c_str(),
                 lcsim::impact::make_impact_law("moreau-qp")->name().c_str(),
                 lcsim::lcp::make_solver("bullet-dantzig")->name().c_str());
+    const std::vector<std::string> integrators = lcsim::sim::integrator_names();
+    if (std::find(integrators.begin(), integrators.end(), "mujoco") != integrators.end())
+      std::printf("made %s\n", lcsim::sim::make_integrator("mujoco")->name().c_str());
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s\n", e.what());
