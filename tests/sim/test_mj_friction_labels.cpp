@@ -180,6 +180,39 @@ TEST(MjFrictionLabels, SlidingBoxIsLabelledByTheFacetOppositeItsHeading) {
   expect_box_labels(1, 1, false);
 }
 
+// The band: a box at rest pushed by exactly the cone's bound at its
+// heading (mu g along edge 0 or edge 1, mu g cos(pi/(2d)) along a face's
+// bisector; unit mass) has its impulse on the cone's boundary, where the
+// law's answer is the velocity's: stick, the velocity being zero to the
+// rounding of h mu g against mu (g h). The label is stick in every sample,
+// and the box moves by less than 1e-12 m over the run (rounding: 1e-18 m/s
+// per step at most over 200 steps), the independent evidence that it sticks.
+TEST(MjFrictionLabels, BoxPushedAtTheConesBoundarySticks) {
+  struct Push {
+    int d;
+    double psi, size;  // heading (rad) and force (N) of the push
+  };
+  const std::vector<Push> pushes = {{1, 0.0, kMu * kG},
+                                    {4, 0.0, kMu * kG},
+                                    {4, kPi / 4, kMu * kG},
+                                    {4, kPi / 8, kMu * kG * std::cos(kPi / 8)},
+                                    {3, 5 * kPi / 6, kMu * kG * std::cos(kPi / 6)}};
+  for (const Push& p : pushes) {
+    mech::Model model = box(p.d);
+    model.mechanical->f(0) = p.size * std::cos(p.psi);
+    model.mechanical->f(1) = p.size * std::sin(p.psi);
+    const sim::Trajectory tr = run_mj(model, VectorXd::Zero(6), 0.2);
+    ASSERT_EQ(tr.status, Status::kOk) << tr.message;
+    for (const sim::Sample& s : tr.samples) {
+      if (s.t > 0.0 && s.u(0) > 0.0) {
+        EXPECT_EQ(s.friction_mode[0], sim::FrictionMode::kStick)
+            << "d = " << p.d << ", psi = " << p.psi << ", t = " << s.t;
+      }
+    }
+    EXPECT_LE(tr.final_state.head(2).lpNorm<Eigen::Infinity>(), 1e-12) << "d = " << p.d;
+  }
+}
+
 // The planar box (one tangent, d = 1): slides along +t (slip+) until t* =
 // 1/(mu g), then sticks; along -t slip-.
 TEST(MjFrictionLabels, PlanarSlidingBoxIsLabelledSlipThenStick) {
