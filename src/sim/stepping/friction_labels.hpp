@@ -1,6 +1,7 @@
 // Private to src/sim/stepping: the stick / slip label of a closed
 // frictional contact after a time step, by Coulomb's law (issue 27), for
-// Moreau–Jean (moreau_jean.cpp) and backward Euler (euler_friction.cpp).
+// Moreau–Jean's samples (moreau_jean.cpp); written for any time-stepping
+// scheme that has a step's impulses and end velocity.
 #pragma once
 
 #include <lcsim/mech/mech.hpp>
