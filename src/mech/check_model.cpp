@@ -83,8 +83,12 @@ double cosine(const Eigen::SparseVector<double>& a, const Eigen::SparseVector<do
 // the rod and moves the normal), and it depends on the masses, not on the
 // contact's geometry; for a matrix model in the contact point's Cartesian
 // coordinates the Euclidean test is the geometric one.
-std::optional<ModelProblem> check_friction_3d(const MechanicalModel& m, const FrictionalContact& c,
-                                              const std::string& at) {
+// E_rows: E by rows (E's row c.contact as a sparse vector in O(its entries);
+// m.E.row() of the column-major E scans every column, O(N) per contact and
+// O(N^2) over a model's contacts: seconds at N = 10^4).
+std::optional<ModelProblem> check_friction_3d(
+    const MechanicalModel& m, const Eigen::SparseMatrix<double, Eigen::RowMajor>& E_rows,
+    const FrictionalContact& c, const std::string& at) {
   const Eigen::Index N = m.M.rows();
   if (auto p = check_tangent(c.tangent2, N, at + ".tangents[1]")) return p;
   if (c.edges < 0)
@@ -93,7 +97,7 @@ std::optional<ModelProblem> check_friction_3d(const MechanicalModel& m, const Fr
     return ModelProblem{at + ".velocity", "a moving surface is planar only (got " +
                                               short_number(c.velocity) + " with two tangents)"};
   if (c.world_frame) return std::nullopt;  // orthonormal in the world (FrictionalContact)
-  const Eigen::SparseVector<double> n = m.E.row(c.contact).transpose();
+  const Eigen::SparseVector<double> n = E_rows.row(c.contact).transpose();
   const std::string row = "the normal row E[" + std::to_string(c.contact) + "]";
   const std::pair<std::string, double> pairs[] = {
       {"tangents[0] and " + row, cosine(n, c.tangent)},
@@ -119,6 +123,7 @@ std::optional<ModelProblem> check_friction_3d(const MechanicalModel& m, const Fr
 std::optional<ModelProblem> check_friction(const MechanicalModel& m) {
   const Eigen::Index N = m.M.rows(), k = m.E.rows();
   std::vector<int> owner(static_cast<size_t>(k), -1);
+  Eigen::SparseMatrix<double, Eigen::RowMajor> E_rows;  // E by rows, made at the first 3-D contact
   for (size_t f = 0; f < m.friction.size(); ++f) {
     const FrictionalContact& c = m.friction[f];
     const std::string at = "mechanical.friction[" + std::to_string(f) + "]";
@@ -141,8 +146,10 @@ std::optional<ModelProblem> check_friction(const MechanicalModel& m) {
       return ModelProblem{at + ".mu", "must be >= 0 (got " + short_number(c.mu) + ")"};
     if (!std::isfinite(c.velocity))
       return ModelProblem{at + ".velocity", "not finite (got " + short_number(c.velocity) + ")"};
-    if (c.is_3d())
-      if (auto p = check_friction_3d(m, c, at)) return p;
+    if (c.is_3d()) {
+      if (E_rows.rows() == 0 && !c.world_frame) E_rows = m.E;
+      if (auto p = check_friction_3d(m, E_rows, c, at)) return p;
+    }
   }
   if (m.cone_edges < 1)
     return ModelProblem{"mechanical.friction_d",

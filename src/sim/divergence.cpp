@@ -75,11 +75,17 @@ DivergenceGuard::DivergenceGuard(const mech::Model& model, const VectorXd& x0, d
   energy_scale_ = mech::kinetic_energy(m, v0) + std::abs(mech::potential_energy(m, q0)) + e_f + e_b;
   const double reach =
       q0.cwiseAbs().maxCoeff() + (m_min > 0.0 ? T * std::sqrt(2.0 * energy_scale_ / m_min) : 0.0);
-  for (int i = 0; i < m.num_constraints(); ++i) {
-    double row = 0.0;
-    for (int j = 0; j < N; ++j) row += std::abs(m.E.coeff(i, j));
-    length_scale_ = std::max(length_scale_, std::abs(m.g(i)) + row * reach);
-  }
+  // Each row's sum of |E_ij| from its stored entries, in the order of j as
+  // the sum over every column was (the zeros it skips add nothing to a sum
+  // of non-negative terms, so the figure is the same to the bit): one pass
+  // over E's columns, O(nnz) where E.coeff(i, j) for every (i, j) cost
+  // O(k N) (3 s at N = 10^4).
+  VectorXd row = VectorXd::Zero(m.num_constraints());
+  for (int j = 0; j < m.E.outerSize(); ++j)
+    for (mech::SparseMatrix::InnerIterator it(m.E, j); it; ++it)
+      row(it.row()) += std::abs(it.value());
+  for (int i = 0; i < m.num_constraints(); ++i)
+    length_scale_ = std::max(length_scale_, std::abs(m.g(i)) + row(i) * reach);
   mechanical_ = true;
 }
 

@@ -69,6 +69,7 @@
 // the divergence guard, the sample). The run's state lives in MjRun, so no
 // stage allocates once the active set has been seen.
 #include <algorithm>
+#include <cmath>
 #include <lcsim/lcp/sparse.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <limits>
@@ -78,6 +79,7 @@
 #include <utility>
 #include <vector>
 
+#include "sim/stepping/friction_labels.hpp"
 #include "sim/stepping/mj_friction.hpp"
 #include "sim/stepping/step_kernels.hpp"
 #include "sim/stepping/step_sensitivity.hpp"
@@ -98,32 +100,6 @@ constexpr double kActivationRounding = 64 * std::numeric_limits<double>::epsilon
 constexpr double kPgsTolerance = 1e-13;  // natural residual <= tol * (1 + ||b||_inf)
 constexpr int kPgsMaxSweeps = 5000;
 constexpr int kPivotFallbackMax = 2000;
-
-// A closed frictional contact's mode after a step with velocity v: stick
-// when its sliding velocity is zero to rounding (a stuck velocity is a
-// cancellation of terms of the size of |t| |v|, exact to a few hundred eps
-// of it: 1e-12 of it), else slip along the sliding velocity's sign.
-// A 3-D contact: the same on the sliding speed |(t.v - velocity, t2.v)|
-// with the terms of both rows, kSlip when it slides.
-FrictionMode friction_mode_after_step(const mech::FrictionalContact& fc, const VectorXd& v) {
-  const double s = fc.sliding(v);
-  double scale = fc.tangent.cwiseAbs().dot(v.cwiseAbs()) + std::abs(fc.velocity);
-  if (fc.is_3d()) {
-    const double s2 = fc.tangent2.dot(v);
-    scale += fc.tangent2.cwiseAbs().dot(v.cwiseAbs());
-    // hypot(s, s2) lies in [max, sqrt(2) max] of |s|, |s2| (and its
-    // rounding keeps it there, within 1.5 max): decided without it outside
-    // that band, the same answer with a tenth of the cost per contact.
-    const double bound = 1e-12 * scale + std::numeric_limits<double>::min();
-    const double top = std::max(std::abs(s), std::abs(s2));
-    if (top > bound) return FrictionMode::kSlip;
-    if (1.5 * top <= bound) return FrictionMode::kStick;
-    return std::hypot(s, s2) <= bound ? FrictionMode::kStick : FrictionMode::kSlip;
-  }
-  if (std::abs(s) <= 1e-12 * scale + std::numeric_limits<double>::min())
-    return FrictionMode::kStick;
-  return s > 0.0 ? FrictionMode::kSlipPositive : FrictionMode::kSlipNegative;
-}
 
 // The cone facet holding a sliding 3-D contact's friction force after a
 // step with velocity v (Sample::friction_facet): the facet of maximal
@@ -317,6 +293,7 @@ class MjRun {
   // The friction LCP over [E_A; T_F] (mj_friction.hpp); v_next_ becomes the
   // post-step velocity.
   bool friction_step(MjIteration& f, double h, double t0) {
+    v_free_size_ = v_next_.size() > 0 ? v_next_.lpNorm<Eigen::Infinity>() : 0.0;  // v_free
     if (!friction_->step(f, A_, cols_, Ev_, e_, *solver_, opt_.pivot_max_active, v_next_, z_,
                          lambda_T_, tr_.lcp_solves, failed_, friction_warning_)) {
       failure_ = lcp_failure("moreau-jean", t0, failed_);
@@ -329,8 +306,9 @@ class MjRun {
     for (size_t fi = 0; fi < m_.friction.size(); ++fi) {
       const mech::FrictionalContact& fc = m_.friction[fi];
       u_t_(static_cast<Eigen::Index>(fi)) = lambda_T_(fc.contact) / h;
+      // Closed; stick or slip is decided where a sample is kept (label_modes).
       if (const int p = pos_[static_cast<size_t>(fc.contact)]; p >= 0 && z_(p) > 0.0)
-        fmode_[fi] = friction_mode_after_step(fc, v_next_);
+        fmode_[fi] = FrictionMode::kStick;
       if (u_t2_.size() == 0) continue;  // planar model
       u_t2_(static_cast<Eigen::Index>(fi)) = friction_->lambda_T2()(fc.contact) / h;
     }
@@ -478,6 +456,7 @@ class MjRun {
     s.mode = mode_;
     if (friction_) {
       s.u_t = u_t_;
+      label_modes();
       s.friction_mode = fmode_;
       s.u_t2 = u_t2_;
       // The facets only where a sample is kept (a run that records none, or
@@ -490,6 +469,23 @@ class MjRun {
     }
     if (sens_) sens_->fill(s.dx, s.dx_exists);
     tr_.record_sample(std::move(s), opt_);
+  }
+
+  // The last step's closed contacts (fmode_ kStick) labelled stick or slip
+  // by Coulomb's law (friction_mode_after_step), only where a sample is kept
+  // (as the facets: the cone's gauge costs trigonometry per contact). Called
+  // between the step and the next one: z_, pos_, lambda_T_ and the second
+  // tangents' impulses are the step's, v_ its end velocity.
+  void label_modes() {
+    const double V = std::max(v_free_size_, v_.size() > 0 ? v_.lpNorm<Eigen::Infinity>() : 0.0);
+    for (size_t fi = 0; fi < fmode_.size(); ++fi) {
+      if (fmode_[fi] != FrictionMode::kStick) continue;  // open (closed ones are kStick here)
+      const mech::FrictionalContact& fc = m_.friction[fi];
+      const double p2 = u_t2_.size() > 0 ? friction_->lambda_T2()(fc.contact) : 0.0;
+      fmode_[fi] =
+          friction_mode_after_step(fc, m_.edges_of(fc), z_(pos_[static_cast<size_t>(fc.contact)]),
+                                   lambda_T_(fc.contact), p2, v_, V);
+    }
   }
 
   const mech::Model& model_;
@@ -517,9 +513,11 @@ class MjRun {
   // samples' u_t.
   VectorXd u_t_;
   // Their modes over the step (the samples' friction_mode): open unless the
-  // normal impulse is positive; then stick when the sliding velocity at the
-  // step's end is zero to rounding, else slip along its sign.
+  // normal impulse is positive; then Coulomb's law (label_modes): stick when
+  // the friction impulse is strictly inside the cone or the sliding velocity
+  // at the step's end is zero to the step's rounding band, else slip.
   std::vector<FrictionMode> fmode_;
+  double v_free_size_ = 0.0;  // |v_free|_inf of the last friction step (m/s): label_modes' scale
   // Models with 3-D friction (empty otherwise): the mean force along each
   // entry's second tangent (N) and the facet of each sliding entry.
   VectorXd u_t2_;
