@@ -67,6 +67,20 @@ std::optional<Refined> refine_on_active_set(const Setup& s, const VectorXd& v,
 // surfaces (J; Kane's paradox, only restitution can cause it).
 double friction_mode_threshold(const Setup& s);
 void flag_friction_energy_gain(double surface_work, ImpactResult& out);
+// The Painlevé test on a solved friction impact (issue 27; friction.cpp).
+// Wf: the Delassus matrix over [E_J; friction rows]; its first nj rows are
+// the closed normals. stick_rows: the friction rows held by the contacts
+// that stick after the impact (index into Wf); slip_cols (Wf.rows() x nj):
+// column j the friction of normal j's contact frozen in its sliding's
+// direction, mu W_f D(w) (zero for a sticking or frictionless contact).
+// True when the normal impulses are unique for these modes: the normal
+// matrix with the slips' columns, the sticking rows eliminated (Schur
+// complement over an independent subset of them, which holds them all), is
+// a P-matrix on the sets of contacts of independent normal rows; always
+// true when nothing slips. nj <= 12 (2^nj minors), else not judged (true).
+bool no_painleve_after_solve(const MatrixXd& Wf, Eigen::Index nj,
+                             const std::vector<Eigen::Index>& stick_rows,
+                             const MatrixXd& slip_cols);
 // The message of a friction impact whose LCP no solver solved (`tried`: the
 // solvers, in the order tried).
 std::string friction_lcp_failure(const std::string& tried, const lcp::Result& res);

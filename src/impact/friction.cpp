@@ -6,6 +6,7 @@
 #include <cmath>
 #include <lcsim/core/format.hpp>
 #include <lcsim/impact/impact.hpp>
+#include <lcsim/lcp/redundant.hpp>
 #include <limits>
 
 #include "impact/detail.hpp"
@@ -130,17 +131,19 @@ ClosedFriction closed_friction(const mech::MechanicalModel& m, const IndexSet& c
 // Painlevé-type cases. With the frictional contacts sliding in directions
 // sigma (lambda_T = -sigma mu lambda_N), the normal impulses solve the LCP
 // with matrix W_NN - W_NT diag(sigma mu) S (S picks the frictional rows);
-// when it is not a P-matrix that LCP may have no solution or several. One
-// contact: its coefficient W_NN - mu |W_NT| <= 0. Several: every sign
-// pattern, up to kMaxPatternContacts frictional and kMaxPatternNormals
-// closed contacts (2^n_F P-matrix tests of 2^n_N minors); beyond, the
-// single-contact test alone. The message, or "" when there is none.
-constexpr Eigen::Index kMaxPatternContacts = 8, kMaxPatternNormals = 12;
+// when it is not a P-matrix that LCP may have no solution or several.
+// Before the solve, one contact alone: its coefficient W_NN - mu |W_NT| <= 0
+// (painleve_alone). After it, the modes the solution gives (issue 27:
+// painleve_solved; each contact slipping with the sign of its sliding after
+// the impact, or sticking, its row held), judged by
+// detail::no_painleve_after_solve; the sign patterns this impact does not
+// take are not judged (before, every pattern was, up to 8 frictional
+// contacts, and none above). The message, or "" when there is none.
+constexpr const char* kPainleveTail =
+    "; the friction impact LCP may have no solution or several (not resolved)";
 
-std::string painleve(const mech::MechanicalModel& m, const IndexSet& closed,
-                     const ClosedFriction& c, const MatrixXd& W, const MatrixXd& WNT) {
-  const std::string tail =
-      "; the friction impact LCP may have no solution or several (not resolved)";
+std::string painleve_alone(const mech::MechanicalModel& m, const IndexSet& closed,
+                           const ClosedFriction& c, const MatrixXd& W, const MatrixXd& WNT) {
   for (size_t f = 0; f < c.index.size(); ++f) {
     const int j = c.normal_of[f];
     const double wnn = W(j, j), wnt = WNT(j, static_cast<Eigen::Index>(f));
@@ -152,28 +155,42 @@ std::string painleve(const mech::MechanicalModel& m, const IndexSet& closed,
     return text("Painlevé-type case at contact ", row, " ('", m.constraints[row],
                 "'): W_NN - mu |W_NT| = ", wnn, " - ", mu, " * ", std::abs(wnt), " = ", coef,
                 " <= 0, so sliding ", (wnt > 0 ? "along +t" : "along -t"),
-                " presses the contact shut", tail);
-  }
-  const Eigen::Index nf = c.mu.size();
-  if (nf < 1 || (nf == 1 && W.rows() == 1) || nf > kMaxPatternContacts ||
-      W.rows() > kMaxPatternNormals)
-    return "";
-  for (long pattern = 0; pattern < (1L << nf); ++pattern) {
-    MatrixXd Ns = W;
-    for (Eigen::Index f = 0; f < nf; ++f) {
-      const double sigma = (pattern >> f) & 1 ? -1.0 : 1.0;
-      Ns.col(c.normal_of[static_cast<size_t>(f)]) -= sigma * c.mu(f) * WNT.col(f);
-    }
-    if (lcp::is_p_matrix(Ns)) continue;
-    std::string msg = "Painlevé-type case at contacts";
-    for (size_t f = 0; f < c.index.size(); ++f)
-      msg += text(" ", closed[static_cast<size_t>(c.normal_of[f])],
-                  (((pattern >> f) & 1) ? " (slip-)" : " (slip+)"));
-    return msg +
-           ": with these slips the normal matrix W_NN - W_NT diag(sigma mu) is not a P-matrix" +
-           tail;
+                " presses the contact shut", kPainleveTail);
   }
   return "";
+}
+
+std::string painleve_solved(const ImpactInput& in, const ClosedFriction& c, const MatrixXd& Wg,
+                            const VectorXd& v_after) {
+  const Eigen::Index nf = c.mu.size(), nj = Wg.rows() - nf;
+  if (nf < 1 || (nf == 1 && nj == 1)) return "";
+  MatrixXd slip = MatrixXd::Zero(Wg.rows(), nj);
+  std::vector<Eigen::Index> stick;
+  std::string msg = "Painlevé-type case at contacts";
+  const VectorXd vv = in.v.cwiseAbs() + v_after.cwiseAbs();
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    const int j = c.normal_of[static_cast<size_t>(f)];
+    msg += text(" ", in.closed[static_cast<size_t>(j)]);
+    // Sliding after the impact (zero to the rounding of the terms of t'v,
+    // as set_outcomes): sigma its sign, lambda_T = -sigma mu lambda_N, the
+    // column -sigma mu W_g t; else it sticks (its row held).
+    const double ut = c.T.row(f).dot(v_after) - c.velocity(f);
+    const double scale = c.T.row(f).cwiseAbs().dot(vv) + std::abs(c.velocity(f));
+    if (std::abs(ut) <= mech::zero_tolerance(scale)) {
+      stick.push_back(nj + f);
+      msg += " (stick)";
+      continue;
+    }
+    const double sigma = ut > 0 ? 1.0 : -1.0;
+    slip.col(j) -= sigma * c.mu(f) * Wg.col(nj + f);
+    msg += sigma > 0 ? " (slip+)" : " (slip-)";
+  }
+  if (detail::no_painleve_after_solve(Wg, nj, stick, slip)) return "";
+  return msg +
+         ": with these modes of the impact LCP's solution the normal matrix W_NN - W_NT "
+         "diag(sigma mu), the sticking rows eliminated, is not a P-matrix on contacts of "
+         "independent normal rows" +
+         kPainleveTail;
 }
 
 void set_outcomes(const mech::MechanicalModel& m, const ImpactInput& in, const ClosedFriction& c,
@@ -240,7 +257,8 @@ ImpactResult moreau_friction(const ImpactInput& in, const lcp::Solver& solver) {
   s->L.triangularView<Eigen::Lower>().solveInPlace(MinvTt);
   s->L.transpose().triangularView<Eigen::Upper>().solveInPlace(MinvTt);
   const MatrixXd Wg = delassus(*s, c, MinvTt);
-  if (std::string p = painleve(m, in.closed, c, s->W, Wg.topRightCorner(nj, nf)); !p.empty()) {
+  if (std::string p = painleve_alone(m, in.closed, c, s->W, Wg.topRightCorner(nj, nf));
+      !p.empty()) {
     out.painleve = true;
     out.message = p;
     return out;
@@ -259,8 +277,13 @@ ImpactResult moreau_friction(const ImpactInput& in, const lcp::Solver& solver) {
   const VectorXd* z = &res.z;
   VectorXd lambda_N, lambda_T;
   friction_impulses(*z, static_cast<int>(nj), c.normal_of, c.mu, lambda_N, lambda_T);
-  const VectorXd v_after = in.v + s->MinvEt * lambda_N + MinvTt * lambda_T;
   const double tiny = detail::friction_mode_threshold(*s);
+  const VectorXd v_after = in.v + s->MinvEt * lambda_N + MinvTt * lambda_T;
+  if (std::string p = painleve_solved(in, c, Wg, v_after); !p.empty()) {
+    out.painleve = true;
+    out.message = p;
+    return out;
+  }
   detail::finish(in, *s, lambda_N, v_after, tiny, out);
   set_outcomes(m, in, c, lambda_N, lambda_T, tiny, out);
   out.status = Status::kOk;
@@ -288,6 +311,44 @@ void flag_friction_energy_gain(double surface_work, ImpactResult& out) {
                        " J: Newton restitution with coupled normal and tangential "
                        "directions (W_NT != 0) can create energy (Kane's paradox)");
   }
+}
+
+bool no_painleve_after_solve(const MatrixXd& Wf, Eigen::Index nj,
+                             const std::vector<Eigen::Index>& stick_rows,
+                             const MatrixXd& slip_cols) {
+  if (nj > 12 || slip_cols.cwiseAbs().maxCoeff() == 0.0) return true;
+  std::vector<Eigen::Index> idx(static_cast<size_t>(nj));
+  for (Eigen::Index i = 0; i < nj; ++i) idx[static_cast<size_t>(i)] = i;
+  // An independent subset of the sticking rows (their Gram matrix's
+  // nonsingular principal part: dependent rows hold with the others).
+  std::vector<Eigen::Index> held;
+  if (!stick_rows.empty()) {
+    const Eigen::Index ns = static_cast<Eigen::Index>(stick_rows.size());
+    MatrixXd G(ns, ns);
+    for (Eigen::Index a = 0; a < ns; ++a)
+      for (Eigen::Index b = 0; b < ns; ++b)
+        G(a, b) = Wf(stick_rows[static_cast<size_t>(a)], stick_rows[static_cast<size_t>(b)]);
+    Eigen::FullPivLU<MatrixXd> lu(G);
+    lu.setThreshold(1e-10);  // relative to the largest pivot: dependence to rounding
+    for (Eigen::Index r = 0; r < lu.rank(); ++r)
+      held.push_back(stick_rows[static_cast<size_t>(lu.permutationQ().indices()(r))]);
+  }
+  const Eigen::Index nh = static_cast<Eigen::Index>(held.size());
+  for (const Eigen::Index h : held) idx.push_back(h);
+  const Eigen::Index n = nj + nh;
+  MatrixXd A(n, n);
+  for (Eigen::Index a = 0; a < n; ++a)
+    for (Eigen::Index b = 0; b < n; ++b) {
+      const Eigen::Index ra = idx[static_cast<size_t>(a)], cb = idx[static_cast<size_t>(b)];
+      A(a, b) = Wf(ra, cb) + (b < nj ? slip_cols(ra, b) : 0.0);
+    }
+  MatrixXd Ns = A.topLeftCorner(nj, nj);
+  if (nh > 0) {
+    const Eigen::FullPivLU<MatrixXd> lu(A.bottomRightCorner(nh, nh));
+    if (!lu.isInvertible()) return true;  // not judged: the held rows' system is singular
+    Ns -= A.topRightCorner(nj, nh) * lu.solve(A.bottomLeftCorner(nh, nj));
+  }
+  return lcp::is_p_matrix(Ns) || lcp::is_p_matrix_on_independent_rows(Ns, Wf.topLeftCorner(nj, nj));
 }
 
 std::string friction_lcp_failure(const std::string& tried, const lcp::Result& res) {

@@ -9,6 +9,7 @@
 #include <lcsim/impact/impact.hpp>
 #include <lcsim/lcp/redundant.hpp>
 #include <limits>
+#include <optional>
 
 #include "impact/detail.hpp"
 
@@ -169,60 +170,6 @@ FrictionLcp cone_lcp(const MatrixXd& Wb, const VectorXd& rate_N, const VectorXd&
   return friction_cone_lcp(Wb, rate_N, rate_D, c.normal_of, c.first, c.d, c.mu);
 }
 
-// Painlevé-type cases (friction.cpp's painleve, with one edge per contact in
-// place of one sign): a contact alone with W_NN - mu max_i |W_N D_i| <= 0,
-// then the normal matrix W_NN + sum_f mu_f W_N D_(i_f) e_f' over every
-// choice of edges i_f while there are at most kMaxPatterns choices and
-// kMaxPatternNormals closed contacts. A choice whose normal matrix is not
-// a P-matrix only through sets of dependent normal rows (a box landing flat
-// on its four coplanar corners: W_NN of rank 3, every minor over the four
-// zero whatever the friction) is redundancy, not Painlevé: the impulse is
-// not unique there but the LCP below (Stewart and Trinkle's, which Lemke
-// solves for this class: Anitescu and Potra 1997) still gives the velocity,
-// checked on its result. "" when there is none.
-constexpr long kMaxPatterns = 256, kMaxPatternNormals = 12;
-
-std::string cone_painleve(const mech::MechanicalModel& m, const IndexSet& closed,
-                          const ClosedCone& c, const MatrixXd& W, const MatrixXd& WND) {
-  const std::string tail =
-      "; the friction impact LCP may have no solution or several (not resolved)";
-  long patterns = 1;
-  for (size_t f = 0; f < c.index.size(); ++f) {
-    const int j = c.normal_of[f], n = 2 * c.d[f];
-    Eigen::Index worst = 0;
-    const double w = WND.row(j).segment(c.first[f], n).cwiseAbs().maxCoeff(&worst);
-    const double mu = c.mu(static_cast<Eigen::Index>(f)), coef = W(j, j) - mu * w;
-    patterns = std::min(patterns * n, kMaxPatterns + 1);
-    // Relative to the terms that form it: below that it is zero to rounding.
-    if (coef > 1e-12 * (W(j, j) + mu * w)) continue;
-    const int row = closed[static_cast<size_t>(j)];
-    return text("Painlevé-type case at contact ", row, " ('", m.constraints[row],
-                "'): W_NN - mu max_i |W_N D_i| = ", W(j, j), " - ", mu, " * ", w, " = ", coef,
-                " <= 0, so friction on the edge ", static_cast<int>(worst),
-                " or its opposite presses the contact shut", tail);
-  }
-  if (c.index.empty() || patterns > kMaxPatterns || W.rows() > kMaxPatternNormals ||
-      (c.index.size() == 1 && W.rows() == 1))
-    return "";
-  for (long p = 0; p < patterns; ++p) {
-    MatrixXd Ns = W;
-    std::string which;
-    long rest = p;
-    for (size_t f = 0; f < c.index.size(); ++f) {
-      const int n = 2 * c.d[f], i = static_cast<int>(rest % n);
-      rest /= n;
-      Ns.col(c.normal_of[f]) += c.mu(static_cast<Eigen::Index>(f)) * WND.col(c.first[f] + i);
-      which += text(" ", closed[static_cast<size_t>(c.normal_of[f])], " (edge ", i, ")");
-    }
-    if (lcp::is_p_matrix(Ns) || lcp::is_p_matrix_on_independent_rows(Ns, W)) continue;
-    return "Painlevé-type case at contacts" + which +
-           ": with friction on these edges the normal matrix W_NN + W_ND diag(mu) has a "
-           "principal minor <= 0 on contacts of independent normal rows" +
-           tail;
-  }
-  return "";
-}
-
 // The friction impulse along t and t2 of contact f from its edge impulses.
 std::pair<double, double> tangential(const ClosedCone& c, size_t f, const VectorXd& beta) {
   double p1 = 0.0, p2 = 0.0;
@@ -232,6 +179,96 @@ std::pair<double, double> tangential(const ClosedCone& c, size_t f, const Vector
     p2 += sn * beta(c.first[f] + i);
   }
   return {p1, p2};
+}
+
+constexpr const char* kPainleveTail =
+    "; the friction impact LCP may have no solution or several (not resolved)";
+
+// The single-contact Painlevé test, before the LCP is solved: a contact
+// alone with W_NN - mu max_i |W_N D_i| <= 0 (friction on that edge presses
+// it shut whatever the others do). "" when there is none.
+std::string cone_painleve_alone(const mech::MechanicalModel& m, const IndexSet& closed,
+                                const ClosedCone& c, const MatrixXd& W, const MatrixXd& WND) {
+  for (size_t f = 0; f < c.index.size(); ++f) {
+    const int j = c.normal_of[f], n = 2 * c.d[f];
+    Eigen::Index worst = 0;
+    const double w = WND.row(j).segment(c.first[f], n).cwiseAbs().maxCoeff(&worst);
+    const double mu = c.mu(static_cast<Eigen::Index>(f)), coef = W(j, j) - mu * w;
+    // Relative to the terms that form it: below that it is zero to rounding.
+    if (coef > 1e-12 * (W(j, j) + mu * w)) continue;
+    const int row = closed[static_cast<size_t>(j)];
+    return text("Painlevé-type case at contact ", row, " ('", m.constraints[row],
+                "'): W_NN - mu max_i |W_N D_i| = ", W(j, j), " - ", mu, " * ", w, " = ", coef,
+                " <= 0, so friction on the edge ", static_cast<int>(worst),
+                " or its opposite presses the contact shut", kPainleveTail);
+  }
+  return "";
+}
+
+// The facet of maximal dissipation for contact f sliding at v (the one
+// friction takes against that sliding: cone_facet), or none when the
+// sliding is zero to the rounding of the terms of t'v, t2'v (scale: |v|
+// summed with the other velocity of the impact, as set_cone_outcomes).
+std::optional<ConeFacet> sliding_facet(const mech::MechanicalModel& m, const ClosedCone& c,
+                                       size_t f, const VectorXd& v, const VectorXd& vv) {
+  const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(c.index[f])];
+  const double u1 = fc.tangent.dot(v) - fc.velocity;
+  // d = 1 has no friction along t2: only the sliding along t counts.
+  const bool two = fc.is_3d() && c.d[f] > 1;
+  const double u2 = two ? fc.tangent2.dot(v) : 0.0;
+  double scale = fc.tangent.cwiseAbs().dot(vv) + std::abs(fc.velocity);
+  if (two) scale += fc.tangent2.cwiseAbs().dot(vv);
+  if (std::hypot(u1, u2) <= mech::zero_tolerance(scale)) return std::nullopt;
+  return cone_facet(u1, u2, c.d[f]);
+}
+
+// The Painlevé test on the solved LCP (issue 27: by solving, not by
+// enumerating every edge choice in advance). Each closed contact takes the
+// mode the solution gives it: sliding after the impact, its friction frozen
+// on the facet of maximal dissipation (sliding_facet: an edge D_i, or a
+// face's midpoint (D_i + D_(i+1))/2, at mu times the normal impulse),
+// whether or not it has a normal impulse (if pressed, that is the friction
+// it takes); else sticking, its rows t (and for d >= 2 the next edge, which
+// with t spans the tangent plane) held. detail::no_painleve_after_solve
+// judges the normal matrix of these modes (a P-matrix on contacts of
+// independent normal rows, the sticking rows eliminated); when it is not,
+// the impact is Painlevé-type in these modes (that LCP may have several
+// solutions or none) and is refused, naming the contacts and their modes.
+// Modes this impact does not take are not judged (before, every choice of
+// one edge per contact was, up to 256 choices, and none above: the
+// quadruped's landing at d = 1 was refused for a yaw it does not take).
+std::string cone_painleve_solved(const mech::MechanicalModel& m, const ImpactInput& in,
+                                 const ClosedCone& c, const MatrixXd& Wb, const VectorXd& v_after) {
+  const Eigen::Index nj = static_cast<Eigen::Index>(in.closed.size());
+  if (c.index.empty() || (c.index.size() == 1 && nj == 1)) return "";
+  MatrixXd slip = MatrixXd::Zero(Wb.rows(), nj);
+  std::vector<Eigen::Index> stick;
+  std::string which;
+  const VectorXd vv = in.v.cwiseAbs() + v_after.cwiseAbs();
+  for (size_t f = 0; f < c.index.size(); ++f) {
+    const int j = c.normal_of[f], n = 2 * c.d[f], first = c.first[f];
+    which += text(" ", in.closed[static_cast<size_t>(j)]);
+    const std::optional<ConeFacet> facet = sliding_facet(m, c, f, v_after, vv);
+    if (!facet) {
+      stick.push_back(nj + first);
+      if (c.d[f] > 1) stick.push_back(nj + first + 1);
+      which += " (stick)";
+      continue;
+    }
+    const double mu = c.mu(static_cast<Eigen::Index>(f));
+    const int i = facet->edge;
+    if (facet->face)
+      slip.col(j) += 0.5 * mu * (Wb.col(nj + first + i) + Wb.col(nj + first + (i + 1) % n));
+    else
+      slip.col(j) += mu * Wb.col(nj + first + i);
+    which += text(facet->face ? " (face " : " (edge ", i, ")");
+  }
+  if (detail::no_painleve_after_solve(Wb, nj, stick, slip)) return "";
+  return "Painlevé-type case at contacts" + which +
+         ": with friction in the modes of the impact LCP's solution the normal matrix "
+         "W_NN + W_ND diag(mu), the sticking rows eliminated, has a principal minor <= 0 on "
+         "contacts of independent normal rows" +
+         std::string(kPainleveTail);
 }
 
 // Impulses, outcomes and facets per constraint; planar contacts as
@@ -299,7 +336,8 @@ ImpactResult moreau_friction_cone(const ImpactInput& in, const lcp::Solver& solv
   Wb.topRightCorner(nj, ne) = s->EJ * MinvDt;
   Wb.bottomLeftCorner(ne, nj) = Wb.topRightCorner(nj, ne).transpose();
   Wb.bottomRightCorner(ne, ne) = c.D * MinvDt;
-  if (std::string p = cone_painleve(m, in.closed, c, s->W, Wb.topRightCorner(nj, ne)); !p.empty()) {
+  if (std::string p = cone_painleve_alone(m, in.closed, c, s->W, Wb.topRightCorner(nj, ne));
+      !p.empty()) {
     out.painleve = true;
     out.message = p;
     return out;
@@ -314,8 +352,13 @@ ImpactResult moreau_friction_cone(const ImpactInput& in, const lcp::Solver& solv
     return out;
   }
   const VectorXd lambda_N = res.z.head(nj), beta = res.z.segment(nj, ne);
-  const VectorXd v_after = in.v + s->MinvEt * lambda_N + MinvDt * beta;
   const double tiny = detail::friction_mode_threshold(*s);
+  const VectorXd v_after = in.v + s->MinvEt * lambda_N + MinvDt * beta;
+  if (std::string p = cone_painleve_solved(m, in, c, Wb, v_after); !p.empty()) {
+    out.painleve = true;
+    out.message = p;
+    return out;
+  }
   detail::finish(in, *s, lambda_N, v_after, tiny, out);
   set_cone_outcomes(m, in, c, lambda_N, beta, tiny, out);
   out.status = Status::kOk;

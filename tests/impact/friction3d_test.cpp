@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <lcsim/impact/impact.hpp>
 #include <random>
 #include <vector>
@@ -365,6 +366,84 @@ TEST(Friction3dImpact, PainleveCaseIsDiagnosedByName) {
     } else {
       EXPECT_FALSE(r.painleve) << r.message;
       EXPECT_TRUE(r.ok()) << r.message;
+    }
+  }
+}
+
+// Issue 27: the Painlevé test judges the modes of the solved impact, not
+// every edge choice in advance; with four contacts at d = 4 (8^4 = 4096
+// choices, above the 256 the enumeration took, so it judged nothing) it is
+// now judged. Two contacts coupled through M: coordinates (x1 y1 z1 x2 y2
+// z2), normals x1, x2, tangents (y_i, z_i), and M^-1 = I plus c between x1
+// and y2 and between x2 and y1 (blocks [1 c; c 1], positive definite for
+// |c| < 1): W_NN = I, W_N1 y1 = 0, W_N1 y2 = W_N2 y1 = c. Each contact alone
+// is never Painlevé (W_NN - mu max_i |W_N D_i| = 1), but friction along +y
+// at both (both sliding along -y) gives the normal matrix
+// [1 mu c; mu c 1], of determinant 1 - (mu c)^2 = -0.44 for mu c = 1.2: its
+// LCP with q = (-1, -1) (the approach) has three solutions, (1, 0), (0, 1)
+// and (1, 1)/(1 + mu c), a genuine Painlevé case, refused by name. Sliding
+// in opposite directions gives [1 -mu c; mu c 1] (determinant 1.44, a
+// P-matrix): solved, with the Coulomb law checked (expect_coulomb) and no
+// energy gain at e = 0. Two more point masses (x normal, d = 4) slide and
+// land beside them, so that four contacts take part. Sliding speeds of
+// 10 m/s against normal impulses of order 1 N s (approach 1 m/s, W_NN = I)
+// keep every contact sliding through the impact.
+TEST(Friction3dImpact, PainleveIsJudgedOnTheSolvedModesWithManyContacts) {
+  const double c = 0.8, mu = 1.5;
+  Eigen::MatrixXd Minv = Eigen::MatrixXd::Identity(12, 12);
+  Minv(0, 4) = Minv(4, 0) = Minv(3, 1) = Minv(1, 3) = c;
+  const Eigen::MatrixXd M = Minv.inverse();
+  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(4, 12);
+  for (int i = 0; i < 4; ++i) E(i, 3 * i) = 1.0;
+  for (const double sign2 : {1.0, -1.0}) {
+    mech::MechanicalModel model = testing::make_model(M, E);
+    for (int i = 0; i < 4; ++i) {
+      VectorXd t = VectorXd::Zero(12), t2 = VectorXd::Zero(12);
+      t(3 * i + 1) = 1.0, t2(3 * i + 2) = 1.0;
+      mech::FrictionalContact fc(i, t, i < 2 ? mu : 0.5);
+      fc.tangent2 = t2.sparseView();
+      fc.edges = 4;
+      model.friction.push_back(fc);
+    }
+    ASSERT_FALSE(mech::check_mechanical(model));
+    VectorXd v = VectorXd::Zero(12);
+    v(0) = v(3) = v(6) = v(9) = -1.0;  // every normal approaches
+    v(1) = -10.0, v(4) = -10.0 * sign2;
+    v(7) = 2.0, v(8) = 1.0, v(10) = -1.0, v(11) = 3.0;
+    const ImpactResult r = by("cone", model, v, VectorXd::Zero(4));
+    const std::string at = sign2 > 0 ? "both along -y" : "opposite";
+    // The matrix of the frozen slips, from M^-1 (independently of the law).
+    Eigen::Matrix2d Ns;
+    Ns << Minv(0, 0), mu * Minv(0, 4) * sign2, mu * Minv(3, 1), Minv(3, 3);
+    if (sign2 > 0) {
+      EXPECT_NEAR(Ns.determinant(), 1 - 1.44, 1e-12);
+      EXPECT_TRUE(r.painleve) << at << ": " << r.message;
+      EXPECT_FALSE(r.ok()) << at;
+      EXPECT_NE(r.message.find("Painlevé-type case at contacts 0 (edge 0) 1 (edge 0)"),
+                std::string::npos)
+          << r.message;
+      // The three solutions of the frozen normal LCP w = Ns l + q >= 0, l >= 0.
+      for (const Eigen::Vector2d& l : {Eigen::Vector2d(1, 0), Eigen::Vector2d(0, 1),
+                                       Eigen::Vector2d(Eigen::Vector2d(1, 1) / (1 + mu * c))}) {
+        const Eigen::Vector2d w = Ns * l - Eigen::Vector2d(1, 1);
+        EXPECT_GE(w.minCoeff(), -1e-12);
+        EXPECT_LE(std::abs(w.dot(l)), 1e-12);
+      }
+    } else {
+      EXPECT_NEAR(Ns.determinant(), 1 + 1.44, 1e-12);
+      ASSERT_TRUE(r.ok()) << at << ": " << r.message;
+      EXPECT_FALSE(r.painleve);
+      EXPECT_LE(r.energy_after, r.energy_before * (1 + 1e-12));
+      expect_coulomb(model, v, r);
+      // Still sliding after it (friction from contact 0 can push contact 1
+      // open: no normal impulse there).
+      for (int i = 0; i < 4; ++i) {
+        const ContactOutcome o = r.outcome[static_cast<size_t>(i)];
+        EXPECT_TRUE(o == ContactOutcome::kSlip || (i < 2 && o == ContactOutcome::kNoImpulse))
+            << "contact " << i << ": " << to_string(o);
+      }
+      std::printf("[ painleve ] opposite slips: outcomes %s %s %s %s\n", to_string(r.outcome[0]),
+                  to_string(r.outcome[1]), to_string(r.outcome[2]), to_string(r.outcome[3]));
     }
   }
 }

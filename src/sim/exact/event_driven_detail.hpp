@@ -31,6 +31,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <utility>
@@ -306,6 +307,8 @@ class EventDriven {
   // frictionless models).
   Phase make_phase(const lcs::IndexSet& mode, const std::vector<FrictionMode>& friction,
                    const lcs::IndexSet& undetermined, const VectorXd& xa, std::string& err) const;
+  Phase build_phase(const lcs::IndexSet& mode, const std::vector<FrictionMode>& friction,
+                    const lcs::IndexSet& undetermined, const VectorXd& xa, std::string& err) const;
   // Friction (friction_phase.cpp, friction_modes.cpp).
   void init_friction();
   bool friction_feedback(Phase& ph, const VectorXd& xa, std::string& err) const;
@@ -550,6 +553,17 @@ class EventDriven {
   double rho_A_ = 0.0;  // bound on the spectral radius of the free dynamics
   mutable std::map<lcs::IndexSet, lcs::ModeFeedback> feedback_cache_;
   mutable std::map<std::pair<lcs::IndexSet, std::vector<FrictionMode>>, double> rho_cache_;
+  // The last phase built without error and its arguments (make_phase): a
+  // selection at an event builds its chosen phase to check it, and the
+  // caller then asks for the same one (the same mode, friction modes,
+  // undetermined set and state, bit for bit), which is returned as built.
+  struct PhaseMemo {
+    lcs::IndexSet mode, undetermined;
+    std::vector<FrictionMode> friction;
+    VectorXd xa;
+    Phase phase;
+  };
+  mutable std::optional<PhaseMemo> phase_memo_;
   std::map<std::pair<lcs::IndexSet, std::vector<FrictionMode>>, StepExp> step_cache_;
   // The cache entry for `phase`'s samples on a grid of step dt, reset when
   // its Ab or dt differ (a frictional mode's feedback depends on the state).

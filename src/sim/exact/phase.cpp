@@ -109,6 +109,23 @@ VectorXd Phase::expv(double tau, const VectorXd& z) const {
 Phase EventDriven::make_phase(const lcs::IndexSet& mode, const std::vector<FrictionMode>& friction,
                               const lcs::IndexSet& undetermined, const VectorXd& xa,
                               std::string& err) const {
+  // The state compared exactly (NaN never matches): a phase's monitors are
+  // scaled by it, so only the very same state gives the very same phase.
+  const PhaseMemo* m = phase_memo_ ? &*phase_memo_ : nullptr;
+  if (m && m->mode == mode && m->friction == friction && m->undetermined == undetermined &&
+      m->xa.size() == xa.size() && (m->xa.array() == xa.array()).all())
+    return m->phase;
+  Phase ph = build_phase(mode, friction, undetermined, xa, err);
+  if (err.empty())
+    phase_memo_ = PhaseMemo{mode, undetermined, friction, xa, ph};
+  else
+    phase_memo_.reset();
+  return ph;
+}
+
+Phase EventDriven::build_phase(const lcs::IndexSet& mode, const std::vector<FrictionMode>& friction,
+                               const lcs::IndexSet& undetermined, const VectorXd& xa,
+                               std::string& err) const {
   Phase ph;
   ph.mode = mode;
   ph.friction = friction;
