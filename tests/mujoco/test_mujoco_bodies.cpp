@@ -1,0 +1,176 @@
+// MuJoCo (src/mujoco/mjcf_bodies.cpp) on scenes of several bodies, and the
+// friction multipliers of its samples, against closed forms.
+//
+// Tolerances from MuJoCo's soft contact, as tests/mujoco/test_mujoco_contacts.cpp
+// derives them: with margin 0 a contact exists only once its geoms overlap
+// at the start of a step, so the first contact force is in the step after
+// the crossing, within 2 h of the exact impact. At rest a contact carrying
+// f sinks by r = R f / k with R = (1 - d) / d A_ii (A_ii the row's inverse
+// inertia) and MuJoCo's stiffness k = d / (dmax^2 tc^2 zeta^2): r = f (1 -
+// d) A_ii dmax^2 tc^2 zeta^2 / d^2, tc = 2 h = 2 ms, zeta = 1, dmax = 0.95,
+// and d = dmin = 0.9 at a penetration of microns (solimp's width is 1 mm:
+// d rises above dmin by 2 (dmax - dmin) (r / width)^2 < 1e-6).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <lcsim/bullet/bullet.hpp>
+#include <lcsim/mujoco/mujoco.hpp>
+#include <lcsim/scene/scene.hpp>
+#include <lcsim/sim/sim.hpp>
+#include <stdexcept>
+
+namespace lcsim::mujoco {
+namespace {
+
+const std::string kRobots = std::string(LCSIM_SOURCE_DIR) + "/robots/";
+const std::string kData = std::string(LCSIM_SOURCE_DIR) + "/tests/bullet/data/";
+constexpr double kG = 9.81;
+
+sim::Options options(const mech::Model& m, double h) {
+  sim::Options o;
+  o.t_end = m.t_end;
+  o.h = h;
+  o.dt_out = h;
+  return o;
+}
+
+double first_contact(const sim::Trajectory& tr, int row) {
+  for (const auto& e : tr.events)
+    if (std::find(e.mode_after.begin(), e.mode_after.end(), row) != e.mode_after.end()) return e.t;
+  return NAN;
+}
+
+TEST(MujocoBodies, BallDroppedOntoATableMeetsItAtTheFreeFallTime) {
+  const mech::Model m = scene::load_model(kData + "ball_table_scene.yaml");
+  const double h = 1e-3;
+  const sim::Trajectory tr = simulate_mujoco(m, m.initial, options(m, h));
+  ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
+  const double t_star = std::sqrt(2.0 * 0.25 / kG);
+  const double t_mj = first_contact(tr, 0);
+  std::printf("[ mujoco   ] ball on table: first contact %.6g (exact %.6g), rest z %.9g\n", t_mj,
+              t_star, tr.final_state(2));
+  EXPECT_GT(t_mj, t_star);
+  EXPECT_LE(t_mj, t_star + 2 * h);
+  // Rests on the table top: f = m g = 9.81 N, the ball's A_ii = 1 / m = 1
+  // 1/kg (its centre on the normal: no lever): r = 9.81 * 0.1 * 0.9025 *
+  // 4e-6 / 0.81 = 4.37211e-6 m, d's rise above dmin making it smaller by a
+  // relative 1e-6 at most; 1e-9 m is MuJoCo's rest to its solver's
+  // tolerance (1e-8 of the force) and more.
+  const double sink = 0.65 - tr.final_state(2);
+  EXPECT_NEAR(sink, 9.81 * 0.1 * 0.9025 * 4e-6 / 0.81, 1e-9);
+  EXPECT_NEAR(tr.final_state(0), 0.0, 1e-12);  // falls straight: no lateral force
+  EXPECT_NEAR(tr.final_state(1), 0.0, 1e-12);
+}
+
+TEST(MujocoBodies, GripperClosesOnTheBoxWithinTwoStepsOfTheExactRun) {
+  const mech::Model m = scene::load_model(kRobots + "gripper_box_scene.yaml");
+  const double h = 1e-3;
+  sim::Options o = options(m, h);
+  const auto event = sim::make_integrator("event");
+  const sim::Trajectory ex = event->run(m, m.initial, sim::keep_used(o, event->options_used()));
+  ASSERT_EQ(ex.status, sim::RunStatus::kCompleted) << ex.message;
+  const sim::Trajectory mj = simulate_mujoco(m, m.initial, o);
+  ASSERT_EQ(mj.status, sim::RunStatus::kCompleted) << mj.message;
+  // Each finger (q = 0.05 + 0.1 cos(20 t)) meets the box's face at q = 0.11 m.
+  const double t_star = std::acos(0.6) / 20.0;
+  const auto& c = m.mechanical->constraints;
+  for (const char* tip : {"left_tip.sphere0", "right_tip.sphere0"}) {
+    const int row = static_cast<int>(std::find(c.begin(), c.end(), tip) - c.begin());
+    ASSERT_LT(row, static_cast<int>(c.size())) << tip;
+    EXPECT_GT(first_contact(mj, row), t_star) << tip;
+    EXPECT_LE(first_contact(mj, row), t_star + 2 * h) << tip;
+  }
+  // Both settle squeezing the box: the final states differ by the soft
+  // contacts' sinks (above): the fingers' f = 2.4 N with A_ii = 1 / 0.1 +
+  // 1 / 1.2 = 10.8 1/kg (the tips at the box's centre height: no lever),
+  // r = 2.4 * 0.1 * 10.8 * 3.61e-6 / 0.81 = 1.2e-5 m; the box's corners on
+  // the floor, f <= m g = 11.8 N, A_ii <= 5.08 1/kg
+  // (test_mujoco_contacts.cpp): r <= 2.7e-5 m.
+  const bullet::Comparison cmp = bullet::compare_trajectories(ex, mj, 1e-12);
+  std::printf("[ mujoco   ] gripper: final difference %.3e\n", cmp.error_final);
+  EXPECT_LE(cmp.error_final, 2.7e-5);
+}
+
+// Sums of the friction entries' multipliers along t1 and t2, and of the
+// normal multipliers, at sample s.
+struct Totals {
+  double t1 = 0.0, t2 = 0.0, n = 0.0;
+};
+Totals totals(const sim::Sample& s) {
+  Totals out;
+  if (s.u_t.size() > 0) out.t1 = s.u_t.sum();
+  if (s.u_t2.size() > 0) out.t2 = s.u_t2.sum();
+  out.n = s.u.sum();
+  return out;
+}
+
+// The box sliding on the floor (tests/bullet/data/box_slide_bodies_scene.yaml):
+// the floor's friction on it is along +t2 = -x, against the velocity, and
+// on the cone's boundary while it slides, so each step's u_t2 is mu times
+// its u_n (MuJoCo's pyramidal and elliptic cones agree along a tangent);
+// u_t1 is zero (nothing pushes across). The multipliers are the whole
+// horizontal force on the box, so their impulse is its momentum change,
+// sum h u_t2 = m (v0 - v_x(T)), to rounding (500 steps of O(1) N: 1e-12
+// N s). The closed form -mu m g holds on average: MuJoCo's soft contacts
+// let the box hop, so u_n is m g only on average, and the box sticks when
+// the impulse reaches m v0, at v0 / (mu g) = 0.33979 s, which MuJoCo's
+// run meets to its step and the hop's (measured 0.340; 2e-3 s asserted).
+TEST(MujocoBodies, SlidingBoxFeelsMuMgAgainstItsVelocity) {
+  const mech::Model m = scene::load_model(kData + "box_slide_bodies_scene.yaml");
+  const double h = 1e-3, mu = 0.3, mass = 1.2, v0 = 1.0;
+  for (Settings::Cone cone : {Settings::Cone::kPyramidal, Settings::Cone::kElliptic}) {
+    Settings s;
+    s.cone = cone;
+    const sim::Trajectory tr = simulate_mujoco(m, m.initial, options(m, h), s);
+    ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
+    ASSERT_EQ(tr.samples.back().u_t.size(), 8);  // the box's eight corners
+    ASSERT_EQ(tr.samples.back().u_t2.size(), 8);
+    double coulomb = 0.0, across = 0.0, impulse = 0.0, t_stop = NAN;
+    int sliding = 0;
+    for (std::size_t j = 1; j < tr.samples.size(); ++j) {
+      const sim::Sample& smp = tr.samples[j];
+      const Totals f = totals(smp);
+      impulse += h * f.t2;
+      across = std::max(across, std::abs(f.t1));
+      if (std::isnan(t_stop) && smp.x(6) < 1e-3) t_stop = smp.t;
+      if (smp.x(6) < 0.05) continue;  // sliding: v_x well above 0
+      coulomb = std::max(coulomb, std::abs(f.t2 - mu * f.n));
+      ++sliding;
+    }
+    const double v_end = tr.final_state(6);
+    std::printf(
+        "[ mujoco   ] %s: |u_t2 - mu u_n| <= %.3e N over %d sliding steps, |u_t1| <= "
+        "%.3e N, impulse %.12g N s (m (v0 - v_end) = %.12g), stop %.6g s (closed form "
+        "%.6g)\n",
+        cone_name(cone).c_str(), coulomb, sliding, across, impulse, mass * (v0 - v_end), t_stop,
+        v0 / (mu * kG));
+    EXPECT_GT(sliding, 250);
+    EXPECT_LE(coulomb, 1e-12);  // rounding of O(1) N
+    EXPECT_LE(across, 1e-9);    // MuJoCo's solver tolerance (1e-8) of O(0.1) N
+    EXPECT_NEAR(impulse, mass * (v0 - v_end), 1e-12);
+    EXPECT_NEAR(t_stop, v0 / (mu * kG), 2e-3);
+  }
+}
+
+TEST(MujocoBodies, RefusesAJointStopInOneLine) {
+  const std::string path = ::testing::TempDir() + "/stop_bodies.yaml";
+  std::ofstream(path) << "bodies:\n  - {name: gripper, urdf: " << kRobots
+                      << "two_finger_gripper.urdf, joints: [{name: left}, {name: right}]}\n"
+                      << "  - {name: ball, urdf: " << kData
+                      << "ball.urdf, base: {type: floating, pose: {xyz: [0, 0.5, 0]}}}\n"
+                      << "t_end: 0.1\n";
+  const mech::Model m = scene::load_model(path);
+  try {
+    check_expressible(m);
+    FAIL() << "a joint stop is not a contact";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("is not a contact"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+}
+
+}  // namespace
+}  // namespace lcsim::mujoco
