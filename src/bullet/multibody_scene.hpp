@@ -2,6 +2,8 @@
 // by simulate_bullet (world.cpp) for models from URDF scenes.
 #pragma once
 
+#include <BulletDynamics/ConstraintSolver/btContactSolverInfo.h>
+
 #include <Eigen/Dense>
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
@@ -41,6 +43,27 @@ std::string multibody_description(const WorldSettings& s, bool contacts = false,
 sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene& setup,
                                    const std::vector<JointLimit>& limits, const Eigen::VectorXd& x0,
                                    const sim::Options& opt, const WorldSettings& s);
+
+// The solver settings both multibody scenes pin (multibody_world.cpp's
+// header): iterations, ERP = limit_erp, CFM 0, SOR 1, no split impulse, no
+// early exit, slop 0, warm starting without the articulated one, and with
+// `friction` WorldSettings::friction's flags.
+void pin_solver_info(btContactSolverInfo& info, const WorldSettings& s, bool friction);
+
+// ---- A scene of several bodies (bodies_world.cpp) ----
+
+// Why Bullet cannot run the scene of bodies, or "": a mimic joint.
+std::string bodies_refusal(const scene::Scene& setup);
+// The scene's rows that are not contacts as joint limits (joint_limits_of);
+// std::invalid_argument for a row on a floating base's coordinate.
+std::vector<JointLimit> bodies_joint_limits(const mech::MechanicalModel& m,
+                                            const scene::Scene& setup);
+// "one btMultiBody per body, ..." with the solver's and the contacts' settings.
+std::string bodies_description(const WorldSettings& s, bool friction);
+// The scene of bodies run in Bullet (bodies_world.cpp says how). Never throws.
+sim::Trajectory simulate_bodies(const mech::Model& model, const scene::Scene& setup,
+                                const std::vector<JointLimit>& limits, const Eigen::VectorXd& x0,
+                                const sim::Options& opt, const WorldSettings& s);
 
 }  // namespace lcsim::bullet
 

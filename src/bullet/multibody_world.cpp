@@ -159,20 +159,7 @@ std::unique_ptr<MbWorld> make_world(const scene::Scene& setup, const WorldSettin
   w->world = std::make_unique<btMultiBodyDynamicsWorld>(w->dispatcher.get(), w->broadphase.get(),
                                                         w->solver.get(), w->config.get());
   w->world->setGravity(btVector3(setup.gravity.x(), setup.gravity.y(), setup.gravity.z()));
-  btContactSolverInfo& info = w->world->getSolverInfo();
-  info.m_numIterations = s.solver_iterations;
-  info.m_erp = s.limit_erp;
-  info.m_erp2 = s.limit_erp;
-  info.m_globalCfm = 0.0;
-  info.m_sor = 1.0;
-  info.m_splitImpulse = 0;
-  info.m_leastSquaresResidualThreshold = 0.0;
-  info.m_linearSlop = 0.0;  // Bullet's default; contacts: penetration = distance + slop
-  info.m_solverMode = SOLVER_USE_WARMSTARTING | SOLVER_SIMD;  // no articulated warm start
-  if (friction && s.friction != WorldSettings::Friction::kOneDirection)
-    info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
-  if (friction && s.friction == WorldSettings::Friction::kBox)
-    info.m_solverMode |= SOLVER_DISABLE_IMPLICIT_CONE_FRICTION;
+  pin_solver_info(w->world->getSolverInfo(), s, friction);
   return w;
 }
 
@@ -371,6 +358,22 @@ void limit_impulses(MbWorld& w, const std::vector<JointLimit>& limits, VectorXd&
 }
 
 }  // namespace
+
+void pin_solver_info(btContactSolverInfo& info, const WorldSettings& s, bool friction) {
+  info.m_numIterations = s.solver_iterations;
+  info.m_erp = s.limit_erp;
+  info.m_erp2 = s.limit_erp;
+  info.m_globalCfm = 0.0;
+  info.m_sor = 1.0;
+  info.m_splitImpulse = 0;
+  info.m_leastSquaresResidualThreshold = 0.0;
+  info.m_linearSlop = 0.0;  // Bullet's default; contacts: penetration = distance + slop
+  info.m_solverMode = SOLVER_USE_WARMSTARTING | SOLVER_SIMD;  // no articulated warm start
+  if (friction && s.friction != WorldSettings::Friction::kOneDirection)
+    info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
+  if (friction && s.friction == WorldSettings::Friction::kBox)
+    info.m_solverMode |= SOLVER_DISABLE_IMPLICIT_CONE_FRICTION;
+}
 
 std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m, const std::string& source,
                                         const scene::Scene* setup) {

@@ -41,9 +41,14 @@ class RunRecorder {
                    const Eigen::VectorXd& v, const Eigen::VectorXd& impulse, double tiny);
   // Final state and energy.
   void finish();
+  // The next step's friction impulses on each contact row's point along its
+  // tangents t1, t2 (N s, by row of E): that step's sample gives each
+  // friction entry's (mech::MechanicalModel::friction) u_t and, for 3-D
+  // friction, u_t2 (the impulse / h). Without it a sample has none.
+  void friction(const Eigen::VectorXd& t1, const Eigen::VectorXd& t2);
 
  private:
-  void record(double t, const Eigen::VectorXd& u);
+  void record(double t, const Eigen::VectorXd& u, double h = 0.0);
   const mech::MechanicalModel& m_;
   const sim::Options& opt_;
   sim::Trajectory& tr_;
@@ -52,6 +57,7 @@ class RunRecorder {
   Eigen::VectorXd q_, v_, y_;
   double t_ = 0.0;  // time of (q_, v_), the last step recorded (s)
   sim::IndexSet mode_;
+  Eigen::VectorXd ft1_, ft2_;  // friction(): the step's tangential impulses by row
 };
 
 }  // namespace lcsim::bullet
