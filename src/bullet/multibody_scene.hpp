@@ -101,11 +101,12 @@ struct ContactColliders {
   std::vector<std::unique_ptr<btCollisionShape>> shapes;
   std::map<int, btCollisionShape*> shape_of;  // Bullet link -> its compound
   std::vector<std::unique_ptr<btCollisionObject>> planes;
-  std::map<std::pair<int, int>, int> row_of;  // (Bullet link, compound child) -> row of E
-  std::map<int, double> restitution_of;       // Bullet link -> the largest e of its points
-  std::map<int, double> friction_of;          // Bullet link -> its points' mu (one per link)
-  bool friction = false;                      // some contact has friction
-  int rows = 0;                               // contact rows
+  std::map<std::pair<int, int>, int> row_of;    // (Bullet link, compound child) -> row of E
+  std::map<int, double> restitution_of;         // Bullet link -> the largest e of its points
+  std::map<int, double> friction_of;            // Bullet link -> its points' mu (one per link)
+  bool friction = false;                        // some contact has friction
+  int rows = 0;                                 // contact rows
+  std::map<int, Eigen::Vector3d> t1_of, t2_of;  // row -> its world tangents (scene::ContactFrame)
 };
 // Collision filter groups of links with contacts and of planes.
 constexpr int kContactLinkGroup = 1 << 6, kPlaneGroup = 1 << 7;
@@ -126,6 +127,11 @@ std::string link_friction_error(const scene::Scene& setup, const mech::Mechanica
 // (size k, by row of E), from the dispatcher's manifolds.
 void contact_impulses(btCollisionDispatcher& d, const ContactColliders& c,
                       Eigen::VectorXd& impulse);
+// The step's friction impulses on each contact point along its row's
+// tangents t1, t2 (N s, by row of E; zero elsewhere): Bullet's lateral
+// impulses act on the manifold's body A along its friction directions.
+void contact_friction_impulses(btCollisionDispatcher& d, const ContactColliders& c,
+                               Eigen::VectorXd& t1, Eigen::VectorXd& t2);
 
 // A btCollisionDispatcher whose manifolds keep points up to `threshold` (m)
 // apart (Bullet's default is 0.02 times the shapes' bounding radius): a

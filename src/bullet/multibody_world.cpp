@@ -477,7 +477,7 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene&
   }
   RunRecorder rec(model, opt, tr, q, v);
   const sim::StepGrid grid = sim::StepGrid::of(*opt.t_end, opt.h);
-  VectorXd tau(N), q_next(N), v_next(N), impulse(k);
+  VectorXd tau(N), q_next(N), v_next(N), impulse(k), t1(k), t2(k);
   for (long j = 1; j <= grid.n; ++j) {
     const bool last = j == grid.n;
     if (opt.progress && j % sim::Options::kProgressSteps == 0) opt.progress(j * opt.h);
@@ -485,6 +485,10 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene&
     tau = f_s - K_s * q - D * v;
     step(*w, q, tau, h, q_next, v_next);
     limit_impulses(*w, limits, impulse);
+    if (w->contacts.friction) {  // each contact's friction along its tangents
+      contact_friction_impulses(*w->dispatcher, w->contacts, t1, t2);
+      rec.friction(t1, t2);
+    }
     // Round-off in an impulse is ~1e-16 of the momentum; real ones are O(h).
     const double tiny =
         1e-10 * (1.0 + (m.M * v).cwiseAbs().maxCoeff() + h * tau.cwiseAbs().maxCoeff());

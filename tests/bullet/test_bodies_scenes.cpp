@@ -140,6 +140,29 @@ TEST(BulletBodies, SlidingBoxFeelsMuMgAgainstItsVelocity) {
   }
 }
 
+// The legged robot (robots/vision60_drop_scene.yaml, a one-body `bodies:`
+// scene: floating base, 12 PD-held joints) dropped 0.03 m: free fall is a
+// rigid translation, so its four toes land together at sqrt(2 h / g) =
+// 0.0782 s, Bullet's within 1.5 steps (above). Its dampers (20 N m s/rad
+// on light legs) are explicit joint torques in Bullet, stable only for h
+// below 6.7e-4 s (the run's own warning): at h = 1e-3 the run must end as a
+// numerical failure, never completed; at h = 1e-4 it lands.
+TEST(BulletBodies, LeggedRobotLandsOnItsFourToesAtTheFreeFallTime) {
+  const mech::Model m = scene::load_model(kRobots + "vision60_drop_scene.yaml");
+  sim::Options o = options(m, 1e-3);
+  o.t_end = 0.15;
+  const sim::Trajectory coarse = simulate_bullet(m, m.initial, o);
+  EXPECT_EQ(coarse.status, sim::RunStatus::kNumericalFailure) << coarse.message;
+  o.h = o.dt_out = 1e-4;
+  const sim::Trajectory tr = simulate_bullet(m, m.initial, o);
+  ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
+  const double t_star = std::sqrt(2.0 * 0.03 / kG);
+  for (int toe = 0; toe < 4; ++toe) {
+    EXPECT_LE(std::abs(first_contact(tr, toe) - t_star), 1.5 * o.h) << "toe " << toe;
+    EXPECT_EQ(first_contact(tr, toe), first_contact(tr, 0)) << "toe " << toe;
+  }
+}
+
 // A body Bullet's model of a scene of bodies cannot hold (a mimic joint) is
 // refused before anything runs, in one line naming the body and the joint.
 TEST(BulletBodies, RefusesAMimicJointInOneLine) {
