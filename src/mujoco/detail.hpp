@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <lcsim/scene/scene.hpp>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -34,6 +35,16 @@ MjModelPtr load_scene_model(const scene::Scene& setup);
 // compiles from it (std::invalid_argument naming the body and the joint or
 // shape it cannot hold, or with MuJoCo's message).
 std::string bodies_mjcf(const scene::Scene& setup);
+// A joint stop of a scene of bodies as a MuJoCo joint range: the rows of E
+// that are not contacts and hold one coordinate, c q_j + g >= 0, the bound
+// -g / c below (c > 0) or above (c < 0); the other side 1e6 away (m or rad)
+// when the scene has none. By coordinate name (the MJCF joint's).
+struct JointRange {
+  double lower = -1e6, upper = 1e6;
+  int lower_row = -1, upper_row = -1;           // rows of E, -1: none
+  double lower_scale = 1.0, upper_scale = 1.0;  // |c|: the row's multiplier is the force / |c|
+};
+std::map<std::string, JointRange> joint_ranges(const scene::Scene& setup);
 MjModelPtr load_bodies_model(const scene::Scene& setup);
 // The names of what that model adds: contact row r's point geom, another
 // body's shape's geom (scene::BodyShape::name), a floating body's free joint.

@@ -86,6 +86,7 @@ std::string inertial(const urdf::Link& link) {
 struct Composer {
   const scene::Scene& setup;
   const LinkGeoms& geoms;
+  const std::map<std::string, JointRange>& ranges;  // by coordinate name
   std::string xml;
 
   // The link `name` of body b and its subtree; `X` its frame in the parent's.
@@ -116,9 +117,14 @@ struct Composer {
         moves && std::find(body.joints.begin(), body.joints.end(), j.name) != body.joints.end();
     std::string joint;
     if (simulated) {
-      joint = "<joint name=\"" + body.name + "." + j.name + "\" type=\"" +
+      const std::string name = body.name + "." + j.name;
+      std::string range;
+      if (const auto r = ranges.find(name); r != ranges.end())
+        range = " limited=\"true\" range=\"" + format_number(r->second.lower) + " " +
+                format_number(r->second.upper) + "\"";
+      joint = "<joint name=\"" + name + "\" type=\"" +
               (j.type == urdf::Joint::PRISMATIC ? "slide" : "hinge") + "\" pos=\"0 0 0\" axis=\"" +
-              triple(axis) + "\"/>\n";
+              triple(axis) + "\"" + range + "/>\n";
     } else if (moves) {  // frozen at its q0
       const auto it = body.q0.find(j.name);
       const double q = it == body.q0.end() ? 0.0 : it->second;
@@ -167,9 +173,40 @@ std::string row_geom_name(Eigen::Index row) { return "lcsim_c" + std::to_string(
 std::string shape_geom_name(const std::string& shape) { return "lcsim_s:" + shape; }
 std::string base_joint_name(const std::string& body) { return "lcsim_base:" + body; }
 
+std::map<std::string, JointRange> joint_ranges(const scene::Scene& setup) {
+  const mech::MechanicalModel& m = *setup.model.mechanical;
+  std::vector<bool> contact(static_cast<std::size_t>(m.num_constraints()), false);
+  for (const scene::ContactFrame& cf : setup.contacts)
+    contact[static_cast<std::size_t>(cf.row)] = true;
+  std::map<std::string, JointRange> out;
+  for (int i = 0; i < m.num_constraints(); ++i) {
+    if (contact[static_cast<std::size_t>(i)]) continue;
+    int coordinate = -1, count = 0;
+    for (int j = 0; j < m.dofs(); ++j)
+      if (m.E.coeff(i, j) != 0.0) {
+        coordinate = j;
+        ++count;
+      }
+    if (count != 1) continue;  // refused by check_expressible
+    const double c = m.E.coeff(i, coordinate), bound = -m.g(i) / c;
+    JointRange& r = out[m.coordinates[static_cast<std::size_t>(coordinate)]];
+    if (c > 0.0) {
+      r.lower = bound;
+      r.lower_row = i;
+      r.lower_scale = c;
+    } else {
+      r.upper = bound;
+      r.upper_row = i;
+      r.upper_scale = -c;
+    }
+  }
+  return out;
+}
+
 std::string bodies_mjcf(const scene::Scene& setup) {
   const LinkGeoms geoms = contact_geoms(setup);
-  Composer c{setup, geoms, ""};
+  const std::map<std::string, JointRange> ranges = joint_ranges(setup);
+  Composer c{setup, geoms, ranges, ""};
   c.xml =
       "<mujoco model=\"lcsim\">\n<compiler angle=\"radian\" inertiafromgeom=\"false\" "
       "fusestatic=\"false\"/>\n<worldbody>\n";

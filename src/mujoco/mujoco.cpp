@@ -123,9 +123,10 @@ std::string friction_refusal(const mech::MechanicalModel& m, const scene::Scene&
 }
 
 // What a scene of bodies cannot have in MuJoCo (mjcf_bodies.cpp), or "":
-// a constraint that is not a contact (a joint stop), friction that is not a
-// scene contact's, a mimic joint. Each contact point is a geom of its own,
-// so explicit points, frozen joints and one mu per pair are fine.
+// a constraint that is neither a contact nor a stop on one joint (a joint
+// range in MuJoCo), friction that is not a scene contact's, a mimic joint.
+// Each contact point is a geom of its own, so explicit points, frozen joints
+// and one mu per pair are fine.
 std::string bodies_refusal(const mech::MechanicalModel& m, const scene::Scene& sc,
                            const std::vector<bool>& contact) {
   for (const mech::FrictionalContact& f : m.friction)
@@ -133,10 +134,20 @@ std::string bodies_refusal(const mech::MechanicalModel& m, const scene::Scene& s
       return "constraint '" + m.constraints[static_cast<std::size_t>(f.contact)] +
              "' has friction that is not a scene contact's: MuJoCo runs the friction of "
              "contacts: only";
-  for (int i = 0; i < m.num_constraints(); ++i)
-    if (!contact[static_cast<std::size_t>(i)])
+  for (int i = 0; i < m.num_constraints(); ++i) {
+    if (contact[static_cast<std::size_t>(i)]) continue;
+    std::vector<int> nz;
+    for (int j = 0; j < m.dofs(); ++j)
+      if (m.E.coeff(i, j) != 0.0) nz.push_back(j);
+    bool on_base = false;
+    for (const scene::SceneBody& b : sc.bodies)
+      if (nz.size() == 1 && b.base.floating && nz[0] >= b.offset && nz[0] < b.offset + 6)
+        on_base = true;
+    if (nz.size() != 1 || on_base)
       return "constraint '" + m.constraints[static_cast<std::size_t>(i)] +
-             "' is not a contact: MuJoCo runs contacts only";
+             "' is not a contact nor a stop on one joint: MuJoCo runs contacts and joint ranges "
+             "only";
+  }
   for (const scene::SceneBody& b : sc.bodies)
     for (const auto& [name, j] : b.urdf->joints_)
       if (j->mimic)

@@ -10,6 +10,7 @@
 #include <lcsim/mujoco/mujoco.hpp>
 #include <lcsim/scene/scene.hpp>
 #include <lcsim/scene/so3.hpp>
+#include <map>
 #include <optional>
 #include <stdexcept>
 
@@ -50,6 +51,8 @@ struct Run {
   // Each contact row's world tangents (scene::ContactFrame), for the friction
   // multipliers.
   std::vector<Vector3d> row_t1, row_t2;
+  // A scene of bodies' joint stops by MuJoCo joint id (joint_ranges).
+  std::map<int, JointRange> stops;
 };
 
 int id_or_throw(const mjModel* m, int type, const std::string& name, const char* what) {
@@ -137,8 +140,15 @@ void configure(Run& r, const scene::Scene& setup, const mech::MechanicalModel& m
     m->dof_frictionloss[j] = 0.0;
   }
   for (int j = 0; j < m->njnt; ++j) {
-    m->jnt_limited[j] = 0;
+    // A scene of bodies' joints have the ranges of its stops (mjcf_bodies.cpp),
+    // soft as the contacts; a one-URDF scene's none (MuJoCo's URDF ranges off).
+    if (setup.bodies.empty()) m->jnt_limited[j] = 0;
     m->jnt_stiffness[j] = 0.0;
+    m->jnt_solref[2 * j] = tc;
+    m->jnt_solref[2 * j + 1] = s.damping_ratio;
+    const double imp[5] = {s.dmin, s.dmax, s.width, 0.5, 2.0};
+    std::copy(imp, imp + 5, m->jnt_solimp + 5 * j);
+    m->jnt_margin[j] = 0.0;
   }
 }
 
@@ -181,6 +191,9 @@ void map_coordinates(Run& r, const scene::Scene& setup, const mech::MechanicalMo
   r.row_t1.assign(static_cast<std::size_t>(k), Vector3d::UnitX());
   r.row_t2.assign(static_cast<std::size_t>(k), Vector3d::UnitY());
   if (!setup.bodies.empty()) r.geom_row.assign(static_cast<std::size_t>(m->ngeom), -1);
+  if (!setup.bodies.empty())
+    for (const auto& [name, range] : joint_ranges(setup))
+      r.stops[id_or_throw(m, mjOBJ_JOINT, name, "joint")] = range;
   for (const auto& cf : setup.contacts) {
     const auto i = static_cast<std::size_t>(cf.row);
     r.row_local[i] = cf.point.local;
@@ -322,6 +335,19 @@ void contact_forces(const Run& r, VectorXd& u, VectorXd& ut1, VectorXd& ut2) {
     const Vector3d force = sign * (frame.transpose() * Vector3d(f[0], f[1], f[2]));
     ut1(best) += r.row_t1[static_cast<std::size_t>(best)].dot(force);
     ut2(best) += r.row_t2[static_cast<std::size_t>(best)].dot(force);
+  }
+  // A scene of bodies' joint stops: each limit row's force (>= 0) on the side
+  // its Jacobian says (+1 at the lower bound, -1 at the upper), per |c|.
+  for (int i = 0; i < d->nefc; ++i) {
+    if (d->efc_type[i] != mjCNSTR_LIMIT_JOINT) continue;
+    const auto stop = r.stops.find(d->efc_id[i]);
+    if (stop == r.stops.end()) continue;
+    const int dof = m->jnt_dofadr[d->efc_id[i]];
+    const bool lower = d->efc_J[static_cast<std::size_t>(i) * static_cast<std::size_t>(m->nv) +
+                                static_cast<std::size_t>(dof)] > 0.0;
+    const JointRange& jr = stop->second;
+    const int row = lower ? jr.lower_row : jr.upper_row;
+    if (row >= 0) u(row) += d->efc_force[i] / (lower ? jr.lower_scale : jr.upper_scale);
   }
 }
 

@@ -175,20 +175,62 @@ TEST(MujocoBodies, SlidingBoxFeelsMuMgAgainstItsVelocity) {
   }
 }
 
-TEST(MujocoBodies, RefusesAJointStopInOneLine) {
+// Joint stops in a scene of bodies are MuJoCo joint ranges (soft as its
+// contacts). The gripper's fingers keep their URDF stops (0 <= q <= 0.2 m),
+// their springs (40 N/m, 0.1 kg: w = 20 rad/s) pull them from 0.15 m toward
+// -0.05 m, so q = -0.05 + 0.2 cos(20 t) meets the stop q = 0 at
+// t* = acos(0.25) / 20 = 0.06591 s; the limit's force comes within 2 h
+// after it, and the finger rests at the stop sunk by the soft constraint's
+// r = f (1 - d) A dmax^2 tc^2 / d^2 with f = 40 * 0.05 = 2 N, A = 1 / 0.1:
+// 8.91e-6 m (the closed form of the header, d = 0.9; 1e-8 m: d's rise and
+// the solver's tolerance). The table is an obstacle that makes it a scene of
+// bodies; nothing touches it.
+TEST(MujocoBodies, JointStopsAreJointRanges) {
   const std::string path = ::testing::TempDir() + "/stop_bodies.yaml";
   std::ofstream(path) << "bodies:\n  - {name: gripper, urdf: " << kRobots
-                      << "two_finger_gripper.urdf, joints: [{name: left}, {name: right}]}\n"
-                      << "  - {name: ball, urdf: " << kData
-                      << "ball.urdf, base: {type: floating, pose: {xyz: [0, 0.5, 0]}}}\n"
-                      << "t_end: 0.1\n";
+                      << "two_finger_gripper.urdf, joints: [{name: left}, {name: right}], q0: "
+                         "{left: 0.15, right: 0.15}}\n"
+                      << "  - {name: table, urdf: " << kData
+                      << "table.urdf, base: {type: fixed, pose: {xyz: [0, 0, -1]}}}\n"
+                      << "springs:\n"
+                         "  - {name: l, joint: gripper.left, stiffness: 40, rest: -0.05}\n"
+                         "  - {name: r, joint: gripper.right, stiffness: 40, rest: -0.05}\n"
+                      << "t_end: 0.3\n";
+  const mech::Model m = scene::load_model(path);
+  check_expressible(m);
+  const auto& c = m.mechanical->constraints;
+  const int lower =
+      static_cast<int>(std::find(c.begin(), c.end(), "gripper.left_lower") - c.begin());
+  ASSERT_LT(lower, static_cast<int>(c.size()));
+  const double h = 1e-3;
+  const sim::Trajectory tr = simulate_mujoco(m, m.initial, options(m, h));
+  ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
+  const double t_star = std::acos(0.25) / 20.0;
+  std::printf("[ mujoco   ] finger stop: first force %.6g (exact %.6g), rest q %.9g\n",
+              first_contact(tr, lower), t_star, tr.final_state(0));
+  EXPECT_GT(first_contact(tr, lower), t_star);
+  EXPECT_LE(first_contact(tr, lower), t_star + 2 * h);
+  EXPECT_NEAR(tr.final_state(0), -2.0 * 0.1 * 10.0 * 0.9025 * 4e-6 / 0.81, 1e-8);
+  EXPECT_NEAR(tr.final_state(1), tr.final_state(0), 1e-15);  // the fingers alike
+  // At rest the stop holds the spring's force there, 40 (q + 0.05) N (the
+  // solver's tolerance, 1e-8 of it, and more).
+  EXPECT_NEAR(tr.samples.back().u(lower), 40.0 * (tr.final_state(0) + 0.05), 1e-6);
+}
+
+// What a scene of bodies cannot have in MuJoCo is refused before anything
+// runs, in one line naming the body and the joint: a mimic joint.
+TEST(MujocoBodies, RefusesAMimicJointInOneLine) {
+  const std::string path = ::testing::TempDir() + "/mimic_bodies.yaml";
+  std::ofstream(path) << "bodies:\n  - {name: pair, urdf: " << kData
+                      << "mimic_pair.urdf, joints: [{name: lead}]}\n  - {name: ball, urdf: "
+                      << kData << "ball.urdf, base: {type: floating}}\nt_end: 0.1\n";
   const mech::Model m = scene::load_model(path);
   try {
     check_expressible(m);
-    FAIL() << "a joint stop is not a contact";
+    FAIL() << "a mimic joint";
   } catch (const std::invalid_argument& e) {
     const std::string what = e.what();
-    EXPECT_NE(what.find("is not a contact"), std::string::npos) << what;
+    EXPECT_NE(what.find("body 'pair': joint 'follow' is a mimic"), std::string::npos) << what;
     EXPECT_EQ(what.find('\n'), std::string::npos) << what;
   }
 }
