@@ -163,6 +163,19 @@ TEST(BulletBodies, LeggedRobotLandsOnItsFourToesAtTheFreeFallTime) {
   }
 }
 
+// Only the scene's named pairs collide: the ball falls through a table
+// that no contact names (tests/bullet/data/ball_through_table_scene.yaml)
+// and meets the floor at sqrt(2 * 0.8 / g); it touches nothing before.
+TEST(BulletBodies, OnlyTheNamedPairsCollide) {
+  const mech::Model m = scene::load_model(kData + "ball_through_table_scene.yaml");
+  const double h = 1e-3;
+  const sim::Trajectory tr = simulate_bullet(m, m.initial, options(m, h));
+  ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
+  ASSERT_FALSE(tr.events.empty());
+  const double t = tr.events.front().t, t_star = std::sqrt(2.0 * 0.8 / kG);
+  EXPECT_LE(std::abs(t - t_star), 1.5 * h);  // the landing step (above)
+}
+
 // A body Bullet's model of a scene of bodies cannot hold (a mimic joint) is
 // refused before anything runs, in one line naming the body and the joint.
 TEST(BulletBodies, RefusesAMimicJointInOneLine) {

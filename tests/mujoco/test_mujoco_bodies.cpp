@@ -217,6 +217,20 @@ TEST(MujocoBodies, JointStopsAreJointRanges) {
   EXPECT_NEAR(tr.samples.back().u(lower), 40.0 * (tr.final_state(0) + 0.05), 1e-6);
 }
 
+// Only the scene's named pairs collide: the ball falls through a table
+// that no contact names (tests/bullet/data/ball_through_table_scene.yaml)
+// and meets the floor at sqrt(2 * 0.8 / g); it touches nothing before.
+TEST(MujocoBodies, OnlyTheNamedPairsCollide) {
+  const mech::Model m = scene::load_model(kData + "ball_through_table_scene.yaml");
+  const double h = 1e-3;
+  const sim::Trajectory tr = simulate_mujoco(m, m.initial, options(m, h));
+  ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
+  ASSERT_FALSE(tr.events.empty());
+  const double t = tr.events.front().t, t_star = std::sqrt(2.0 * 0.8 / kG);
+  EXPECT_GT(t, t_star);
+  EXPECT_LE(t, t_star + 2 * h);  // the first force (above)
+}
+
 // What a scene of bodies cannot have in MuJoCo is refused before anything
 // runs, in one line naming the body and the joint: a mimic joint.
 TEST(MujocoBodies, RefusesAMimicJointInOneLine) {
