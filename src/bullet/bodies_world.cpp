@@ -477,7 +477,7 @@ sim::Trajectory simulate_bodies(const mech::Model& model, const scene::Scene& se
   } catch (const std::exception& e) {
     return fail(std::string("bullet: ") + e.what());
   }
-  RunRecorder rec(model, opt, tr, q, v);
+  RunRecorder rec(model, opt, tr, q, v, m.has_friction());
   const sim::StepGrid grid = sim::StepGrid::of(*opt.t_end, opt.h);
   VectorXd tau(N), q_next(N), v_next(N), impulse(k), t1(k), t2(k);
   for (long j = 1; j <= grid.n; ++j) {

@@ -60,7 +60,7 @@ void warn_explicit_damping(sim::Trajectory& tr, const mech::MechanicalModel& m, 
 }
 
 RunRecorder::RunRecorder(const mech::Model& model, const sim::Options& opt, sim::Trajectory& tr,
-                         const VectorXd& q0, const VectorXd& v0)
+                         const VectorXd& q0, const VectorXd& v0, bool friction_outputs)
     : m_(*model.mechanical),
       opt_(opt),
       tr_(tr),
@@ -71,6 +71,7 @@ RunRecorder::RunRecorder(const mech::Model& model, const sim::Options& opt, sim:
   tr_.energy_initial = mech::total_energy(m_, q_, v_);
   y_ = m_.E * q_ + m_.g;
   if (m_.num_constraints() > 0) tr_.max_violation = std::min(0.0, y_.minCoeff());
+  if (friction_outputs) ft1_ = ft2_ = VectorXd::Zero(m_.num_constraints());
   record(0.0, VectorXd::Zero(m_.num_constraints()));
 }
 

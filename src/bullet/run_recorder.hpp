@@ -29,9 +29,10 @@ void warn_explicit_damping(sim::Trajectory& tr, const mech::MechanicalModel& m, 
 
 class RunRecorder {
  public:
-  // Records the sample at t = 0.
+  // Records the sample at t = 0 (with `friction_outputs`, the run gives
+  // friction(): its u_t, u_t2 zero).
   RunRecorder(const mech::Model& model, const sim::Options& opt, sim::Trajectory& tr,
-              const Eigen::VectorXd& q0, const Eigen::VectorXd& v0);
+              const Eigen::VectorXd& q0, const Eigen::VectorXd& v0, bool friction_outputs = false);
   // One step of length h ending at t (the last one when `last`), from the
   // state held to (q, v), with constraint impulses `impulse` (h u, size k).
   // "" when recorded; else the state diverged (sim::DivergenceGuard): nothing

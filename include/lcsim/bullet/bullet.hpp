@@ -130,7 +130,7 @@ void check_expressible(const mech::Model& model);
 // model's coordinate order), u = constraint impulse / h (rb6: from the
 // momentum balance; multibody: Bullet's limit and contact impulses; a
 // contact scene with friction: u_t, u_t2 = the friction impulse / h on each
-// friction entry's point along its contact's tangents t1, t2, empty at
+// friction entry's point along its contact's tangents t1, t2, zero at
 // t = 0), mode = constraints
 // with a nonzero impulse in the step, events at every mode change, energy
 // (of lcsim's model at Bullet's states), max_violation. A model Bullet cannot

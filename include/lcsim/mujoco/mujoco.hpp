@@ -74,8 +74,8 @@ void check_expressible(const mech::Model& model);
 // model's coordinate order), u = each contact point's normal force (its own
 // geom's in a scene of bodies; the MuJoCo contact nearest to that point on
 // its link in a one-URDF scene, N), u_t and u_t2 = the friction force on
-// each friction entry's point along its contact's tangents t1, t2 (N; empty
-// at t = 0 and without friction), mode = the contact
+// each friction entry's point along its contact's tangents t1, t2 (N; zero
+// at t = 0, empty without friction), mode = the contact
 // points with a force, events at every mode change, energies of lcsim's
 // model at MuJoCo's states, max_violation (lcsim's linear gaps there: the
 // soft contacts penetrate). Not expressible: std::invalid_argument before
