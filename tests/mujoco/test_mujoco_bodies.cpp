@@ -114,6 +114,36 @@ TEST(MujocoBodies, LeggedRobotLandsOnItsFourToesAtTheFreeFallTime) {
   }
 }
 
+// Both peers on the legged robot to T = 1 s (h = 1e-4): two independent
+// nonlinear simulators of the same URDF settle it to the same state up to
+// MuJoCo's resting sink on its toes (64 N each, a toe's A_ii < 40 1/kg as
+// test_mujoco_contacts.cpp bounds the quadruped's, tc = 2 h:
+// r <= 64 * 0.1 * 40 * 0.9025 * 4e-8 / 0.81 = 1.2e-5 m; measured 6.3e-7),
+// so their common difference to the exact run of the linear model (2.9e-4,
+// the same in both to that sink) is lcsim's linearisation, not a peer's
+// error.
+TEST(MujocoBodies, BothPeersSettleTheLeggedRobotAlikeAwayFromTheLinearModel) {
+  const mech::Model m = scene::load_model(kRobots + "vision60_drop_scene.yaml");
+  sim::Options o = options(m, 1e-4);
+  const auto event = sim::make_integrator("event");
+  sim::Options oe = o;
+  oe.h = 1e-3;
+  const sim::Trajectory ex = event->run(m, m.initial, sim::keep_used(oe, event->options_used()));
+  ASSERT_EQ(ex.status, sim::RunStatus::kCompleted) << ex.message;
+  const sim::Trajectory mj = simulate_mujoco(m, m.initial, o);
+  ASSERT_EQ(mj.status, sim::RunStatus::kCompleted) << mj.message;
+  const sim::Trajectory bt = bullet::simulate_bullet(m, m.initial, o);
+  ASSERT_EQ(bt.status, sim::RunStatus::kCompleted) << bt.message;
+  const double peers = (mj.final_state - bt.final_state).cwiseAbs().maxCoeff();
+  const double e_mj = (mj.final_state - ex.final_state).cwiseAbs().maxCoeff();
+  const double e_bt = (bt.final_state - ex.final_state).cwiseAbs().maxCoeff();
+  std::printf("[ mujoco   ] vision60: |mujoco - bullet| %.3e, to the exact run %.3e / %.3e\n",
+              peers, e_mj, e_bt);
+  EXPECT_LE(peers, 1.2e-5);
+  EXPECT_LE(std::abs(e_mj - e_bt), 1.2e-5);
+  EXPECT_GT(e_bt, 10 * peers);  // the linear model's difference, well above the peers'
+}
+
 // Sums of the friction entries' multipliers along t1 and t2, and of the
 // normal multipliers, at sample s.
 struct Totals {
