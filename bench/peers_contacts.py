@@ -7,7 +7,10 @@ so every ratio compares runs made on the same machine at the same time:
 1. table: on the dropped box, the tipped box and the quadruped drop at a few
    amplitudes, lcsim's reported linearisation error (`simulate`) beside each
    peer's final-state difference and first-impact shift to the exact run
-   (`compare --peer ...`, h = 1e-3);
+   (`compare --peer ...`, h = 1e-3); then the same on the scenes of several
+   bodies (`bodies:`): a ball dropped onto a table, the gripper closing on
+   the box (h = 1e-3) and the Vision 60 drop (h = 1e-4: its dampers are
+   explicit torques in both peers, unstable at 1e-3);
 2. the quadruped drop to T = 1 s with the exact method (target < 5 ms wall):
    median of REPEAT runs;
 3. Moreau-Jean at h = 1e-3 per step vs MuJoCo's mj_step on the same robot,
@@ -77,6 +80,22 @@ def table():
     print("(lin. error: simulate's relative error of the linear model's M and forces over the "
           "run; final: max-abs final-state difference to the exact run; shift: the first "
           "impact's t_peer - t_exact, s)")
+
+
+def table_bodies():
+    data = os.path.join(HERE, "..", "tests", "bullet", "data")
+    cases = [(os.path.join(data, "ball_table_scene.yaml"), "ball_table", "1e-3"),
+             (os.path.join(ROBOTS, "gripper_box_scene.yaml"), "gripper_box", "1e-3"),
+             (os.path.join(ROBOTS, "vision60_drop_scene.yaml"), "vision60_drop", "1e-4")]
+    print("scene of bodies  h              lin. error   bullet final  bullet shift  mujoco final  mujoco shift")
+    for path, scene, h in cases:
+        sim = run("simulate", path, "--json", "--dt-out", "0")
+        cells = []
+        for peer in ("bullet", "mujoco"):
+            c = run("compare", path, "--peer", peer, "--h", h, "--json")
+            cells += [c["error_final"], first_shift(c)]
+        print(f"{scene:16s} {h:14s} {sim['linearisation_error']:.3e}    "
+              + "  ".join(f"{v:+.3e}  " for v in cells))
 
 
 def walls(*args):
@@ -152,6 +171,7 @@ def friction_slide():
 
 if __name__ == "__main__":
     table()
+    table_bodies()
     print()
     target_quadruped()
     target_moreau_jean_vs_mujoco()

@@ -166,6 +166,8 @@ ContactColliders make_contact_colliders(const scene::Scene& setup, const UrdfMul
                            btTransform(btMatrix3x3::getIdentity(), bt(Vector3d(cf.point.local)));
     auto& compound = static_cast<btCompoundShape&>(*shape);
     out.row_of[{own->second, compound.getNumChildShapes()}] = static_cast<int>(cf.row);
+    out.t1_of[static_cast<int>(cf.row)] = cf.tangent1;
+    out.t2_of[static_cast<int>(cf.row)] = cf.tangent2;
     compound.addChildShape(at, sphere.get());
     out.shapes.push_back(std::move(sphere));
     double& e = out.restitution_of[own->second];
@@ -208,6 +210,29 @@ void contact_impulses(btCollisionDispatcher& d, const ContactColliders& c,
       const int child = l0 ? pt.m_index0 : pt.m_index1;
       const auto row = c.row_of.find({link->m_link, child});
       if (row != c.row_of.end()) impulse(row->second) += pt.m_appliedImpulse;
+    }
+  }
+}
+
+void contact_friction_impulses(btCollisionDispatcher& d, const ContactColliders& c,
+                               Eigen::VectorXd& t1, Eigen::VectorXd& t2) {
+  t1.setZero();
+  t2.setZero();
+  for (int i = 0; i < d.getNumManifolds(); ++i) {
+    const btPersistentManifold* pm = d.getManifoldByIndexInternal(i);
+    const auto* l0 = btMultiBodyLinkCollider::upcast(pm->getBody0());
+    const auto* l1 = btMultiBodyLinkCollider::upcast(pm->getBody1());
+    const btMultiBodyLinkCollider* link = l0 ? l0 : l1;
+    if (!link || (l0 && l1)) continue;
+    const double sign = l0 ? 1.0 : -1.0;  // the link is body A, or B
+    for (int j = 0; j < pm->getNumContacts(); ++j) {
+      const btManifoldPoint& pt = pm->getContactPoint(j);
+      const auto row = c.row_of.find({link->m_link, l0 ? pt.m_index0 : pt.m_index1});
+      if (row == c.row_of.end()) continue;
+      const Vector3d f = sign * (pt.m_appliedImpulseLateral1 * eig(pt.m_lateralFrictionDir1) +
+                                 pt.m_appliedImpulseLateral2 * eig(pt.m_lateralFrictionDir2));
+      t1(row->second) += c.t1_of.at(row->second).dot(f);
+      t2(row->second) += c.t2_of.at(row->second).dot(f);
     }
   }
 }

@@ -2,6 +2,8 @@
 // by simulate_bullet (world.cpp) for models from URDF scenes.
 #pragma once
 
+#include <BulletDynamics/ConstraintSolver/btContactSolverInfo.h>
+
 #include <Eigen/Dense>
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
@@ -42,6 +44,27 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene&
                                    const std::vector<JointLimit>& limits, const Eigen::VectorXd& x0,
                                    const sim::Options& opt, const WorldSettings& s);
 
+// The solver settings both multibody scenes pin (multibody_world.cpp's
+// header): iterations, ERP = limit_erp, CFM 0, SOR 1, no split impulse, no
+// early exit, slop 0, warm starting without the articulated one, and with
+// `friction` WorldSettings::friction's flags.
+void pin_solver_info(btContactSolverInfo& info, const WorldSettings& s, bool friction);
+
+// ---- A scene of several bodies (bodies_world.cpp) ----
+
+// Why Bullet cannot run the scene of bodies, or "": a mimic joint.
+std::string bodies_refusal(const scene::Scene& setup);
+// The scene's rows that are not contacts as joint limits (joint_limits_of);
+// std::invalid_argument for a row on a floating base's coordinate.
+std::vector<JointLimit> bodies_joint_limits(const mech::MechanicalModel& m,
+                                            const scene::Scene& setup);
+// "one btMultiBody per body, ..." with the solver's and the contacts' settings.
+std::string bodies_description(const WorldSettings& s, bool friction);
+// The scene of bodies run in Bullet (bodies_world.cpp says how). Never throws.
+sim::Trajectory simulate_bodies(const mech::Model& model, const scene::Scene& setup,
+                                const std::vector<JointLimit>& limits, const Eigen::VectorXd& x0,
+                                const sim::Options& opt, const WorldSettings& s);
+
 }  // namespace lcsim::bullet
 
 // ---- Floating bases and contacts (multibody_contacts.cpp) ----
@@ -78,11 +101,12 @@ struct ContactColliders {
   std::vector<std::unique_ptr<btCollisionShape>> shapes;
   std::map<int, btCollisionShape*> shape_of;  // Bullet link -> its compound
   std::vector<std::unique_ptr<btCollisionObject>> planes;
-  std::map<std::pair<int, int>, int> row_of;  // (Bullet link, compound child) -> row of E
-  std::map<int, double> restitution_of;       // Bullet link -> the largest e of its points
-  std::map<int, double> friction_of;          // Bullet link -> its points' mu (one per link)
-  bool friction = false;                      // some contact has friction
-  int rows = 0;                               // contact rows
+  std::map<std::pair<int, int>, int> row_of;    // (Bullet link, compound child) -> row of E
+  std::map<int, double> restitution_of;         // Bullet link -> the largest e of its points
+  std::map<int, double> friction_of;            // Bullet link -> its points' mu (one per link)
+  bool friction = false;                        // some contact has friction
+  int rows = 0;                                 // contact rows
+  std::map<int, Eigen::Vector3d> t1_of, t2_of;  // row -> its world tangents (scene::ContactFrame)
 };
 // Collision filter groups of links with contacts and of planes.
 constexpr int kContactLinkGroup = 1 << 6, kPlaneGroup = 1 << 7;
@@ -103,6 +127,11 @@ std::string link_friction_error(const scene::Scene& setup, const mech::Mechanica
 // (size k, by row of E), from the dispatcher's manifolds.
 void contact_impulses(btCollisionDispatcher& d, const ContactColliders& c,
                       Eigen::VectorXd& impulse);
+// The step's friction impulses on each contact point along its row's
+// tangents t1, t2 (N s, by row of E; zero elsewhere): Bullet's lateral
+// impulses act on the manifold's body A along its friction directions.
+void contact_friction_impulses(btCollisionDispatcher& d, const ContactColliders& c,
+                               Eigen::VectorXd& t1, Eigen::VectorXd& t2);
 
 // A btCollisionDispatcher whose manifolds keep points up to `threshold` (m)
 // apart (Bullet's default is 0.02 times the shapes' bounding radius): a

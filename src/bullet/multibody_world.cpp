@@ -159,20 +159,7 @@ std::unique_ptr<MbWorld> make_world(const scene::Scene& setup, const WorldSettin
   w->world = std::make_unique<btMultiBodyDynamicsWorld>(w->dispatcher.get(), w->broadphase.get(),
                                                         w->solver.get(), w->config.get());
   w->world->setGravity(btVector3(setup.gravity.x(), setup.gravity.y(), setup.gravity.z()));
-  btContactSolverInfo& info = w->world->getSolverInfo();
-  info.m_numIterations = s.solver_iterations;
-  info.m_erp = s.limit_erp;
-  info.m_erp2 = s.limit_erp;
-  info.m_globalCfm = 0.0;
-  info.m_sor = 1.0;
-  info.m_splitImpulse = 0;
-  info.m_leastSquaresResidualThreshold = 0.0;
-  info.m_linearSlop = 0.0;  // Bullet's default; contacts: penetration = distance + slop
-  info.m_solverMode = SOLVER_USE_WARMSTARTING | SOLVER_SIMD;  // no articulated warm start
-  if (friction && s.friction != WorldSettings::Friction::kOneDirection)
-    info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
-  if (friction && s.friction == WorldSettings::Friction::kBox)
-    info.m_solverMode |= SOLVER_DISABLE_IMPLICIT_CONE_FRICTION;
+  pin_solver_info(w->world->getSolverInfo(), s, friction);
   return w;
 }
 
@@ -372,6 +359,22 @@ void limit_impulses(MbWorld& w, const std::vector<JointLimit>& limits, VectorXd&
 
 }  // namespace
 
+void pin_solver_info(btContactSolverInfo& info, const WorldSettings& s, bool friction) {
+  info.m_numIterations = s.solver_iterations;
+  info.m_erp = s.limit_erp;
+  info.m_erp2 = s.limit_erp;
+  info.m_globalCfm = 0.0;
+  info.m_sor = 1.0;
+  info.m_splitImpulse = 0;
+  info.m_leastSquaresResidualThreshold = 0.0;
+  info.m_linearSlop = 0.0;  // Bullet's default; contacts: penetration = distance + slop
+  info.m_solverMode = SOLVER_USE_WARMSTARTING | SOLVER_SIMD;  // no articulated warm start
+  if (friction && s.friction != WorldSettings::Friction::kOneDirection)
+    info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
+  if (friction && s.friction == WorldSettings::Friction::kBox)
+    info.m_solverMode |= SOLVER_DISABLE_IMPLICIT_CONE_FRICTION;
+}
+
 std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m, const std::string& source,
                                         const scene::Scene* setup) {
   std::vector<JointLimit> out;
@@ -472,9 +475,9 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene&
   } catch (const std::exception& e) {
     return fail(std::string("bullet: ") + e.what());
   }
-  RunRecorder rec(model, opt, tr, q, v);
+  RunRecorder rec(model, opt, tr, q, v, w->contacts.friction);
   const sim::StepGrid grid = sim::StepGrid::of(*opt.t_end, opt.h);
-  VectorXd tau(N), q_next(N), v_next(N), impulse(k);
+  VectorXd tau(N), q_next(N), v_next(N), impulse(k), t1(k), t2(k);
   for (long j = 1; j <= grid.n; ++j) {
     const bool last = j == grid.n;
     if (opt.progress && j % sim::Options::kProgressSteps == 0) opt.progress(j * opt.h);
@@ -482,6 +485,10 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene&
     tau = f_s - K_s * q - D * v;
     step(*w, q, tau, h, q_next, v_next);
     limit_impulses(*w, limits, impulse);
+    if (w->contacts.friction) {  // each contact's friction along its tangents
+      contact_friction_impulses(*w->dispatcher, w->contacts, t1, t2);
+      rec.friction(t1, t2);
+    }
     // Round-off in an impulse is ~1e-16 of the momentum; real ones are O(h).
     const double tiny =
         1e-10 * (1.0 + (m.M * v).cwiseAbs().maxCoeff() + h * tau.cwiseAbs().maxCoeff());

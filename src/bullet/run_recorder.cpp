@@ -60,7 +60,7 @@ void warn_explicit_damping(sim::Trajectory& tr, const mech::MechanicalModel& m, 
 }
 
 RunRecorder::RunRecorder(const mech::Model& model, const sim::Options& opt, sim::Trajectory& tr,
-                         const VectorXd& q0, const VectorXd& v0)
+                         const VectorXd& q0, const VectorXd& v0, bool friction_outputs)
     : m_(*model.mechanical),
       opt_(opt),
       tr_(tr),
@@ -71,10 +71,16 @@ RunRecorder::RunRecorder(const mech::Model& model, const sim::Options& opt, sim:
   tr_.energy_initial = mech::total_energy(m_, q_, v_);
   y_ = m_.E * q_ + m_.g;
   if (m_.num_constraints() > 0) tr_.max_violation = std::min(0.0, y_.minCoeff());
+  if (friction_outputs) ft1_ = ft2_ = VectorXd::Zero(m_.num_constraints());
   record(0.0, VectorXd::Zero(m_.num_constraints()));
 }
 
-void RunRecorder::record(double t, const VectorXd& u) {
+void RunRecorder::friction(const VectorXd& t1, const VectorXd& t2) {
+  ft1_ = t1;
+  ft2_ = t2;
+}
+
+void RunRecorder::record(double t, const VectorXd& u, double h) {
   if (!opt_.record_samples) return;
   sim::Sample smp;
   smp.t = t;
@@ -83,6 +89,16 @@ void RunRecorder::record(double t, const VectorXd& u) {
   smp.u = u;
   smp.y = y_;
   smp.mode = mode_;
+  if (ft1_.size() > 0 && !m_.friction.empty()) {  // friction(): each entry's, by its row
+    const auto nf = static_cast<Eigen::Index>(m_.friction.size());
+    smp.u_t = VectorXd::Zero(nf);
+    if (m_.has_friction_3d()) smp.u_t2 = VectorXd::Zero(nf);
+    for (Eigen::Index e = 0; e < nf && h > 0.0; ++e) {
+      const int row = m_.friction[static_cast<std::size_t>(e)].contact;
+      smp.u_t(e) = ft1_(row) / h;
+      if (smp.u_t2.size() > 0) smp.u_t2(e) = ft2_(row) / h;
+    }
+  }
   tr_.record_sample(std::move(smp), opt_);
 }
 
@@ -127,7 +143,7 @@ std::string RunRecorder::step(double t, double h, bool last, const VectorXd& q, 
   if (k > 0) ++tr_.lcp_solves;  // the constraint solver runs every step
   y_ = m_.E * q_ + m_.g;
   if (k > 0) tr_.max_violation = std::min(tr_.max_violation, std::min(0.0, y_.minCoeff()));
-  if (sampler_.want(t, opt_.h, last)) record(t, k > 0 ? VectorXd(impulse / h) : VectorXd());
+  if (sampler_.want(t, opt_.h, last)) record(t, k > 0 ? VectorXd(impulse / h) : VectorXd(), h);
   return "";
 }
 

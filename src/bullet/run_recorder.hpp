@@ -29,9 +29,10 @@ void warn_explicit_damping(sim::Trajectory& tr, const mech::MechanicalModel& m, 
 
 class RunRecorder {
  public:
-  // Records the sample at t = 0.
+  // Records the sample at t = 0 (with `friction_outputs`, the run gives
+  // friction(): its u_t, u_t2 zero).
   RunRecorder(const mech::Model& model, const sim::Options& opt, sim::Trajectory& tr,
-              const Eigen::VectorXd& q0, const Eigen::VectorXd& v0);
+              const Eigen::VectorXd& q0, const Eigen::VectorXd& v0, bool friction_outputs = false);
   // One step of length h ending at t (the last one when `last`), from the
   // state held to (q, v), with constraint impulses `impulse` (h u, size k).
   // "" when recorded; else the state diverged (sim::DivergenceGuard): nothing
@@ -41,9 +42,14 @@ class RunRecorder {
                    const Eigen::VectorXd& v, const Eigen::VectorXd& impulse, double tiny);
   // Final state and energy.
   void finish();
+  // The next step's friction impulses on each contact row's point along its
+  // tangents t1, t2 (N s, by row of E): that step's sample gives each
+  // friction entry's (mech::MechanicalModel::friction) u_t and, for 3-D
+  // friction, u_t2 (the impulse / h). Without it a sample has none.
+  void friction(const Eigen::VectorXd& t1, const Eigen::VectorXd& t2);
 
  private:
-  void record(double t, const Eigen::VectorXd& u);
+  void record(double t, const Eigen::VectorXd& u, double h = 0.0);
   const mech::MechanicalModel& m_;
   const sim::Options& opt_;
   sim::Trajectory& tr_;
@@ -52,6 +58,7 @@ class RunRecorder {
   Eigen::VectorXd q_, v_, y_;
   double t_ = 0.0;  // time of (q_, v_), the last step recorded (s)
   sim::IndexSet mode_;
+  Eigen::VectorXd ft1_, ft2_;  // friction(): the step's tangential impulses by row
 };
 
 }  // namespace lcsim::bullet

@@ -266,11 +266,20 @@ std::optional<scene::Scene> contact_scene_of(const mech::Model& model) {
   return sc;
 }
 
+// The scene of several bodies `model` was loaded from (and still is), else
+// nullopt.
+std::optional<scene::Scene> bodies_scene_of(const mech::Model& model) {
+  std::optional<scene::Scene> sc = scene::scene_of(model);
+  if (!sc || sc->bodies.empty()) return std::nullopt;
+  return sc;
+}
+
 // Which scene runs a model: the multibody for a URDF scene whose rows are
 // all joint limits; else rb6 (a scene's matrices included, with a warning);
 // std::invalid_argument when neither can express it.
 struct Plan {
-  std::optional<scene::Scene> scene;  // set: the multibody
+  std::optional<scene::Scene> scene;   // set: the multibody
+  std::optional<scene::Scene> bodies;  // set: a scene of several bodies (bodies_world.cpp)
   std::vector<JointLimit> joint_limits;
   std::vector<Limit> rb6_limits;
   std::string warning;
@@ -281,6 +290,13 @@ Plan plan_of(const mech::Model& model, const WorldSettings& s) {
   std::optional<scene::Scene> setup =
       model.is_mechanical() ? scene::scene_setup(model) : std::nullopt;
   if (!setup && model.is_mechanical()) {
+    if (std::optional<scene::Scene> b = bodies_scene_of(model)) {
+      if (std::string why = bodies_refusal(*b); !why.empty())
+        throw std::invalid_argument("bullet: " + model.source + ": " + why);
+      p.joint_limits = bodies_joint_limits(*model.mechanical, *b);
+      p.bodies = std::move(b);
+      return p;
+    }
     // scene::scene_setup hands over scenes with a fixed root at the identity
     // and no contacts only; the multibody builds the others too.
     if (std::optional<scene::Scene> c = contact_scene_of(model)) {
@@ -322,6 +338,7 @@ std::string rb6_description(const WorldSettings& s) {
 
 std::string solver_description(const mech::Model& model, const WorldSettings& s) {
   const Plan p = plan_of(model, s);
+  if (p.bodies) return bodies_description(s, model.mechanical->has_friction());
   return p.scene ? multibody_description(s, !p.scene->contacts.empty(),
                                          model.mechanical->has_friction())
                  : rb6_description(s);
@@ -506,7 +523,8 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
   // `--method bullet` still refuses it (and the methods that take friction
   // are listed without Bullet, which takes it on contact scenes only).
   sim::OptionsUsed used = bullet_options_used();
-  if (model.is_mechanical() && model.mechanical->has_friction() && contact_scene_of(model))
+  if (model.is_mechanical() && model.mechanical->has_friction() &&
+      (contact_scene_of(model) || bodies_scene_of(model)))
     used.friction = used.friction_3d = true;
   if (auto refused = sim::refuse_invalid_run(model, x0, opt, "bullet", used))
     return std::move(*refused);
@@ -519,8 +537,9 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
   }
   const auto wall0 = std::chrono::steady_clock::now();
   const Plan p = plan_of(model, s);  // throws for an inexpressible model
-  sim::Trajectory tr = p.scene ? simulate_multibody(model, *p.scene, p.joint_limits, x0, opt, s)
-                               : simulate_rb6(model, p.rb6_limits, x0, opt, s);
+  sim::Trajectory tr = p.bodies  ? simulate_bodies(model, *p.bodies, p.joint_limits, x0, opt, s)
+                       : p.scene ? simulate_multibody(model, *p.scene, p.joint_limits, x0, opt, s)
+                                 : simulate_rb6(model, p.rb6_limits, x0, opt, s);
   if (!p.warning.empty()) tr.warn("bullet-scene", 0.0, p.warning);
   sim::check_diverged(model, x0, tr);  // what the scenes report at their end, as run() checks it
   tr.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -16,6 +16,8 @@
 // compared the same way.
 // A contact scene with friction at its contacts runs with the peer's own
 // friction (--bullet-friction, --mujoco-cone; reported in bullet_solver).
+// --peer-out writes the peer's samples as a trajectory CSV (with the
+// friction multipliers along each contact's two tangents).
 // Any other model with friction must be a block on a floor (bullet::friction_block_of):
 // Bullet's box on a plane runs beside the exact run, and the stick times and
 // slide distances of the closed form, the exact run and Bullet are printed.
@@ -57,6 +59,9 @@ struct CompareArgs {
   // (bullet::parse_friction) and MuJoCo's cone (mujoco::parse_cone).
   std::string bullet_friction = "cone";
   std::string mujoco_cone = "pyramidal";
+  // The peer's samples (on the comparison grid) as a trajectory CSV, its
+  // friction multipliers u_t, u_t2 among them; "" = none.
+  std::string peer_out;
 };
 
 // A block on a floor with friction: Bullet's box beside the exact run
@@ -208,6 +213,7 @@ void compare_bullet(const scene::LoadedModel& loaded, const CompareArgs& a, app:
     return bullet::simulate_bullet(m, x0, opt, ws);
   };
   req.check_linearisation = false;  // the exact run's states are checked
+  req.csv_path = a.peer_out;
   const sim::Trajectory bt = compare_run(loaded, req, "Bullet");
   const bullet::Comparison c = bullet::compare_trajectories(exact, bt, 1e-9 * a.h);
   // What the Bullet scene does differently (lost restitution, explicit
@@ -233,6 +239,7 @@ void compare_mujoco(const scene::LoadedModel& loaded, const CompareArgs& a, app:
     return mujoco::simulate_mujoco(m, x0, opt, ms);
   };
   req.check_linearisation = false;  // the exact run's states are checked
+  req.csv_path = a.peer_out;
   const sim::Trajectory mj = compare_run(loaded, req, "MuJoCo");
   const bullet::Comparison c = bullet::compare_trajectories(exact, mj, 1e-9 * a.h);
   print_warnings(mj);
@@ -319,6 +326,9 @@ void setup(CLI::App& app) {
   cmd->add_option("--mujoco-cone", a->mujoco_cone,
                   "MuJoCo's friction cone at a contact scene's contacts: pyramidal (default, "
                   "MuJoCo's) or elliptic");
+  cmd->add_option("--peer-out", a->peer_out,
+                  "Write the peer's samples (on the comparison grid) as a trajectory CSV, its "
+                  "friction multipliers u_t, u_t2 per contact among them");
   cmd->add_flag("--json", a->json, "Print the comparison as JSON");
   cmd->callback([a, t_end] {
     a->t_end_given = t_end->count() > 0;

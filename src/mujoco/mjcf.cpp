@@ -35,21 +35,6 @@ std::string read_text(const fs::path& p) {
   return ss.str();
 }
 
-// A directory of its own under the system's temporary one, removed with it.
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static std::atomic<long> counter{0};
-    path = fs::temp_directory_path() /
-           ("lcsim-mujoco-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-};
-
 std::string triple(const Eigen::Vector3d& v) {
   return format_number(v.x()) + " " + format_number(v.y()) + " " + format_number(v.z());
 }
@@ -78,6 +63,18 @@ std::string edit_mjcf(std::string xml, const scene::Scene& setup) {
 }
 
 }  // namespace
+
+TempDir::TempDir() {
+  static std::atomic<long> counter{0};
+  path = fs::temp_directory_path() /
+         ("lcsim-mujoco-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+  fs::create_directories(path);
+}
+
+TempDir::~TempDir() {
+  std::error_code ec;
+  fs::remove_all(path, ec);
+}
 
 MjModelPtr load_scene_model(const scene::Scene& setup) {
   const fs::path urdf = setup.urdf_source;

@@ -122,19 +122,54 @@ std::string friction_refusal(const mech::MechanicalModel& m, const scene::Scene&
   return "";
 }
 
+// What a scene of bodies cannot have in MuJoCo (mjcf_bodies.cpp), or "":
+// a constraint that is neither a contact nor a stop on one joint (a joint
+// range in MuJoCo), friction that is not a scene contact's, a mimic joint.
+// Each contact point is a geom of its own, so explicit points, frozen joints
+// and one mu per pair are fine.
+std::string bodies_refusal(const mech::MechanicalModel& m, const scene::Scene& sc,
+                           const std::vector<bool>& contact) {
+  for (const mech::FrictionalContact& f : m.friction)
+    if (f.velocity != 0.0 || !f.is_3d())
+      return "constraint '" + m.constraints[static_cast<std::size_t>(f.contact)] +
+             "' has friction that is not a scene contact's: MuJoCo runs the friction of "
+             "contacts: only";
+  for (int i = 0; i < m.num_constraints(); ++i) {
+    if (contact[static_cast<std::size_t>(i)]) continue;
+    std::vector<int> nz;
+    for (int j = 0; j < m.dofs(); ++j)
+      if (m.E.coeff(i, j) != 0.0) nz.push_back(j);
+    bool on_base = false;
+    for (const scene::SceneBody& b : sc.bodies)
+      if (nz.size() == 1 && b.base.floating && nz[0] >= b.offset && nz[0] < b.offset + 6)
+        on_base = true;
+    if (nz.size() != 1 || on_base)
+      return "constraint '" + m.constraints[static_cast<std::size_t>(i)] +
+             "' is not a contact nor a stop on one joint: MuJoCo runs contacts and joint ranges "
+             "only";
+  }
+  for (const scene::SceneBody& b : sc.bodies)
+    for (const auto& [name, j] : b.urdf->joints_)
+      if (j->mimic)
+        return "body '" + b.name + "': joint '" + name +
+               "' is a mimic: lcsim's MuJoCo model of a scene of bodies has none";
+  return "";
+}
+
 // What check_expressible refuses, or "" (the scene found).
 std::string refusal(const mech::Model& model, std::optional<scene::Scene>& sc) {
   sc = scene::scene_of(model);
   if (!sc)
     return "mujoco: " + model.source +
            ": MuJoCo runs URDF scenes only (a model file with `urdf:`, unchanged since loading)";
-  if (!sc->bodies.empty())
-    return "mujoco: " + model.source +
-           ": a scene of several bodies (`bodies:`): MuJoCo runs one-URDF scenes only";
   const mech::MechanicalModel& m = *model.mechanical;
   const std::string where = "mujoco: " + model.source + ": ";
   std::vector<bool> contact(static_cast<std::size_t>(m.num_constraints()), false);
   for (const auto& cf : sc->contacts) contact[static_cast<std::size_t>(cf.row)] = true;
+  if (!sc->bodies.empty()) {
+    const std::string why = bodies_refusal(m, *sc, contact);
+    return why.empty() ? why : where + why;
+  }
   if (std::string why = friction_refusal(m, *sc); !why.empty()) return where + why;
   for (int i = 0; i < m.num_constraints(); ++i)
     if (!contact[static_cast<std::size_t>(i)])

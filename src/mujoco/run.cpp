@@ -10,6 +10,7 @@
 #include <lcsim/mujoco/mujoco.hpp>
 #include <lcsim/scene/scene.hpp>
 #include <lcsim/scene/so3.hpp>
+#include <map>
 #include <optional>
 #include <stdexcept>
 
@@ -24,20 +25,34 @@ using Eigen::MatrixXd;
 using Eigen::Vector3d;
 using Eigen::VectorXd;
 
+// A floating base: its six coordinates from `offset`, its free joint's
+// qpos and qvel addresses, its reference orientation.
+struct FreeBase {
+  int offset = 0;
+  int q = -1, v = -1;
+  Matrix3d R0 = Matrix3d::Identity();
+};
+
 // Where each lcsim coordinate lives in MuJoCo, and the scene's forces.
 struct Run {
   MjModelPtr m;
   MjDataPtr d;
-  int nb = 0;                    // 6 for a floating base
-  int free_q = -1, free_v = -1;  // the free joint's qpos and qvel addresses
-  std::vector<int> qadr, vadr;   // coordinate c >= nb -> qpos / qvel address
-  Matrix3d R0 = Matrix3d::Identity();
+  std::vector<FreeBase> bases;  // one per floating base
+  std::vector<int> qadr, vadr;  // coordinate c -> qpos / qvel address (-1: a base's)
   MatrixXd K_s, D;
   VectorXd f_s;
   std::vector<int> row_body;        // contact row -> MuJoCo body of its link (-1: none)
   std::vector<Vector3d> row_local;  // its point in the link frame, minus nothing
   std::vector<double> row_radius;
   std::vector<Vector3d> row_normal;
+  // A scene of bodies: MuJoCo geom -> the contact row whose point it is (-1:
+  // none), so each contact's force goes to its own row.
+  std::vector<int> geom_row;
+  // Each contact row's world tangents (scene::ContactFrame), for the friction
+  // multipliers.
+  std::vector<Vector3d> row_t1, row_t2;
+  // A scene of bodies' joint stops by MuJoCo joint id (joint_ranges).
+  std::map<int, JointRange> stops;
 };
 
 int id_or_throw(const mjModel* m, int type, const std::string& name, const char* what) {
@@ -46,6 +61,30 @@ int id_or_throw(const mjModel* m, int type, const std::string& name, const char*
     throw std::invalid_argument("mujoco: MuJoCo's model has no " + std::string(what) + " '" + name +
                                 "'");
   return id;
+}
+
+// A scene of bodies' contact pairs (mjcf_bodies.cpp: pair i is contact i of
+// setup.contacts): condim 3 with the row's mu (sliding only) or 1, soft as
+// the geoms below, no margin or gap. Its geoms have contype = conaffinity =
+// 0 already (configure leaves a link's geoms colliding only in a one-URDF
+// scene).
+void configure_pairs(Run& r, const scene::Scene& setup, const std::vector<double>& row_mu,
+                     const Settings& s, double tc) {
+  mjModel* m = r.m.get();
+  if (setup.bodies.empty()) return;
+  for (int p = 0; p < m->npair; ++p) {
+    const double mu =
+        row_mu[static_cast<std::size_t>(setup.contacts[static_cast<std::size_t>(p)].row)];
+    m->pair_dim[p] = mu >= 0.0 ? 3 : 1;
+    const double fr[5] = {std::max(mu, 0.0), std::max(mu, 0.0), 0.0, 0.0, 0.0};
+    std::copy(fr, fr + 5, m->pair_friction + 5 * p);
+    m->pair_solref[2 * p] = tc;
+    m->pair_solref[2 * p + 1] = s.damping_ratio;
+    const double imp[5] = {s.dmin, s.dmax, s.width, 0.5, 2.0};
+    std::copy(imp, imp + 5, m->pair_solimp + 5 * p);
+    m->pair_margin[p] = 0.0;
+    m->pair_gap[p] = 0.0;
+  }
 }
 
 // Geoms: the contact links' collide with the planes only, with the link's
@@ -66,6 +105,7 @@ void configure(Run& r, const scene::Scene& setup, const mech::MechanicalModel& m
   for (const mech::FrictionalContact& f : mm.friction)
     row_mu[static_cast<std::size_t>(f.contact)] = f.mu;
   for (const auto& cf : setup.contacts) {
+    if (!setup.bodies.empty()) break;  // pairs (configure_pairs)
     const auto b =
         static_cast<std::size_t>(id_or_throw(m, mjOBJ_BODY, cf.point.link, "body for link"));
     contact_body[b] = true;
@@ -93,42 +133,80 @@ void configure(Run& r, const scene::Scene& setup, const mech::MechanicalModel& m
     for (int k = 0; k < 3; ++k) m->geom_friction[3 * g + k] = 0.0;
     if (link && mu >= 0.0) m->geom_friction[3 * g] = mu;  // sliding; MuJoCo takes the larger
   }
+  configure_pairs(r, setup, row_mu, s, tc);
   for (int j = 0; j < m->nv; ++j) {
     m->dof_damping[j] = 0.0;
     m->dof_armature[j] = 0.0;
     m->dof_frictionloss[j] = 0.0;
   }
   for (int j = 0; j < m->njnt; ++j) {
-    m->jnt_limited[j] = 0;
+    // A scene of bodies' joints have the ranges of its stops (mjcf_bodies.cpp),
+    // soft as the contacts; a one-URDF scene's none (MuJoCo's URDF ranges off).
+    if (setup.bodies.empty()) m->jnt_limited[j] = 0;
     m->jnt_stiffness[j] = 0.0;
+    m->jnt_solref[2 * j] = tc;
+    m->jnt_solref[2 * j + 1] = s.damping_ratio;
+    const double imp[5] = {s.dmin, s.dmax, s.width, 0.5, 2.0};
+    std::copy(imp, imp + 5, m->jnt_solimp + 5 * j);
+    m->jnt_margin[j] = 0.0;
+  }
+}
+
+// The bases and joints: a one-URDF scene's free joint (kFreeJoint) and
+// joints by their URDF names; a scene of bodies' free joints by body and
+// joints by coordinate name (mjcf_bodies.cpp).
+void map_joints(Run& r, const scene::Scene& setup, const mech::MechanicalModel& mm) {
+  const mjModel* m = r.m.get();
+  const auto N = static_cast<std::size_t>(mm.dofs());
+  r.qadr.assign(N, -1);
+  r.vadr.assign(N, -1);
+  auto add_base = [&](int offset, const std::string& joint, const Matrix3d& R0) {
+    const int j = id_or_throw(m, mjOBJ_JOINT, joint, "free joint");
+    r.bases.push_back({offset, m->jnt_qposadr[j], m->jnt_dofadr[j], R0});
+  };
+  if (setup.bodies.empty() && setup.base.floating)
+    add_base(0, kFreeJoint, setup.base.pose.linear());
+  for (const scene::SceneBody& b : setup.bodies)
+    if (b.base.floating)
+      add_base(static_cast<int>(b.offset), base_joint_name(b.name), b.base.pose.linear());
+  std::vector<bool> base(N, false);
+  for (const FreeBase& fb : r.bases)
+    for (int i = 0; i < 6; ++i) base[static_cast<std::size_t>(fb.offset + i)] = true;
+  for (std::size_t c = 0; c < N; ++c) {
+    if (base[c]) continue;
+    const int j = id_or_throw(m, mjOBJ_JOINT, mm.coordinates[c], "joint");
+    r.qadr[c] = m->jnt_qposadr[j];
+    r.vadr[c] = m->jnt_dofadr[j];
   }
 }
 
 void map_coordinates(Run& r, const scene::Scene& setup, const mech::MechanicalModel& mm) {
   const mjModel* m = r.m.get();
-  r.nb = setup.base.floating ? 6 : 0;
-  r.R0 = setup.base.pose.linear();
-  if (r.nb > 0) {
-    const int j = id_or_throw(m, mjOBJ_JOINT, kFreeJoint, "free joint");
-    r.free_q = m->jnt_qposadr[j];
-    r.free_v = m->jnt_dofadr[j];
-  }
-  for (int c = r.nb; c < mm.dofs(); ++c) {
-    const int j = id_or_throw(m, mjOBJ_JOINT, mm.coordinates[static_cast<std::size_t>(c)], "joint");
-    r.qadr.push_back(m->jnt_qposadr[j]);
-    r.vadr.push_back(m->jnt_dofadr[j]);
-  }
+  map_joints(r, setup, mm);
   const int k = mm.num_constraints();
   r.row_body.assign(static_cast<std::size_t>(k), -1);
   r.row_local.assign(static_cast<std::size_t>(k), Vector3d::Zero());
   r.row_radius.assign(static_cast<std::size_t>(k), 0.0);
   r.row_normal.assign(static_cast<std::size_t>(k), Vector3d::UnitZ());
+  r.row_t1.assign(static_cast<std::size_t>(k), Vector3d::UnitX());
+  r.row_t2.assign(static_cast<std::size_t>(k), Vector3d::UnitY());
+  if (!setup.bodies.empty()) r.geom_row.assign(static_cast<std::size_t>(m->ngeom), -1);
+  if (!setup.bodies.empty())
+    for (const auto& [name, range] : joint_ranges(setup))
+      r.stops[id_or_throw(m, mjOBJ_JOINT, name, "joint")] = range;
   for (const auto& cf : setup.contacts) {
     const auto i = static_cast<std::size_t>(cf.row);
-    r.row_body[i] = mj_name2id(m, mjOBJ_BODY, cf.point.link.c_str());
     r.row_local[i] = cf.point.local;
     r.row_radius[i] = cf.point.radius;
     r.row_normal[i] = cf.normal;
+    r.row_t1[i] = cf.tangent1;
+    r.row_t2[i] = cf.tangent2;
+    if (setup.bodies.empty()) {
+      r.row_body[i] = mj_name2id(m, mjOBJ_BODY, cf.point.link.c_str());
+    } else {
+      const int g = id_or_throw(m, mjOBJ_GEOM, row_geom_name(cf.row), "geom");
+      r.geom_row[static_cast<std::size_t>(g)] = static_cast<int>(cf.row);
+    }
   }
   // The scene's own forces (src/bullet/multibody_world.cpp's scene_forces).
   VectorXd q_ref = VectorXd::Zero(mm.dofs());
@@ -143,45 +221,48 @@ void map_coordinates(Run& r, const scene::Scene& setup, const mech::MechanicalMo
 
 void set_state(Run& r, const VectorXd& q, const VectorXd& v) {
   mjData* d = r.d.get();
-  if (r.nb > 0) {
-    const Vector3d rv = q.segment<3>(3);
-    const Matrix3d R = scene::exp_so3(rv) * r.R0;
+  for (const FreeBase& fb : r.bases) {
+    const Vector3d rv = q.segment<3>(fb.offset + 3);
+    const Matrix3d R = scene::exp_so3(rv) * fb.R0;
     const Eigen::Quaterniond quat(R);
-    for (int i = 0; i < 3; ++i) d->qpos[r.free_q + i] = q(i);
-    d->qpos[r.free_q + 3] = quat.w();
-    d->qpos[r.free_q + 4] = quat.x();
-    d->qpos[r.free_q + 5] = quat.y();
-    d->qpos[r.free_q + 6] = quat.z();
-    const Vector3d omega_local = R.transpose() * (scene::left_jacobian(rv) * v.segment<3>(3));
+    for (int i = 0; i < 3; ++i) d->qpos[fb.q + i] = q(fb.offset + i);
+    d->qpos[fb.q + 3] = quat.w();
+    d->qpos[fb.q + 4] = quat.x();
+    d->qpos[fb.q + 5] = quat.y();
+    d->qpos[fb.q + 6] = quat.z();
+    const Vector3d omega_local =
+        R.transpose() * (scene::left_jacobian(rv) * v.segment<3>(fb.offset + 3));
     for (int i = 0; i < 3; ++i) {
-      d->qvel[r.free_v + i] = v(i);
-      d->qvel[r.free_v + 3 + i] = omega_local(i);
+      d->qvel[fb.v + i] = v(fb.offset + i);
+      d->qvel[fb.v + 3 + i] = omega_local(i);
     }
   }
   for (std::size_t c = 0; c < r.qadr.size(); ++c) {
-    d->qpos[r.qadr[c]] = q(r.nb + static_cast<int>(c));
-    d->qvel[r.vadr[c]] = v(r.nb + static_cast<int>(c));
+    if (r.qadr[c] < 0) continue;
+    d->qpos[r.qadr[c]] = q(static_cast<int>(c));
+    d->qvel[r.vadr[c]] = v(static_cast<int>(c));
   }
 }
 
 void get_state(const Run& r, VectorXd& q, VectorXd& v) {
   const mjData* d = r.d.get();
-  if (r.nb > 0) {
-    const Eigen::Quaterniond quat(d->qpos[r.free_q + 3], d->qpos[r.free_q + 4],
-                                  d->qpos[r.free_q + 5], d->qpos[r.free_q + 6]);
+  for (const FreeBase& fb : r.bases) {
+    const Eigen::Quaterniond quat(d->qpos[fb.q + 3], d->qpos[fb.q + 4], d->qpos[fb.q + 5],
+                                  d->qpos[fb.q + 6]);
     const Matrix3d R = quat.normalized().toRotationMatrix();
-    const Vector3d rv = scene::log_so3(R * r.R0.transpose());
-    const Vector3d omega_local(d->qvel[r.free_v + 3], d->qvel[r.free_v + 4], d->qvel[r.free_v + 5]);
+    const Vector3d rv = scene::log_so3(R * fb.R0.transpose());
+    const Vector3d omega_local(d->qvel[fb.v + 3], d->qvel[fb.v + 4], d->qvel[fb.v + 5]);
     for (int i = 0; i < 3; ++i) {
-      q(i) = d->qpos[r.free_q + i];
-      v(i) = d->qvel[r.free_v + i];
+      q(fb.offset + i) = d->qpos[fb.q + i];
+      v(fb.offset + i) = d->qvel[fb.v + i];
     }
-    q.segment<3>(3) = rv;
-    v.segment<3>(3) = scene::left_jacobian(rv).lu().solve(R * omega_local);
+    q.segment<3>(fb.offset + 3) = rv;
+    v.segment<3>(fb.offset + 3) = scene::left_jacobian(rv).lu().solve(R * omega_local);
   }
   for (std::size_t c = 0; c < r.qadr.size(); ++c) {
-    q(r.nb + static_cast<int>(c)) = d->qpos[r.qadr[c]];
-    v(r.nb + static_cast<int>(c)) = d->qvel[r.vadr[c]];
+    if (r.qadr[c] < 0) continue;
+    q(static_cast<int>(c)) = d->qpos[r.qadr[c]];
+    v(static_cast<int>(c)) = d->qvel[r.vadr[c]];
   }
 }
 
@@ -191,47 +272,82 @@ void get_state(const Run& r, VectorXd& q, VectorXd& v) {
 void apply_forces(Run& r, const VectorXd& q, const VectorXd& tau) {
   mjData* d = r.d.get();
   mju_zero(d->qfrc_applied, r.m->nv);
-  if (r.nb > 0) {
-    const Vector3d rv = q.segment<3>(3);
-    const Matrix3d R = scene::exp_so3(rv) * r.R0;
-    const Vector3d t_world = scene::left_jacobian(rv).transpose().lu().solve(tau.segment<3>(3));
+  for (const FreeBase& fb : r.bases) {
+    const Vector3d rv = q.segment<3>(fb.offset + 3);
+    const Matrix3d R = scene::exp_so3(rv) * fb.R0;
+    const Vector3d t_world =
+        scene::left_jacobian(rv).transpose().lu().solve(tau.segment<3>(fb.offset + 3));
     const Vector3d t_local = R.transpose() * t_world;
     for (int i = 0; i < 3; ++i) {
-      d->qfrc_applied[r.free_v + i] = tau(i);
-      d->qfrc_applied[r.free_v + 3 + i] = t_local(i);
+      d->qfrc_applied[fb.v + i] = tau(fb.offset + i);
+      d->qfrc_applied[fb.v + 3 + i] = t_local(i);
     }
   }
   for (std::size_t c = 0; c < r.vadr.size(); ++c)
-    d->qfrc_applied[r.vadr[c]] = tau(r.nb + static_cast<int>(c));
+    if (r.vadr[c] >= 0) d->qfrc_applied[r.vadr[c]] = tau(static_cast<int>(c));
 }
 
-// Each MuJoCo contact's normal force, given to the scene's contact point of
-// the same body nearest to it (N).
-void contact_forces(const Run& r, VectorXd& u) {
+// Each MuJoCo contact's force on the scene's contact point: its normal
+// component in u, its components along the row's tangents t1, t2
+// (scene::ContactFrame) in ut1, ut2 (N, by row of E). A scene of bodies has
+// one geom per contact row; a one-URDF scene's contact goes to the contact
+// point of the same body nearest to it. MuJoCo's contact frame has the
+// normal from geom1 to geom2 and f is the force on geom2.
+void contact_forces(const Run& r, VectorXd& u, VectorXd& ut1, VectorXd& ut2) {
   const mjModel* m = r.m.get();
   const mjData* d = r.d.get();
   u.setZero();
+  ut1.setZero();
+  ut2.setZero();
   for (int i = 0; i < d->ncon; ++i) {
     const mjContact& c = d->contact[i];
-    const int g = m->geom_bodyid[c.geom1] == 0 ? c.geom2 : c.geom1;
-    const int body = m->geom_bodyid[g];
     mjtNum f[6];
     mj_contactForce(m, d, i, f);
-    const Vector3d pos(c.pos[0], c.pos[1], c.pos[2]);
-    Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> R(d->xmat + 9 * body);
-    const Vector3d x(d->xpos[3 * body], d->xpos[3 * body + 1], d->xpos[3 * body + 2]);
     int best = -1;
-    double best_d = 0.0;
-    for (std::size_t k = 0; k < r.row_body.size(); ++k) {
-      if (r.row_body[k] != body) continue;
-      const Vector3d p = x + R * r.row_local[k] - r.row_radius[k] * r.row_normal[k];
-      const double dist = (p - pos).norm();
-      if (best < 0 || dist < best_d) {
-        best = static_cast<int>(k);
-        best_d = dist;
+    double sign = 1.0;  // the force on the point is sign times the force on geom2
+    if (!r.geom_row.empty()) {
+      const int r1 = r.geom_row[static_cast<std::size_t>(c.geom1)];
+      const int r2 = r.geom_row[static_cast<std::size_t>(c.geom2)];
+      best = r2 >= 0 ? r2 : r1;
+      sign = r2 >= 0 ? 1.0 : -1.0;
+    } else {
+      const bool first_is_world = m->geom_bodyid[c.geom1] == 0;
+      sign = first_is_world ? 1.0 : -1.0;
+      const int g = first_is_world ? c.geom2 : c.geom1;
+      const int body = m->geom_bodyid[g];
+      const Vector3d pos(c.pos[0], c.pos[1], c.pos[2]);
+      Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> R(d->xmat + 9 * body);
+      const Vector3d x(d->xpos[3 * body], d->xpos[3 * body + 1], d->xpos[3 * body + 2]);
+      double best_d = 0.0;
+      for (std::size_t k = 0; k < r.row_body.size(); ++k) {
+        if (r.row_body[k] != body) continue;
+        const Vector3d p = x + R * r.row_local[k] - r.row_radius[k] * r.row_normal[k];
+        const double dist = (p - pos).norm();
+        if (best < 0 || dist < best_d) {
+          best = static_cast<int>(k);
+          best_d = dist;
+        }
       }
     }
-    if (best >= 0) u(best) += f[0];
+    if (best < 0) continue;
+    u(best) += f[0];
+    Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> frame(c.frame);
+    const Vector3d force = sign * (frame.transpose() * Vector3d(f[0], f[1], f[2]));
+    ut1(best) += r.row_t1[static_cast<std::size_t>(best)].dot(force);
+    ut2(best) += r.row_t2[static_cast<std::size_t>(best)].dot(force);
+  }
+  // A scene of bodies' joint stops: each limit row's force (>= 0) on the side
+  // its Jacobian says (+1 at the lower bound, -1 at the upper), per |c|.
+  for (int i = 0; i < d->nefc; ++i) {
+    if (d->efc_type[i] != mjCNSTR_LIMIT_JOINT) continue;
+    const auto stop = r.stops.find(d->efc_id[i]);
+    if (stop == r.stops.end()) continue;
+    const int dof = m->jnt_dofadr[d->efc_id[i]];
+    const bool lower = d->efc_J[static_cast<std::size_t>(i) * static_cast<std::size_t>(m->nv) +
+                                static_cast<std::size_t>(dof)] > 0.0;
+    const JointRange& jr = stop->second;
+    const int row = lower ? jr.lower_row : jr.upper_row;
+    if (row >= 0) u(row) += d->efc_force[i] / (lower ? jr.lower_scale : jr.upper_scale);
   }
 }
 
@@ -243,6 +359,7 @@ struct Recorder {
   sim::Trajectory& tr;
   sim::OutputSampler sampler;
   sim::IndexSet mode;
+  VectorXd ut1, ut2;  // the last step's tangential forces by row (N)
   void sample(double t, const VectorXd& q, const VectorXd& v, const VectorXd& u) {
     const VectorXd y = mm.E * q + mm.g;
     if (y.size() > 0) tr.max_violation = std::min(tr.max_violation, std::min(0.0, y.minCoeff()));
@@ -254,6 +371,18 @@ struct Recorder {
     s.u = u;
     s.y = y;
     s.mode = mode;
+    // Each friction entry's multipliers along its tangent rows (its contact
+    // row's world tangents), as lcsim's own runs give them.
+    if (!mm.friction.empty()) {
+      const auto nf = static_cast<Eigen::Index>(mm.friction.size());
+      s.u_t = VectorXd::Zero(nf);
+      if (mm.has_friction_3d()) s.u_t2 = VectorXd::Zero(nf);
+      for (Eigen::Index e = 0; e < nf && ut1.size() > 0; ++e) {
+        const int row = mm.friction[static_cast<std::size_t>(e)].contact;
+        s.u_t(e) = ut1(row);
+        if (s.u_t2.size() > 0) s.u_t2(e) = ut2(row);
+      }
+    }
     tr.record_sample(std::move(s), opt);
   }
   void step(double t, const VectorXd& x_before, const VectorXd& q, const VectorXd& v,
@@ -285,7 +414,7 @@ struct Recorder {
 void prepare(Run& r, const mech::Model& model, const Settings& s, double h) {
   check_expressible(model);
   const std::optional<scene::Scene> setup = scene::load_scene_details(model.source);
-  r.m = load_scene_model(*setup);
+  r.m = setup->bodies.empty() ? load_scene_model(*setup) : load_bodies_model(*setup);
   configure(r, *setup, *model.mechanical, s, h);
   map_coordinates(r, *setup, *model.mechanical);
 }
@@ -360,7 +489,8 @@ sim::Trajectory simulate_mujoco(const mech::Model& model, const VectorXd& x0,
   mj_forward(r.m.get(), r.d.get());
   tr.energy_initial = mech::total_energy(mm, q, v);
   tr.max_violation = 0.0;
-  Recorder rec{mm, opt, tr, sim::OutputSampler(opt.dt_out), {}};
+  Recorder rec{
+      mm, opt, tr, sim::OutputSampler(opt.dt_out), {}, VectorXd::Zero(k), VectorXd::Zero(k)};
   rec.sample(0.0, q, v, u);
   sim::DivergenceGuard guard(model, x0, *opt.t_end);
   const sim::StepGrid grid = sim::StepGrid::of(*opt.t_end, opt.h);
@@ -374,7 +504,7 @@ sim::Trajectory simulate_mujoco(const mech::Model& model, const VectorXd& x0,
     x_before << q, v;
     apply_forces(r, q, r.f_s - r.K_s * q - r.D * v);
     mj_step(r.m.get(), r.d.get());
-    contact_forces(r, u);
+    contact_forces(r, u, rec.ut1, rec.ut2);
     get_state(r, q, v);
     std::string why = r.d->warning[mjWARN_BADQACC].number > 0
                           ? "diverged at t = " + short_number(t) +

@@ -118,5 +118,46 @@ TEST(MujocoFriction, ALinkWithTwoCoefficientsIsRefusedInOneLine) {
   std::filesystem::remove_all(dir);
 }
 
+// The samples' friction multipliers (issue 27's outputs) on the box sliding
+// along the floor's first tangent (psi = 0: +t1 = +y): each step's friction
+// on the four corners sums to -mu times their normal multipliers while it
+// slides (on the cone's boundary, against the velocity: to rounding of O(1)
+// N), nothing acts along t2, and the multipliers are the whole horizontal
+// force on the box, so their impulse is its momentum change,
+// sum h u_t = m (v_y(T) - v0), to rounding (600 steps: 1e-12 N s).
+TEST(PeerFrictionOutputs, TheSamplesCarryTheFrictionAlongTheTangents) {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("lcsim_mujoco_slide_ut_" + std::to_string(::getpid()));
+  const mech::Model m = scene::load_model(test_support::write_slide_scene(dir, 0.0, kMu, kV0, 0.6));
+  sim::Options o;
+  o.t_end = 0.6;
+  o.h = kH;
+  o.dt_out = kH;
+  const sim::Trajectory tr = simulate_mujoco(m, m.initial, o);
+  std::filesystem::remove_all(dir);  // the peer has read the scene again
+  ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
+  ASSERT_EQ(tr.samples.back().u_t.size(), 4);  // the bottom corners (max_distance drops the top)
+  ASSERT_EQ(tr.samples.back().u_t2.size(), 4);
+  double coulomb = 0.0, across = 0.0, impulse = 0.0;
+  int sliding = 0;
+  for (std::size_t j = 1; j < tr.samples.size(); ++j) {
+    const sim::Sample& s = tr.samples[j];
+    impulse += kH * s.u_t.sum();
+    across = std::max(across, std::abs(s.u_t2.sum()));
+    if (s.x(7) < 0.05) continue;  // sliding: v_y well above 0
+    coulomb = std::max(coulomb, std::abs(s.u_t.sum() + kMu * s.u.sum()));
+    ++sliding;
+  }
+  const double mass = 1.2, v_end = tr.final_state(7);
+  std::printf(
+      "[ mujoco   ] |u_t + mu u_n| <= %.3e N over %d sliding steps, |u_t2| <= %.3e N, "
+      "impulse %.12g N s (m (v_end - v0) = %.12g)\n",
+      coulomb, sliding, across, impulse, mass * (v_end - kV0));
+  EXPECT_GT(sliding, 250);
+  EXPECT_LE(coulomb, 1e-9);
+  EXPECT_LE(across, 1e-9);
+  EXPECT_NEAR(impulse, mass * (v_end - kV0), 1e-12);
+}
+
 }  // namespace
 }  // namespace lcsim::mujoco

@@ -27,7 +27,10 @@ std::string version_string();
 namespace lcsim::bullet {
 
 // Every Bullet setting that affects accuracy, pinned (Bullet's defaults are
-// stated where they differ). Two scenes (docs/bullet-comparison.md):
+// stated where they differ). Three scenes (docs/bullet-comparison.md; a
+// scene of several bodies, `bodies:`, is one btMultiBody per body with its
+// contact points as colliders of their own, src/bullet/bodies_world.cpp and
+// docs/contacts.md, "Scenes of several bodies"):
 // - a model from a URDF scene whose constraints are all joint limits is the
 //   URDF itself: a Featherstone btMultiBody (src/bullet/multibody_world.cpp)
 //   with btMultiBodyJointLimitConstraint limits, the scene's springs and
@@ -125,7 +128,10 @@ void check_expressible(const mech::Model& model);
 // land on opt.t_end), filling the same Trajectory as the time-stepping
 // methods: samples (every step, or on the opt.dt_out grid; x = q then v in the
 // model's coordinate order), u = constraint impulse / h (rb6: from the
-// momentum balance; multibody: Bullet's limit impulses), mode = constraints
+// momentum balance; multibody: Bullet's limit and contact impulses; a
+// contact scene with friction: u_t, u_t2 = the friction impulse / h on each
+// friction entry's point along its contact's tangents t1, t2, zero at
+// t = 0), mode = constraints
 // with a nonzero impulse in the step, events at every mode change, energy
 // (of lcsim's model at Bullet's states), max_violation. A model Bullet cannot
 // express throws std::invalid_argument (an input error, as

@@ -2,10 +2,14 @@
 // with contacts run in MuJoCo beside lcsim (docs/contacts.md, "Peers on
 // contact scenes").
 //
-// Public face of src/mujoco. MuJoCo loads the scene's URDF itself (its own
-// URDF reader: bodies, joints, inertias, the <collision> primitives as
-// geoms); lcsim then adds a free joint at the root (a floating base) and one
-// plane geom per scene plane, and sets the contact parameters below.
+// Public face of src/mujoco. A one-URDF scene: MuJoCo loads the scene's URDF
+// itself (its own URDF reader: bodies, joints, inertias, the <collision>
+// primitives as geoms); lcsim then adds a free joint at the root (a floating
+// base) and one plane geom per scene plane, and sets the contact parameters
+// below. A scene of several bodies (`bodies:`): lcsim writes the whole MJCF
+// from the scene it parsed, each contact point a geom and each contact row an
+// explicit <pair> (src/mujoco/mjcf_bodies.cpp; docs/contacts.md, "Scenes of
+// several bodies").
 #pragma once
 
 #include <Eigen/Dense>
@@ -57,18 +61,21 @@ std::string settings_description(const Settings& s, double h, bool friction = fa
 
 // Throws std::invalid_argument naming what MuJoCo cannot run here: a model
 // that is not a URDF scene (or changed since it was loaded), a scene
-// constraint that is not a contact against a plane (a joint stop), a
-// contact with explicit points, a link whose contact points differ in their
-// friction coefficient (MuJoCo's friction is per geom), a mimic joint, a movable URDF
-// joint the scene does not simulate, a fixed base at a pose other than the
-// identity.
+// constraint that is not a contact (a joint stop), a mimic joint; in a
+// one-URDF scene also a contact with explicit points, a link whose contact
+// points differ in their friction coefficient (MuJoCo's friction is per
+// geom), a movable URDF joint the scene does not simulate, a fixed base at a
+// pose other than the identity.
 void check_expressible(const mech::Model& model);
 
 // The scene run by mj_step at fixed step opt.h (the last step shortened to
 // land on opt.t_end), filling a Trajectory as the time-stepping methods do:
 // samples (every step, or on the opt.dt_out grid; x = q then v in the
-// model's coordinate order), u = each contact point's normal force (the
-// MuJoCo contact nearest to that point on its link, N), mode = the contact
+// model's coordinate order), u = each contact point's normal force (its own
+// geom's in a scene of bodies; the MuJoCo contact nearest to that point on
+// its link in a one-URDF scene, N), u_t and u_t2 = the friction force on
+// each friction entry's point along its contact's tangents t1, t2 (N; zero
+// at t = 0, empty without friction), mode = the contact
 // points with a force, events at every mode change, energies of lcsim's
 // model at MuJoCo's states, max_violation (lcsim's linear gaps there: the
 // soft contacts penetrate). Not expressible: std::invalid_argument before
