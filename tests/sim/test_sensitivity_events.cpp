@@ -570,17 +570,42 @@ TEST(SensitivityEvents, FrictionImpactBlockClosedForm) {
   }
 }
 
+// On the boundary between the two (vx0 = mu w: the impact leaves the block
+// stuck with |P_T| = mu P_N, or sliding at zero velocity, as rounding
+// decides) the impact map has a kink: no derivative, reported at t1 naming
+// the floor, every column absent.
+TEST(SensitivityEvents, FrictionImpactAtStickSlipBoundaryHasNoDerivative) {
+  const mech::Model m = load("robots/block_on_floor_friction.yaml");
+  const double mu = 0.4, g = 9.81, y0 = 0.2, w = std::sqrt(2 * g * y0);
+  VectorXd x0(4);
+  x0 << 0, y0, mu * w, 0;
+  const sim::Trajectory tr = run(m, x0, 0.5, {"x0"});
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  ASSERT_EQ(tr.sensitivity_losses.size(), 1u);
+  const sim::SensitivityLoss& l = tr.sensitivity_losses[0];
+  EXPECT_EQ(l.contact, "floor");
+  EXPECT_NEAR(l.t, w / g, 1e-14);
+  EXPECT_NE(l.reason.find("stick and slip meet"), std::string::npos) << l.reason;
+  for (char e : tr.dx_final_exists) EXPECT_FALSE(e);
+  EXPECT_EQ(tr.dx_final.cwiseAbs().maxCoeff(), 0.0);
+}
+
 // A planar bar (x, y, theta; M = diag(1, 1, 0.1), gravity) landing on its
 // corner, gap y - 0.5 theta, tangential velocity x' + 0.2 y' + 0.4 theta'
 // (orthogonal to the normal row): the Delassus matrix couples normal and
 // tangent (W_NT = 0.2 - 2 = -1.8; W_NN - mu |W_NT| > 0), so the impact
 // turns the bar and its stick or slip outcome depends on every entry of
 // x0. From (0, 0.3, 0, 1, 0, omega0) with mu = 1.5 (sticks) and mu = 0.2
-// (slides), plastic, to T = 0.6 s (events after the impact: its stick or
-// slip phases and releases): every entry of x0 against central
-// differences at x(T) and every event time (6 x (6 + events)).
+// (slides), plastic, and with mu = 0.2 and e = 0.5 (a bounce, restitution
+// on the approaching normal only: impacts at 0.228 and 0.476 s, the third
+// at 0.59998 too close to 0.6 for differences), to T = 0.6 s (0.55 s with
+// e): every entry of x0 against central differences at x(T) and every
+// event time (6 x (6 + events)).
 TEST(SensitivityEvents, FrictionImpactBarAgainstFiniteDifferences) {
-  for (double mu : {1.5, 0.2}) {
+  struct Case {
+    double mu, e, T;
+  };
+  for (const auto& [mu, e, T] : {Case{1.5, 0.0, 0.6}, Case{0.2, 0.0, 0.6}, Case{0.2, 0.5, 0.55}}) {
     mech::Model m;
     m.name = "bar";
     mech::MechanicalModel& b = m.mechanical.emplace();
@@ -596,7 +621,7 @@ TEST(SensitivityEvents, FrictionImpactBarAgainstFiniteDifferences) {
     b.g = VectorXd::Zero(1);
     b.coordinates = {"x", "y", "theta"};
     b.constraints = {"corner"};
-    b.restitution = VectorXd::Zero(1);
+    b.restitution = VectorXd::Constant(1, e);
     mech::FrictionalContact fc;
     fc.contact = 0;
     fc.tangent = Eigen::SparseVector<double>(3);
@@ -607,14 +632,15 @@ TEST(SensitivityEvents, FrictionImpactBarAgainstFiniteDifferences) {
     b.friction = {fc};
     m.initial = VectorXd(6);
     m.initial << 0, 0.3, 0, 1, 0, 0.4;
-    m.t_end = 0.6;
+    m.t_end = T;
     const sim::Trajectory plain = run(m, m.initial, m.t_end);
     ASSERT_TRUE(plain.ok()) << plain.message;
     ASSERT_GE(plain.events.size(), 1u);
     EXPECT_EQ(plain.events[0].type, sim::EventType::kImpact);
     const int n = expect_matches_fd(m, m.initial, m.t_end, {}, true);
     EXPECT_EQ(n, 6 * (6 + static_cast<int>(plain.events.size()))) << "mu = " << mu;
-    std::cout << "bar, mu = " << mu << ": " << plain.events.size() << " events, after the impact "
+    std::cout << "bar, mu = " << mu << ", e = " << e << ": " << plain.events.size()
+              << " events, after the first impact "
               << sim::to_string(plain.events[0].friction_mode_after[0]) << "\n";
   }
 }
