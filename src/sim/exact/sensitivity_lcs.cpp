@@ -150,9 +150,10 @@ void Sensitivity::lcs_mode_derivatives(const lcs::IndexSet& mode, double t) {
   }
   if (!singular.empty())
     lose(t, mode.front(),
-         "the entries " + names +
-             " change a leading row index of this mode: a singular perturbation (for example a "
-             "zero feedthrough made nonzero), where no derivative exists",
+         (singular.size() == 1 ? "the entry " + names + " changes"
+                               : "the entries " + names + " change") +
+             " a leading row index of this mode: a singular perturbation (for example a zero "
+             "feedthrough made nonzero), where no derivative exists",
          singular, true);
 }
 
