@@ -645,5 +645,50 @@ TEST(SensitivityEvents, FrictionImpactBarAgainstFiniteDifferences) {
   }
 }
 
+// An input's own parameter: a sine's amplitude (amplitude[push]), which
+// enters the exosystem's output row only (value = offset + amplitude s), so
+// the phases' dAcl and dF_I carry it as a column of H and no event's
+// re-initialisation moves with it. A unit mass on a unit spring, pushed
+// into a plastic stop q >= -0.5 by f = -0.8 and pulled by a damped sine
+// (amplitude 2, 0.3 Hz, damping 0.1 1/s): impact at 2.841 s, release under
+// the sine at 3.413 s (a multiplier monitor: dF_I), impact at 6.360 s,
+// release at 6.747 s; to T = 8: x0, amplitude[push], f[0] against central
+// differences at x(T) and each event time (4 x (2 + 4) entries). The
+// amplitude of an input that moves a stop, and of a non-sine, are refused.
+TEST(SensitivityEvents, SineAmplitudeAgainstFiniteDifferences) {
+  const std::filesystem::path p = std::filesystem::temp_directory_path() /
+                                  ("lcsim_pushed_" + std::to_string(::getpid()) + ".yaml");
+  std::ofstream(p) << "name: pushed\ninputs:\n"
+                      "  - {name: push, kind: sine, amplitude: 2, frequency: 0.3, damping: 0.1}\n"
+                      "  - {name: lift, kind: constant, value: 1}\n"
+                      "mechanical:\n  M: [[1]]\n  K: [[1]]\n  f: [-0.8]\n  E: [[1]]\n"
+                      "  g: [0.5]\n  restitution: [0]\n  constraints: [stop]\n"
+                      "  coordinates: [x]\n  force_inputs: [{input: push, gain: [1]}]\n"
+                      "initial: [0, 0]\nt_end: 8\n";
+  const mech::Model m = scene::load_model(p.string());
+  std::filesystem::remove(p);
+  const sim::Trajectory plain = run(m, m.initial, 8.0);
+  ASSERT_TRUE(plain.ok()) << plain.message;
+  ASSERT_EQ(plain.events.size(), 4u);
+  const Perturbation amp{"amplitude[push]", 2.0, [](mech::Model& mm, VectorXd&, double d) {
+                           mm.mechanical->inputs[0].amplitude += d;
+                         }};
+  EXPECT_EQ(expect_matches_fd(m, m.initial, 8.0, {amp, force(0, -0.8)}, true), 4 * 6);
+  for (const char* bad : {"amplitude[lift]", "amplitude[nope]"}) {
+    sim::Options o;
+    o.t_end = 1.0;
+    o.sensitivity = {bad};
+    const sim::Trajectory tr = sim::simulate(m, m.initial, o, "event");
+    EXPECT_EQ(tr.status, Status::kInvalidInput) << bad;
+  }
+  const mech::Model shaker = load("robots/shaker_table.yaml");
+  sim::Options o;
+  o.t_end = 0.1;
+  o.sensitivity = {"amplitude[table]"};
+  const sim::Trajectory tr = sim::simulate(shaker, shaker.initial, o, "event");
+  EXPECT_EQ(tr.status, Status::kInvalidInput);
+  EXPECT_NE(tr.message.find("moves a stop"), std::string::npos) << tr.message;
+}
+
 }  // namespace
 }  // namespace lcsim

@@ -39,6 +39,17 @@ void add_input_forces(const mech::MechanicalModel& m, MatrixXd& H) {
   }
 }
 
+// d H / d amplitude of input `input` (N x n): its force uses' gains times
+// d l / d amplitude = (0, 1, 0) on its exosystem's columns.
+MatrixXd amplitude_columns(const mech::MechanicalModel& m, int input, int n) {
+  MatrixXd dH = MatrixXd::Zero(m.dofs(), n);
+  int at = 2 * m.dofs() + 1;
+  for (int i = 0; i < input; ++i) at += m.inputs[static_cast<size_t>(i)].exo_size();
+  for (const mech::InputUse& use : m.force_inputs)
+    if (use.input == input) dH.col(at + 1) += use.gain;
+  return dH;
+}
+
 }  // namespace
 
 Sensitivity::Sensitivity(const mech::Model& model, const lcs::Lcs& sys, const SensColumns& cols,
@@ -209,6 +220,12 @@ void Sensitivity::mode_derivatives(const lcs::IndexSet& mode, double t) {
         dAv -= Q.col(sp.j) * QH.row(sp.i);
         dF += WinvEG.col(sp.j) * QH.row(sp.i);
       }
+    } else if (sp.kind == 'a') {
+      // A sine's amplitude: dH = gain (0, 1, 0) on the input's exosystem
+      // columns, for each force it drives (sensitivity_names.cpp).
+      const MatrixXd dH = amplitude_columns(m, sp.i, n_);
+      dAv = Q * dH;
+      dF = -WinvEG * dH;
     } else {
       const int col = sp.kind == 'f' ? 2 * N_ : sp.kind == 'K' ? sp.j : N_ + sp.j;
       const double sign = sp.kind == 'f' ? 1.0 : -1.0;

@@ -45,10 +45,36 @@ std::vector<std::string> keys(const std::string& s) {
   return out;
 }
 
+// amplitude[input]: a sine input's amplitude (kind 'a', i the input), where
+// it drives forces only: it is the exosystem's output row l = (1, amplitude,
+// 0), so it moves H's input columns and no state of the exosystem (which
+// the breakpoints re-set to functions of t alone). On a moving stop it would
+// move C and the impacts' relative velocity: not named.
+std::string parse_amplitude(const mech::MechanicalModel& m, const std::string& s, SensParam& p) {
+  const std::string bad = "sensitivity '" + s + "': ";
+  const std::vector<std::string> k = keys(s.substr(std::string("amplitude").size() - 1));
+  if (k.size() != 1u) return bad + "expected one index, as amplitude[push]";
+  std::vector<std::string> names;
+  for (const mech::Input& in : m.inputs) names.push_back(in.name);
+  p.kind = 'a';
+  p.name = s;
+  p.i = resolve(k[0], names);
+  if (p.i < 0) return bad + "no input '" + k[0] + "'";
+  if (!m.inputs[static_cast<size_t>(p.i)].sine)
+    return bad + "input '" + k[0] + "' is not a sine (only a sine's amplitude is named)";
+  for (const mech::InputUse& u : m.gap_inputs)
+    if (u.input == p.i)
+      return bad + "input '" + k[0] + "' moves a stop: its amplitude's derivative is not computed";
+  return "";
+}
+
 std::string parse_one(const mech::MechanicalModel& m, const std::string& s, SensParam& p) {
   const std::string bad = "sensitivity '" + s + "': ";
+  if (s.rfind("amplitude[", 0) == 0) return parse_amplitude(m, s, p);
   if (s.size() < 2 || std::string("fgeKDM").find(s[0]) == std::string::npos)
-    return bad + "not a parameter name (x0, f[i], g[c], e[c], K[i][j], D[i][j], M[i][j])";
+    return bad +
+           "not a parameter name (x0, f[i], g[c], e[c], K[i][j], D[i][j], M[i][j], "
+           "amplitude[input])";
   p.kind = s[0];
   p.name = s;
   const std::vector<std::string> k = keys(s);
