@@ -690,5 +690,23 @@ TEST(SensitivityEvents, SineAmplitudeAgainstFiniteDifferences) {
   EXPECT_NE(tr.message.find("moves a stop"), std::string::npos) << tr.message;
 }
 
+// Every column lost at the start (the ball leaving the ground from a zero
+// gap: x0 and g[ground] have one-sided derivatives only), then an impact:
+// the run carries nothing and completes with every entry absent (a
+// regression test: the phases' parameter terms must exist, empty, when no
+// column does).
+TEST(SensitivityEvents, EveryColumnLostAtTheStartThenAnImpact) {
+  const mech::Model m = load("robots/ball.yaml");
+  VectorXd x0(2);
+  x0 << 0.0, 2.0;
+  const sim::Trajectory tr = run(m, x0, 1.0, {"x0", "g[ground]"});
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  ASSERT_GE(tr.events.size(), 1u);
+  EXPECT_EQ(tr.events[0].type, sim::EventType::kImpact);
+  for (char e : tr.dx_final_exists) EXPECT_FALSE(e);
+  EXPECT_EQ(tr.dx_final.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(run(m, x0, 1.0).final_state, tr.final_state);
+}
+
 }  // namespace
 }  // namespace lcsim

@@ -254,7 +254,8 @@ void Sensitivity::begin_phase(const Phase& ph, double t0, const VectorXd& xa, co
   if (std::any_of(exists_.begin(), exists_.end(), [](char e) { return e != 0; }))
     mode_derivatives(ph.mode, t0);
   else
-    dAb_.clear(), dF_.assign(cols_.params.size(), MatrixXd());  // at() carries nothing
+    dAb_.clear(), dF_.assign(cols_.params.size(), MatrixXd()),
+        dW_.assign(cols_.params.size(), MatrixXd());  // at() carries nothing
   norm1_ = Ab_.cwiseAbs().colwise().sum().maxCoeff();
   double dnorm = 0.0;
   for (const MatrixXd& d : dAb_)
