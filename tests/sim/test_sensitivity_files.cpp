@@ -3,7 +3,7 @@
 // short horizon: dx(T)/dx0 and one parameter f[0] against central
 // differences of the exact method where the run says they exist, and where
 // the run says they do not (a zero gap at the start, coinciding events, a
-// general LCS's jump), the loss names a contact or says why and the columns
+// general LCS started on a switching surface), the loss names a contact or says why and the columns
 // carry no number. The friction files are refused (stick / slip is not
 // covered). Tolerance as tests/sim/test_sensitivity.cpp's: 4 |D(d) - D(d/2)|
 // (Richardson's estimate of D(d/2)'s truncation, margin 12) plus
