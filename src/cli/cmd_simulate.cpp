@@ -226,7 +226,8 @@ void setup(CLI::App& app) {
   cmd->add_flag("--json", a->json, "Print the run summary as JSON");
   cmd->add_option("--sensitivity", a->sensitivity,
                   "Forward sensitivities of the exact method, comma-separated: x0, f[i], g[c], "
-                  "e[c], K[i][j], D[i][j], M[i][j] (docs/sensitivities.md); in --json, and with "
+                  "e[c], K[i][j], D[i][j], M[i][j], amplitude[input]; a general LCS's A[i][j], "
+                  "B[i][j], C[i][j], D[i][j] (docs/sensitivities.md); in --json, and with "
                   "--out in <out>.sensitivity.csv");
   cmd->add_option("--linearisation-threshold", a->linearisation_threshold,
                   "Scenes: warn when the linear model is off by more than this (relative; "

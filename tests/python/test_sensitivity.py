@@ -66,3 +66,27 @@ def test_refusals_are_input_errors(robots):
         lcsim.simulate(model, sensitivity=["f[x9]"])
     with pytest.raises(lcsim.InputError, match="does not compute"):
         lcsim.simulate(model, method="moreau-jean", sensitivity=["g[stop]"])
+
+
+def test_circuit_entries_same_numbers_as_the_cli(robots, lcsim_binary):
+    """A general LCS's entries by the states' and the pair's names (docs/sensitivities.md):
+    D[D1][D1] (the diode's series resistance) and A[C1.v][L1.i] on the half-wave RLC, the
+    same numbers as the CLI; a loss names the pair (the rectifier's start on its diode's
+    switching surface: 'D1'); an entry on a scheme is refused."""
+    path = robots.parent / "circuits" / "half_wave_rlc.cir"
+    cols = ["x0", "D[D1][D1]", "A[C1.v][L1.i]"]
+    run = lcsim.simulate(lcsim.load(path), t_end=1e-3, sensitivity=cols)
+    out = subprocess.run([str(lcsim_binary), "simulate", str(path), "--json", "--t-end", "1e-3",
+                          "--sensitivity", ",".join(cols)], capture_output=True, text=True,
+                         check=True)
+    cli = json.loads(out.stdout)["sensitivity"]
+    assert cli["columns"] == run.sensitivity_columns
+    final = np.array(cli["final"])
+    np.testing.assert_array_equal(final[:, 3], run.dx_dp["D[D1][D1]"][-1])
+    np.testing.assert_array_equal(final[:, 4], run.dx_dp["A[C1.v][L1.i]"][-1])
+    assert not np.ma.is_masked(run.dx_dp["D[D1][D1]"])
+    rect = lcsim.simulate(lcsim.load(robots.parent / "circuits" / "half_wave_rectifier.cir"),
+                          t_end=1e-2, sensitivity=["x0"])
+    assert rect.sensitivity_losses[0]["contact"] == "D1"
+    with pytest.raises(lcsim.InputError, match="does not compute a general LCS"):
+        lcsim.simulate(lcsim.load(path), method="euler", sensitivity=["D[D1][D1]"])

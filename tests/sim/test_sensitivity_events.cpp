@@ -290,7 +290,7 @@ TEST(SensitivityEvents, LcsStartOnSwitchingSurfaceHasNoDerivative) {
   ASSERT_TRUE(tr.ok()) << tr.message;
   ASSERT_EQ(tr.sensitivity_losses.size(), 1u);
   EXPECT_EQ(tr.sensitivity_losses[0].t, 0.0);
-  EXPECT_EQ(tr.sensitivity_losses[0].contact, "y0");
+  EXPECT_EQ(tr.sensitivity_losses[0].contact, "D1");  // the pair's name (was "y0")
   EXPECT_NE(tr.sensitivity_losses[0].reason.find("switching surface"), std::string::npos);
   for (char e : tr.dx_final_exists) EXPECT_FALSE(e);
   EXPECT_EQ(tr.dx_final.cwiseAbs().maxCoeff(), 0.0);
@@ -392,6 +392,320 @@ TEST(SensitivityEvents, SchemesRefuseInputs) {
     EXPECT_EQ(tr.status, Status::kInvalidInput) << method;
     EXPECT_NE(tr.message.find("method 'event'"), std::string::npos) << tr.message;
   }
+}
+
+// --- A general LCS's jumps and its own entries (docs/sensitivities.md) ---
+
+// The entry (i, j) of A, B, C or D of a general LCS as a column.
+Perturbation lcs_entry(char kind, int i, int j, const std::string& name, double value) {
+  return {name, value, [kind, i, j](mech::Model& m, VectorXd&, double d) {
+            lcs::Lcs& s = *m.lcs;
+            (kind == 'A' ? s.A : kind == 'B' ? s.B : kind == 'C' ? s.C : s.D)(i, j) += d;
+          }};
+}
+
+// A general LCS whose events jump: body 1 (q1, v1) on a spring, coupled to
+// body 2 (q2, v2), pushed by a sine w1 = sin 2t (w1, w2, weight 0.3) and a
+// constant w3 = 1 (weight 1), against two stops: q1 >= 0 and q2 + 0.1 w3
+// >= 0 (y = C x, u the stops' forces: relative degree 2, D = 0). Reaching a
+// stop is a jump x+ = P_I x that zeroes its body's velocity (for stop1
+// T_I = span(B_1, A B_1) = span(e_v1, e_q1), V_I = {q1 = v1 = 0}), so the
+// saltation is S+ = P S- + (P x'- - x'+) dt/dtheta + dP x-. From
+// (0.3, 0, 0, 0, 0, 2, 1) to T = 6: stop1 at 0.664 (held from then on),
+// stop2 at 4.287 (body 2 leaves it at once: its force would pull).
+mech::Model jumping_lcs() {
+  mech::Model m;
+  m.name = "jumping_lcs";
+  lcs::Lcs s;
+  s.A = Eigen::MatrixXd::Zero(7, 7);
+  s.A(0, 1) = 1;
+  s.A(1, 0) = -2, s.A(1, 2) = 1, s.A(1, 4) = 0.3, s.A(1, 6) = -1;
+  s.A(2, 3) = 1;
+  s.A(3, 0) = 1, s.A(3, 2) = -1;
+  s.A(4, 5) = 1;
+  s.A(5, 4) = -4;
+  s.B = Eigen::MatrixXd::Zero(7, 2);
+  s.B(1, 0) = 1, s.B(3, 1) = 1;
+  s.C = Eigen::MatrixXd::Zero(2, 7);
+  s.C(0, 0) = 1;
+  s.C(1, 2) = 1, s.C(1, 6) = 0.1;
+  s.D = Eigen::MatrixXd::Zero(2, 2);
+  m.lcs = s;
+  m.pair_names = {"stop1", "stop2"};
+  m.initial = VectorXd(7);
+  m.initial << 0.3, 0, 0, 0, 0, 2, 1;
+  m.t_end = 6;
+  return m;
+}
+
+// Every x0 entry and five entries (the springs A[1][0], A[3][2], the
+// constant load A[1][6] (an lcs: model's f: a column on a constant state),
+// the stop's gain B[1][0] and stop2's offset C[stop2][6] (its g)) against
+// central differences at x(T) and both event times: (7 + 5) columns x
+// (7 + 2) entries. The jumps' x0 part is P_I (lcs::projection); their
+// parameter part dP_I x- (sensitivity_lcs.cpp).
+TEST(SensitivityEvents, LcsJumpsAgainstFiniteDifferences) {
+  const mech::Model m = jumping_lcs();
+  const double T = 6.0;
+  const sim::Trajectory plain = run(m, m.initial, T);
+  ASSERT_TRUE(plain.ok()) << plain.message;
+  ASSERT_EQ(plain.events.size(), 2u);
+  EXPECT_EQ(count_type(plain, sim::EventType::kImpact), 2);
+  EXPECT_EQ(plain.events[0].mode_after, (lcs::IndexSet{0}));
+  EXPECT_EQ(plain.events[1].mode_after, (lcs::IndexSet{0}));
+  const std::vector<Perturbation> ps = {
+      lcs_entry('A', 1, 0, "A[1][0]", -2.0), lcs_entry('A', 3, 2, "A[3][2]", -1.0),
+      lcs_entry('A', 1, 6, "A[1][6]", -1.0), lcs_entry('B', 1, 0, "B[1][stop1]", 1.0),
+      lcs_entry('C', 1, 6, "C[stop2][6]", 0.1)};
+  // The pair is C's row: C[6][stop2] names no pair 6 and is refused.
+  sim::Options bad;
+  bad.t_end = T;
+  bad.sensitivity = {"C[6][stop2]"};
+  const sim::Trajectory refused = sim::simulate(m, m.initial, bad, "event");
+  EXPECT_EQ(refused.status, Status::kInvalidInput);
+  EXPECT_NE(refused.message.find("no pair '6'"), std::string::npos) << refused.message;
+  EXPECT_EQ(expect_matches_fd(m, m.initial, T, ps, true), 12 * 9);
+}
+
+// An entry that changes a leading row index is a singular perturbation:
+// B[0][0] makes C B nonzero (stop1's relative degree 2 -> 1), D[stop1][0]
+// makes it 0. Each is reported absent, naming the pair, from the first phase
+// in which the row is in the mode (the first impact) -- x0 and A[1][0] go
+// on. A jump's parameter columns survive it (above), and the model's plain
+// run is unchanged by the request.
+TEST(SensitivityEvents, LcsEntryChangingLeadingIndexIsAbsent) {
+  const mech::Model m = jumping_lcs();
+  const sim::Trajectory tr = run(m, m.initial, 6.0, {"x0", "A[1][0]", "B[0][0]", "D[stop1][0]"});
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  ASSERT_EQ(tr.sensitivity_losses.size(), 1u);
+  const sim::SensitivityLoss& l = tr.sensitivity_losses[0];
+  EXPECT_EQ(l.contact, "stop1");
+  EXPECT_NEAR(l.t, tr.events[0].t, 1e-15);
+  EXPECT_NE(l.reason.find("leading row index"), std::string::npos) << l.reason;
+  EXPECT_EQ(l.columns, (std::vector<int>{8, 9}));
+  for (int c = 0; c < 8; ++c) EXPECT_TRUE(tr.dx_final_exists[static_cast<size_t>(c)]);
+  EXPECT_FALSE(tr.dx_final_exists[8]);
+  EXPECT_FALSE(tr.dx_final_exists[9]);
+  EXPECT_EQ(tr.dx_final.rightCols(2).cwiseAbs().maxCoeff(), 0.0);
+  const sim::Trajectory plain = run(m, m.initial, 6.0);
+  EXPECT_EQ(plain.final_state, tr.final_state);
+}
+
+// A circuit's own entries (circuits/half_wave_rlc.cir, 3 states: C1.v,
+// L1.i and the source's constant "1"; D1's row has the feedthrough R1 =
+// 1 kOhm), by the states' and the pair's names or indices: A[C1.v][C1.v]
+// (no load on the tank: 0), A[C1.v][L1.i] (-1/C1), A[L1.i][C1.v] (1/L1),
+// B[0][D1] (the diode current into C1), C[D1][0] and D[D1][D1] (R1) against
+// central differences to T = 1 ms (3 events): 6 columns x (3 + 3) entries.
+TEST(SensitivityEvents, CircuitEntriesAgainstFiniteDifferences) {
+  const mech::Model m = load("circuits/half_wave_rlc.cir");
+  ASSERT_EQ(m.pair_names, std::vector<std::string>{"D1"});
+  const lcs::Lcs& s = *m.lcs;
+  const double T = 1e-3;
+  const sim::Trajectory plain = run(m, m.initial, T);
+  ASSERT_TRUE(plain.ok()) << plain.message;
+  ASSERT_EQ(plain.events.size(), 3u);
+  const std::vector<Perturbation> ps = {lcs_entry('A', 0, 0, "A[C1.v][C1.v]", s.A(0, 0)),
+                                        lcs_entry('A', 0, 1, "A[C1.v][L1.i]", s.A(0, 1)),
+                                        lcs_entry('A', 1, 0, "A[L1.i][C1.v]", s.A(1, 0)),
+                                        lcs_entry('B', 0, 0, "B[0][D1]", s.B(0, 0)),
+                                        lcs_entry('C', 0, 0, "C[D1][0]", s.C(0, 0)),
+                                        lcs_entry('D', 0, 0, "D[D1][D1]", s.D(0, 0))};
+  EXPECT_EQ(expect_matches_fd(m, m.initial, T, ps, false), 6 * 6);
+  // The source's constant state is named "1": a name is looked up before
+  // an index, so A[1][0] is its row (refused: an input's own dynamics).
+  sim::Options o;
+  o.t_end = T;
+  o.sensitivity = {"A[1][0]"};
+  const sim::Trajectory refused = sim::simulate(m, m.initial, o, "event");
+  EXPECT_EQ(refused.status, Status::kInvalidInput);
+  EXPECT_NE(refused.message.find("exosystem"), std::string::npos) << refused.message;
+}
+
+// --- Impacts with planar friction (sensitivity_friction.cpp) ---
+
+// The block of robots/block_on_floor_friction.yaml (unit mass, mu = 0.4,
+// g = 9.81, plastic floor) dropped from y0 = 0.2 with vy0 = 0 lands at
+// t1 = w/g, w = sqrt(2 g y0) (the approach rate), with the normal impulse w.
+// Sticking (|vx0| <= mu w, vx0 = 0.5): at rest from t1, x(T) = x0 + vx0 t1,
+// so dx/dy0 = vx0/w, dx/dvx0 = t1, dx/dvy0 = vx0/g, dx/dx0 = 1, every other
+// entry 0; dt1/dy0 = 1/w, dt1/dvy0 = 1/g. Sliding (vx0 = 2 > mu w): vT+ =
+// vx0 - mu w, then x(T) = x0 + vx0 t1 + vT+ s - mu g s^2/2 (s = T - t1)
+// until the stick at t1 + vT+/(mu g) = 0.510: at T = 0.4, dx/dy0 = mu,
+// dvx/dy0 = 0, dx/dvx0 = T, dvx/dvx0 = 1, dx/dvy0 = mu T, dvx/dvy0 = mu.
+// Tolerance 1e-12: the run and its derivative are good to a few ulp here
+// (two phases of nilpotent exponentials, one linear solve); margin ~1000.
+TEST(SensitivityEvents, FrictionImpactBlockClosedForm) {
+  const mech::Model m = load("robots/block_on_floor_friction.yaml");
+  const double mu = 0.4, g = 9.81, y0 = 0.2, w = std::sqrt(2 * g * y0), t1 = w / g;
+  ASSERT_EQ(m.mechanical->friction[0].mu, mu);
+  struct Case {
+    double vx0, T;
+    Eigen::Matrix4d dx;  // rows x, y, vx, vy; columns x0, y0, vx0, vy0
+  };
+  Eigen::Matrix4d stick = Eigen::Matrix4d::Zero(), slip = Eigen::Matrix4d::Zero();
+  stick.row(0) << 1, 0.5 / w, t1, 0.5 / g;
+  slip.row(0) << 1, mu, 0.4, mu * 0.4;
+  slip.row(2) << 0, 0, 1, mu;
+  for (const Case& c : {Case{0.5, 0.5, stick}, Case{2.0, 0.4, slip}}) {
+    VectorXd x0(4);
+    x0 << 0, y0, c.vx0, 0;
+    const sim::Trajectory tr = run(m, x0, c.T, {"x0"});
+    ASSERT_TRUE(tr.ok()) << tr.message;
+    EXPECT_TRUE(tr.sensitivity_losses.empty());
+    ASSERT_EQ(tr.events.size(), 1u);
+    const sim::Event& e = tr.events[0];
+    EXPECT_EQ(e.type, sim::EventType::kImpact);
+    ASSERT_EQ(e.friction_mode_after.size(), 1u);
+    EXPECT_EQ(e.friction_mode_after[0],
+              c.vx0 < mu * w ? sim::FrictionMode::kStick : sim::FrictionMode::kSlipPositive);
+    EXPECT_NEAR(e.t, t1, 1e-14);
+    EXPECT_NEAR(e.dt(1), 1 / w, 1e-12);
+    EXPECT_NEAR(e.dt(2), 0.0, 1e-12);
+    EXPECT_NEAR(e.dt(3), 1 / g, 1e-12);
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        EXPECT_NEAR(tr.dx_final(i, j), c.dx(i, j), 1e-12)
+            << "vx0 = " << c.vx0 << ": dx[" << i << "]/dx0[" << j << "]";
+  }
+}
+
+// On the boundary between the two (vx0 = mu w: the impact leaves the block
+// stuck with |P_T| = mu P_N, or sliding at zero velocity, as rounding
+// decides) the impact map has a kink: no derivative, reported at t1 naming
+// the floor, every column absent.
+TEST(SensitivityEvents, FrictionImpactAtStickSlipBoundaryHasNoDerivative) {
+  const mech::Model m = load("robots/block_on_floor_friction.yaml");
+  const double mu = 0.4, g = 9.81, y0 = 0.2, w = std::sqrt(2 * g * y0);
+  VectorXd x0(4);
+  x0 << 0, y0, mu * w, 0;
+  const sim::Trajectory tr = run(m, x0, 0.5, {"x0"});
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  ASSERT_EQ(tr.sensitivity_losses.size(), 1u);
+  const sim::SensitivityLoss& l = tr.sensitivity_losses[0];
+  EXPECT_EQ(l.contact, "floor");
+  EXPECT_NEAR(l.t, w / g, 1e-14);
+  EXPECT_NE(l.reason.find("stick and slip meet"), std::string::npos) << l.reason;
+  for (char e : tr.dx_final_exists) EXPECT_FALSE(e);
+  EXPECT_EQ(tr.dx_final.cwiseAbs().maxCoeff(), 0.0);
+}
+
+// A planar bar (x, y, theta; M = diag(1, 1, 0.1), gravity) landing on its
+// corner, gap y - 0.5 theta, tangential velocity x' + 0.2 y' + 0.4 theta'
+// (orthogonal to the normal row): the Delassus matrix couples normal and
+// tangent (W_NT = 0.2 - 2 = -1.8; W_NN - mu |W_NT| > 0), so the impact
+// turns the bar and its stick or slip outcome depends on every entry of
+// x0. From (0, 0.3, 0, 1, 0, omega0) with mu = 1.5 (sticks) and mu = 0.2
+// (slides), plastic, and with mu = 0.2 and e = 0.5 (a bounce, restitution
+// on the approaching normal only: impacts at 0.228 and 0.476 s, the third
+// at 0.59998 too close to 0.6 for differences), to T = 0.6 s (0.55 s with
+// e): every entry of x0 against central differences at x(T) and every
+// event time (6 x (6 + events)).
+TEST(SensitivityEvents, FrictionImpactBarAgainstFiniteDifferences) {
+  struct Case {
+    double mu, e, T;
+  };
+  for (const auto& [mu, e, T] : {Case{1.5, 0.0, 0.6}, Case{0.2, 0.0, 0.6}, Case{0.2, 0.5, 0.55}}) {
+    mech::Model m;
+    m.name = "bar";
+    mech::MechanicalModel& b = m.mechanical.emplace();
+    Eigen::SparseMatrix<double> M(3, 3), E(1, 3);
+    M.insert(0, 0) = 1, M.insert(1, 1) = 1, M.insert(2, 2) = 0.1;
+    E.insert(0, 1) = 1, E.insert(0, 2) = -0.5;
+    b.M = M;
+    b.D = Eigen::SparseMatrix<double>(3, 3);
+    b.K = Eigen::SparseMatrix<double>(3, 3);
+    b.E = E;
+    b.f = VectorXd::Zero(3);
+    b.f(1) = -9.81;
+    b.g = VectorXd::Zero(1);
+    b.coordinates = {"x", "y", "theta"};
+    b.constraints = {"corner"};
+    b.restitution = VectorXd::Constant(1, e);
+    mech::FrictionalContact fc;
+    fc.contact = 0;
+    fc.tangent = Eigen::SparseVector<double>(3);
+    fc.tangent.insert(0) = 1;
+    fc.tangent.insert(1) = 0.2;
+    fc.tangent.insert(2) = 0.4;
+    fc.mu = mu;
+    b.friction = {fc};
+    m.initial = VectorXd(6);
+    m.initial << 0, 0.3, 0, 1, 0, 0.4;
+    m.t_end = T;
+    const sim::Trajectory plain = run(m, m.initial, m.t_end);
+    ASSERT_TRUE(plain.ok()) << plain.message;
+    ASSERT_GE(plain.events.size(), 1u);
+    EXPECT_EQ(plain.events[0].type, sim::EventType::kImpact);
+    const int n = expect_matches_fd(m, m.initial, m.t_end, {}, true);
+    EXPECT_EQ(n, 6 * (6 + static_cast<int>(plain.events.size()))) << "mu = " << mu;
+    std::cout << "bar, mu = " << mu << ", e = " << e << ": " << plain.events.size()
+              << " events, after the first impact "
+              << sim::to_string(plain.events[0].friction_mode_after[0]) << "\n";
+  }
+}
+
+// An input's own parameter: a sine's amplitude (amplitude[push]), which
+// enters the exosystem's output row only (value = offset + amplitude s), so
+// the phases' dAcl and dF_I carry it as a column of H and no event's
+// re-initialisation moves with it. A unit mass on a unit spring, pushed
+// into a plastic stop q >= -0.5 by f = -0.8 and pulled by a damped sine
+// (amplitude 2, 0.3 Hz, damping 0.1 1/s): impact at 2.841 s, release under
+// the sine at 3.413 s (a multiplier monitor: dF_I), impact at 6.360 s,
+// release at 6.747 s; to T = 8: x0, amplitude[push], f[0] against central
+// differences at x(T) and each event time (4 x (2 + 4) entries). The
+// amplitude of an input that moves a stop, and of a non-sine, are refused.
+TEST(SensitivityEvents, SineAmplitudeAgainstFiniteDifferences) {
+  const std::filesystem::path p = std::filesystem::temp_directory_path() /
+                                  ("lcsim_pushed_" + std::to_string(::getpid()) + ".yaml");
+  std::ofstream(p) << "name: pushed\ninputs:\n"
+                      "  - {name: push, kind: sine, amplitude: 2, frequency: 0.3, damping: 0.1}\n"
+                      "  - {name: lift, kind: constant, value: 1}\n"
+                      "mechanical:\n  M: [[1]]\n  K: [[1]]\n  f: [-0.8]\n  E: [[1]]\n"
+                      "  g: [0.5]\n  restitution: [0]\n  constraints: [stop]\n"
+                      "  coordinates: [x]\n  force_inputs: [{input: push, gain: [1]}]\n"
+                      "initial: [0, 0]\nt_end: 8\n";
+  const mech::Model m = scene::load_model(p.string());
+  std::filesystem::remove(p);
+  const sim::Trajectory plain = run(m, m.initial, 8.0);
+  ASSERT_TRUE(plain.ok()) << plain.message;
+  ASSERT_EQ(plain.events.size(), 4u);
+  const Perturbation amp{"amplitude[push]", 2.0, [](mech::Model& mm, VectorXd&, double d) {
+                           mm.mechanical->inputs[0].amplitude += d;
+                         }};
+  EXPECT_EQ(expect_matches_fd(m, m.initial, 8.0, {amp, force(0, -0.8)}, true), 4 * 6);
+  for (const char* bad : {"amplitude[lift]", "amplitude[nope]"}) {
+    sim::Options o;
+    o.t_end = 1.0;
+    o.sensitivity = {bad};
+    const sim::Trajectory tr = sim::simulate(m, m.initial, o, "event");
+    EXPECT_EQ(tr.status, Status::kInvalidInput) << bad;
+  }
+  const mech::Model shaker = load("robots/shaker_table.yaml");
+  sim::Options o;
+  o.t_end = 0.1;
+  o.sensitivity = {"amplitude[table]"};
+  const sim::Trajectory tr = sim::simulate(shaker, shaker.initial, o, "event");
+  EXPECT_EQ(tr.status, Status::kInvalidInput);
+  EXPECT_NE(tr.message.find("moves a stop"), std::string::npos) << tr.message;
+}
+
+// Every column lost at the start (the ball leaving the ground from a zero
+// gap: x0 and g[ground] have one-sided derivatives only), then an impact:
+// the run carries nothing and completes with every entry absent (a
+// regression test: the phases' parameter terms must exist, empty, when no
+// column does).
+TEST(SensitivityEvents, EveryColumnLostAtTheStartThenAnImpact) {
+  const mech::Model m = load("robots/ball.yaml");
+  VectorXd x0(2);
+  x0 << 0.0, 2.0;
+  const sim::Trajectory tr = run(m, x0, 1.0, {"x0", "g[ground]"});
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  ASSERT_GE(tr.events.size(), 1u);
+  EXPECT_EQ(tr.events[0].type, sim::EventType::kImpact);
+  for (char e : tr.dx_final_exists) EXPECT_FALSE(e);
+  EXPECT_EQ(tr.dx_final.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(run(m, x0, 1.0).final_state, tr.final_state);
 }
 
 }  // namespace

@@ -3,9 +3,10 @@
 // short horizon: dx(T)/dx0 and one parameter f[0] against central
 // differences of the exact method where the run says they exist, and where
 // the run says they do not (a zero gap at the start, coinciding events, a
-// general LCS's jump), the loss names a contact or says why and the columns
-// carry no number. The friction files are refused (stick / slip is not
-// covered). Tolerance as tests/sim/test_sensitivity.cpp's: 4 |D(d) - D(d/2)|
+// general LCS started on a switching surface), the loss names a contact or
+// says why and the columns carry no number. The friction files are refused
+// here (they take x0 only; tests/sim/test_sensitivity_events.cpp).
+// Tolerance as tests/sim/test_sensitivity.cpp's: 4 |D(d) - D(d/2)|
 // (Richardson's estimate of D(d/2)'s truncation, margin 12) plus
 // 64e-13 max(1, |x|) / d (the run's rounding, ~1e-13 of the state, over the
 // step d, margin 32), the step d = 1e-4 max(1, |theta|) per entry; every

@@ -209,12 +209,21 @@ struct EventResult : OutcomeStartingAs<Status::kNumericalFailure> {
   long lcp_solves = 0;
   std::vector<WarningCount> warnings;  // counted into Trajectory::warnings
   // Forward sensitivities only (sensitivity.cpp): each round of the impact
-  // law, its closed contacts, velocity before, impulses and restitution.
+  // law, its closed contacts, velocity before, impulses and restitution,
+  // and with friction each contact's outcome (stick, slip+, slip-).
   struct ImpactRound {
     lcs::IndexSet closed;
     VectorXd v_before, impulse, restitution;
+    std::vector<impact::ContactOutcome> outcome;
   };
   std::vector<ImpactRound> rounds;
+  // A general LCS's jumps (sensitivities only): each jump's mode I (x+ =
+  // P_I x, thesis §3.4.2) and the state before it.
+  struct LcsJump {
+    lcs::IndexSet mode;
+    VectorXd x_before;
+  };
+  std::vector<LcsJump> lcs_jumps;
 };
 
 // Ends a run that cannot make progress: `limit` consecutive events, each

@@ -114,7 +114,7 @@ bool EventDriven::impact_round(double t, ContactScan& scan, bool limit_taken,
       out.friction_impulse(static_cast<Eigen::Index>(f)) +=
           ir.friction_impulse(friction_contacts_[f]);
   out.jumped = true;
-  if (sens_) out.rounds.push_back({in.closed, in.v, ir.impulse, in.restitution});
+  if (sens_) out.rounds.push_back({in.closed, in.v, ir.impulse, in.restitution, ir.outcome});
   record_impacts(in.closed, ir.impulse, t, time_noise);
   return true;
 }
@@ -218,6 +218,7 @@ EventResult EventDriven::process_lcs(const VectorXd& xa0) {
     }
     out.impulse += sel.impulse[0];
     out.jumped = true;
+    if (sens_) out.lcs_jumps.push_back({sel.mode, xa});
     xa = sel.x_plus;
   }
   out.message = "re-initialisation did not reach a regular state after 4 jumps";

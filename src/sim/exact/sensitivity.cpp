@@ -39,6 +39,17 @@ void add_input_forces(const mech::MechanicalModel& m, MatrixXd& H) {
   }
 }
 
+// d H / d amplitude of input `input` (N x n): its force uses' gains times
+// d l / d amplitude = (0, 1, 0) on its exosystem's columns.
+MatrixXd amplitude_columns(const mech::MechanicalModel& m, int input, int n) {
+  MatrixXd dH = MatrixXd::Zero(m.dofs(), n);
+  int at = 2 * m.dofs() + 1;
+  for (int i = 0; i < input; ++i) at += m.inputs[static_cast<size_t>(i)].exo_size();
+  for (const mech::InputUse& use : m.force_inputs)
+    if (use.input == input) dH.col(at + 1) += use.gain;
+  return dH;
+}
+
 }  // namespace
 
 Sensitivity::Sensitivity(const mech::Model& model, const lcs::Lcs& sys, const SensColumns& cols,
@@ -64,6 +75,9 @@ std::vector<std::string> Sensitivity::column_names() const {
 std::string Sensitivity::contact_name(int r) const {
   if (r < 0) return "";
   if (mech_) return model_.mechanical->constraints[static_cast<size_t>(r)];
+  // A general LCS: its pair's name (a circuit's diode), else y<r>.
+  if (static_cast<size_t>(r) < model_.pair_names.size())
+    return model_.pair_names[static_cast<size_t>(r)];
   return "y" + std::to_string(r);
 }
 
@@ -162,14 +176,21 @@ void Sensitivity::start_on_boundary(const VectorXd& xa) {
 // columns of Q and rows of Q H (O(N n) each, not products of N x N
 // matrices). Kept per mode: Acl, its balancing and these depend on the mode
 // only (frictionless models).
-void Sensitivity::mode_derivatives(const lcs::IndexSet& mode) {
+void Sensitivity::mode_derivatives(const lcs::IndexSet& mode, double t) {
   const int P = static_cast<int>(cols_.params.size());
   dAb_.assign(static_cast<size_t>(P), MatrixXd());
   dF_.assign(static_cast<size_t>(P), MatrixXd());
-  if (!mech_ || P == 0) return;
+  dW_.assign(static_cast<size_t>(P), MatrixXd());
+  if (P == 0) return;
   if (const auto it = mode_cache_.find(mode); it != mode_cache_.end()) {
-    dAb_ = it->second.first;
-    dF_ = it->second.second;
+    dAb_ = it->second.dAb;
+    dF_ = it->second.dF;
+    dW_ = it->second.dW;
+    return;
+  }
+  if (!mech_) {
+    lcs_mode_derivatives(mode, t);
+    mode_cache_.emplace(mode, ModeDerivatives{dAb_, dF_, dW_});
     return;
   }
   const mech::MechanicalModel& m = *model_.mechanical;
@@ -199,6 +220,12 @@ void Sensitivity::mode_derivatives(const lcs::IndexSet& mode) {
         dAv -= Q.col(sp.j) * QH.row(sp.i);
         dF += WinvEG.col(sp.j) * QH.row(sp.i);
       }
+    } else if (sp.kind == 'a') {
+      // A sine's amplitude: dH = gain (0, 1, 0) on the input's exosystem
+      // columns, for each force it drives (sensitivity_names.cpp).
+      const MatrixXd dH = amplitude_columns(m, sp.i, n_);
+      dAv = Q * dH;
+      dF = -WinvEG * dH;
     } else {
       const int col = sp.kind == 'f' ? 2 * N_ : sp.kind == 'K' ? sp.j : N_ + sp.j;
       const double sign = sp.kind == 'f' ? 1.0 : -1.0;
@@ -212,7 +239,7 @@ void Sensitivity::mode_derivatives(const lcs::IndexSet& mode) {
     dAb_[static_cast<size_t>(p)] = D_.cwiseInverse().asDiagonal() * dA * D_.asDiagonal();
     dF_[static_cast<size_t>(p)] = dF;
   }
-  mode_cache_.emplace(mode, std::make_pair(dAb_, dF_));
+  mode_cache_.emplace(mode, ModeDerivatives{dAb_, dF_, dW_});
 }
 
 void Sensitivity::begin_phase(const Phase& ph, double t0, const VectorXd& xa, const MatrixXd& S) {
@@ -225,9 +252,10 @@ void Sensitivity::begin_phase(const Phase& ph, double t0, const VectorXd& xa, co
   monitors_ = ph.monitors;
   for (Monitor& mon : monitors_) mon.w = mon.w.cwiseQuotient(ph.D.transpose());
   if (std::any_of(exists_.begin(), exists_.end(), [](char e) { return e != 0; }))
-    mode_derivatives(ph.mode);
+    mode_derivatives(ph.mode, t0);
   else
-    dAb_.clear(), dF_.assign(cols_.params.size(), MatrixXd());  // at() carries nothing
+    dAb_.clear(), dF_.assign(cols_.params.size(), MatrixXd()),
+        dW_.assign(cols_.params.size(), MatrixXd());  // at() carries nothing
   norm1_ = Ab_.cwiseAbs().colwise().sum().maxCoeff();
   double dnorm = 0.0;
   for (const MatrixXd& d : dAb_)
@@ -387,6 +415,7 @@ void Sensitivity::before_event(double tau, const VectorXd& x_minus, int monitor)
     const SensParam& sp = cols_.params[p];
     const Eigen::Index c = nx0_ + static_cast<Eigen::Index>(p);
     if (!mon.multiplier && sp.kind == 'g' && sp.i == mon.constraint) dh(c) += 1.0;
+    if (!mon.multiplier && dW_[p].size() > 0) dh(c) += dW_[p].row(mon.constraint).dot(x_minus);
     if (mon.multiplier && dF_[p].size() > 0) {
       const auto it = std::find(mode_.begin(), mode_.end(), mon.constraint);
       dh(c) += dF_[p].row(it - mode_.begin()).dot(x_minus);
@@ -521,18 +550,29 @@ void Sensitivity::after_event(const EventResult& ev, const Phase& next, double t
   MatrixXd J = MatrixXd::Identity(n_, n_), dR = MatrixXd::Zero(n_, m_);
   if (ev.accumulation)
     lose_all(t, trigger, "accumulation of impacts: the derivative of its limit is not computed");
-  if (!mech_ && ev.jumped)
-    lose_all(t, trigger, "a jump of a general LCS (P_I x): its derivative is not computed");
-  if (mech_ && !ev.rounds.empty() && model_.mechanical->has_friction())
-    lose_all(t, trigger, "an impact with friction: its derivative is not computed");
-  else if (mech_ && !ev.rounds.empty()) {
+  if (!mech_ && ev.jumped) {
+    for (const EventResult::LcsJump& jump : ev.lcs_jumps) {
+      MatrixXd Jr, dRr;
+      if (!lcs_jump(t, jump, Jr, dRr)) break;
+      J = Jr * J;
+      dR = Jr * dR + dRr;
+    }
+    // The jump is P_I x (thesis §3.4.2): the re-initialised state must be
+    // J x- to rounding, else J is not its derivative.
+    if (!ev.lcs_jumps.empty() &&
+        (J * ev.lcs_jumps.front().x_before - x_plus).cwiseAbs().maxCoeff() >
+            1e-9 * (1.0 + x_plus.cwiseAbs().maxCoeff()))
+      lose_all(t, trigger, "a jump of a general LCS that is not P_I x: its derivative is unknown");
+  }
+  if (mech_ && !ev.rounds.empty()) {
+    const bool friction = model_.mechanical->has_friction();
     // Another contact closing at the same time: coinciding events.
     for (int r : ev.rounds.front().closed)
       if (r != trigger && t > 0.0 && std::find(held.begin(), held.end(), r) == held.end())
         lose_all(t, r, "coinciding events: this contact closes at the same time as another");
     for (const auto& rd : ev.rounds) {
-      MatrixXd Jr, dRr;
-      if (!impact_map(t, rd, Jr, dRr)) break;
+      MatrixXd Jr, dRr = MatrixXd::Zero(n_, m_);
+      if (friction ? !friction_impact_map(t, rd, Jr) : !impact_map(t, rd, Jr, dRr)) break;
       J = Jr * J;
       dR = Jr * dR + dRr;
     }

@@ -5,6 +5,9 @@
 //   sensitivity.cpp        their propagation: along a phase the variational
 //                          equation S' = Acl S + (dAcl/dtheta) x, at an event
 //                          the saltation matrix
+//   sensitivity_friction.cpp  an impact with planar friction at its outcome
+//   sensitivity_lcs.cpp    a general LCS's parts: dAcl/dtheta of a mode for
+//                          the entries of A, B, C, D, and the jump P_I x
 #pragma once
 
 #include <Eigen/Dense>
@@ -18,8 +21,9 @@
 
 namespace lcsim::sim::detail {
 
-// A named parameter: f[i], g[c], e[c], K[i][j], D[i][j], M[i][j] (0-based
-// indices resolved from names).
+// A named parameter: f[i], g[c], e[c], K[i][j], D[i][j], M[i][j] of a
+// mechanical model, A[i][j], B[i][j], C[i][j], D[i][j] of a general LCS
+// (0-based indices resolved from names).
 struct SensParam {
   char kind = 'f';
   int i = -1, j = -1;
@@ -82,11 +86,25 @@ class Sensitivity {
   void start_on_boundary(const VectorXd& xa);
   const MatrixXd& at_dense(double t, double tau);
   bool impact_map(double t, const EventResult::ImpactRound& round, MatrixXd& J, MatrixXd& dR);
+  // An impact round with planar friction (sensitivity_friction.cpp): J at
+  // its outcome (x0 only: parameters are refused with friction); false, with
+  // every column lost, where the outcome is not locally constant.
+  bool friction_impact_map(double t, const EventResult::ImpactRound& round, MatrixXd& J);
+  bool friction_impact_regular(double t, const EventResult::ImpactRound& rd,
+                               const std::vector<int>& A, const std::vector<int>& stuck,
+                               const std::vector<int>& sliding, const VectorXd& lambda,
+                               const VectorXd& vplus);
   void moving_stop_columns(const std::vector<int>& A, const MatrixXd& EA,
                            const Eigen::LDLT<MatrixXd>& Wf, const VectorXd& one_e,
                            MatrixXd& J) const;
-  // dAcl/dtheta and dF/dtheta of a mode for each parameter (mechanical).
-  void mode_derivatives(const lcs::IndexSet& mode);
+  // dAcl/dtheta and dF/dtheta of a mode for each parameter.
+  void mode_derivatives(const lcs::IndexSet& mode, double t);
+  // A general LCS (sensitivity_lcs.cpp): the same for the entries of A, B,
+  // C, D (and dW_, the free outputs' monitors), losing a column whose entry
+  // changes a leading row index of the mode; and one jump x+ = P_I x: J = P_I
+  // and dR = (dP_I/dtheta) x (false when not available: every column lost).
+  void lcs_mode_derivatives(const lcs::IndexSet& mode, double t);
+  bool lcs_jump(double t, const EventResult::LcsJump& jump, MatrixXd& J, MatrixXd& dR);
   std::string contact_name(int r) const;
   bool same_event(const Monitor& other, const Monitor& mon) const;
   void check_friction_start(const Monitor& mon, double t, int m0, int trigger, bool stuck);
@@ -107,11 +125,17 @@ class Sensitivity {
   MatrixXd Acl_, Ab_;
   Eigen::SparseMatrix<double, Eigen::RowMajor> Ab_sparse_;  // when the phase uses it
   bool use_sparse_ = false;
-  std::map<lcs::IndexSet, std::pair<std::vector<MatrixXd>, std::vector<MatrixXd>>> mode_cache_;
+  struct ModeDerivatives {
+    std::vector<MatrixXd> dAb, dF, dW;
+  };
+  std::map<lcs::IndexSet, ModeDerivatives> mode_cache_;
   VectorXd D_;
   double norm1_ = 0.0;
   std::vector<MatrixXd> dAb_;  // balanced dAcl/dtheta per parameter
   std::vector<MatrixXd> dF_;   // dF_I/dtheta per parameter (unbalanced)
+  // A general LCS: d(monitor row)/dtheta of each free output (k x n, rows
+  // C_r + D_rI F_I; the mode's rows zero) per parameter, empty otherwise.
+  std::vector<MatrixXd> dW_;
   lcs::IndexSet mode_;
   std::vector<Monitor> monitors_;  // unbalanced w
   // A dense phase's exponentials per step length (at_dense).

@@ -2,7 +2,9 @@
 // run's check of them (check_sensitivity): "x0", and parameters of a
 // frictionless mechanical model named f[i], g[c], e[c], K[i][j], D[i][j],
 // M[i][j] with i, j a coordinate's 0-based index or name and c a
-// constraint's (docs/sensitivities.md).
+// constraint's, or of a general LCS named A[i][j], B[i][j], C[i][j],
+// D[i][j] with its states' and pairs' names or indices
+// (docs/sensitivities.md).
 #include <algorithm>
 #include <lcsim/sim/sim.hpp>
 #include <set>
@@ -17,6 +19,7 @@ namespace {
 
 // The index of `key` among `names` (a 0-based number or a name), or -1.
 int resolve(const std::string& key, const std::vector<std::string>& names) {
+  if (key.empty()) return -1;
   for (size_t i = 0; i < names.size(); ++i)
     if (names[i] == key) return static_cast<int>(i);
   if (key.empty() ||
@@ -42,10 +45,36 @@ std::vector<std::string> keys(const std::string& s) {
   return out;
 }
 
+// amplitude[input]: a sine input's amplitude (kind 'a', i the input), where
+// it drives forces only: it is the exosystem's output row l = (1, amplitude,
+// 0), so it moves H's input columns and no state of the exosystem (which
+// the breakpoints re-set to functions of t alone). On a moving stop it would
+// move C and the impacts' relative velocity: not named.
+std::string parse_amplitude(const mech::MechanicalModel& m, const std::string& s, SensParam& p) {
+  const std::string bad = "sensitivity '" + s + "': ";
+  const std::vector<std::string> k = keys(s.substr(std::string("amplitude").size() - 1));
+  if (k.size() != 1u) return bad + "expected one index, as amplitude[push]";
+  std::vector<std::string> names;
+  for (const mech::Input& in : m.inputs) names.push_back(in.name);
+  p.kind = 'a';
+  p.name = s;
+  p.i = resolve(k[0], names);
+  if (p.i < 0) return bad + "no input '" + k[0] + "'";
+  if (!m.inputs[static_cast<size_t>(p.i)].sine)
+    return bad + "input '" + k[0] + "' is not a sine (only a sine's amplitude is named)";
+  for (const mech::InputUse& u : m.gap_inputs)
+    if (u.input == p.i)
+      return bad + "input '" + k[0] + "' moves a stop: its amplitude's derivative is not computed";
+  return "";
+}
+
 std::string parse_one(const mech::MechanicalModel& m, const std::string& s, SensParam& p) {
   const std::string bad = "sensitivity '" + s + "': ";
+  if (s.rfind("amplitude[", 0) == 0) return parse_amplitude(m, s, p);
   if (s.size() < 2 || std::string("fgeKDM").find(s[0]) == std::string::npos)
-    return bad + "not a parameter name (x0, f[i], g[c], e[c], K[i][j], D[i][j], M[i][j])";
+    return bad +
+           "not a parameter name (x0, f[i], g[c], e[c], K[i][j], D[i][j], M[i][j], "
+           "amplitude[input])";
   p.kind = s[0];
   p.name = s;
   const std::vector<std::string> k = keys(s);
@@ -65,6 +94,37 @@ std::string parse_one(const mech::MechanicalModel& m, const std::string& s, Sens
   return "";
 }
 
+// A general LCS's entry: A[state][state], B[state][pair], C[pair][state],
+// D[pair][pair]. The exosystem's rows of A and B are the inputs' own
+// dynamics (kept autonomous, re-set at breakpoints): not named.
+std::string parse_one_lcs(const mech::Model& model, const std::string& s, SensParam& p) {
+  const std::string bad = "sensitivity '" + s + "': ";
+  const lcs::Lcs& sys = *model.lcs;
+  if (s.size() < 2 || std::string("ABCD").find(s[0]) == std::string::npos)
+    return bad + "not a parameter name of a general LCS (x0, A[i][j], B[i][j], C[i][j], D[i][j])";
+  p.kind = s[0];
+  p.name = s;
+  const std::vector<std::string> k = keys(s);
+  if (k.size() != 2u) return bad + "expected two indices, as " + std::string(1, p.kind) + "[0][1]";
+  auto names = [](const std::vector<std::string>& given, int count) {
+    std::vector<std::string> out = given;
+    if (static_cast<int>(out.size()) != count) out.assign(static_cast<size_t>(count), "");
+    return out;
+  };
+  const std::vector<std::string> states = names(model.state_names, sys.n()),
+                                 pairs = names(model.pair_names, sys.k());
+  const bool row_state = p.kind == 'A' || p.kind == 'B', col_state = p.kind == 'A' || p.kind == 'C';
+  p.i = resolve(k[0], row_state ? states : pairs);
+  if (p.i < 0) return bad + "no " + (row_state ? "state" : "pair") + " '" + k[0] + "'";
+  p.j = resolve(k[1], col_state ? states : pairs);
+  if (p.j < 0) return bad + "no " + (col_state ? "state" : "pair") + " '" + k[1] + "'";
+  if (row_state && p.i >= sys.n() - model.exo_states)
+    return bad + "state '" + k[0] + "' is an input's (the exosystem's, the last " +
+           std::to_string(model.exo_states) + " of " + std::to_string(sys.n()) +
+           " states): its dynamics are the input's own, not named";
+  return "";
+}
+
 }  // namespace
 
 SensColumns parse_sensitivity(const mech::Model& model, const std::vector<std::string>& asked) {
@@ -79,13 +139,9 @@ SensColumns parse_sensitivity(const mech::Model& model, const std::vector<std::s
       c.x0 = true;
       continue;
     }
-    if (!model.is_mechanical()) {
-      c.error = "sensitivity '" + s + "': parameters are named for mechanical models only ('" +
-                model.name + "' is a general LCS; ask x0)";
-      return c;
-    }
     SensParam p;
-    c.error = parse_one(*model.mechanical, s, p);
+    c.error =
+        model.is_mechanical() ? parse_one(*model.mechanical, s, p) : parse_one_lcs(model, s, p);
     if (!c.error.empty()) return c;
     c.params.push_back(p);
   }
@@ -157,6 +213,9 @@ std::string check_sensitivity(const mech::Model& model, const Options& opt, std:
            "at a fixed active set)";
   const detail::SensColumns c = detail::parse_sensitivity(model, opt.sensitivity);
   if (!c.error.empty()) return c.error;
+  if (!model.is_mechanical() && !c.params.empty() && !used.event_search)
+    return "Options::sensitivity '" + c.params.front().name + "': method '" + std::string(method) +
+           "' does not compute a general LCS's parameters (the method 'event' does)";
   return refuse_for_scheme(c, method);
 }
 

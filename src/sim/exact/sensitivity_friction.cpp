@@ -1,0 +1,187 @@
+// Forward sensitivities through an impact with planar friction
+// (docs/sensitivities.md): the planar Coulomb impact law (impact::
+// moreau_friction, the LCP in (lambda_N, lambda_R, xi)) is linear in v at a
+// fixed outcome: the contacts with a positive normal impulse A, and for each
+// frictional contact on A its post-impact stick or slip sign. With G =
+// M^{-1}, the unknowns the normal impulses lambda_A and the stuck contacts'
+// tangential impulses lambda_S,
+//   E_r v+ = -e_r E_r v   (r in A; e_r = 0 unless approaching, E_r v < 0),
+//   t_f v+ = velocity_f   (f stuck),
+//   lambda_T,f = -sigma_f mu_f lambda_N   (f sliding along sigma_f t_f),
+// so v+ = v + G B lambda with B = [E_A' + T_slip' (-sigma mu), T_S'],
+// X G B lambda = c - R v (X = [E_A; T_S], R = [(1 + e) E_A; T_S], c = [0;
+// velocity]) and J's velocity block is I - G B (X G B)^{-1} R. The map is
+// not differentiable where the outcome is not locally constant: a stuck
+// contact at the cone's edge (|lambda_T| = mu lambda_N), a sliding contact
+// whose post-impact sliding velocity is zero, an approach rate at zero on a
+// contact with restitution (e switches on there), and a closed contact with a
+// zero impulse and a zero separation rate, each to sqrt(eps) of its scale.
+#include <algorithm>
+#include <cmath>
+
+#include "sim/exact/sensitivity.hpp"
+
+namespace lcsim::sim::detail {
+
+namespace {
+
+// The rows of one impact round's linear system at its outcome.
+struct FrictionImpactRows {
+  MatrixXd X, R, B;        // (a + s) x N, (a + s) x N, N x (a + s)
+  VectorXd c;              // (a + s)
+  std::vector<int> stuck;  // entries of mechanical.friction stuck after the impact
+  std::vector<int> sliding;
+  std::vector<double> sigma;  // per sliding entry
+};
+
+// The friction's part of the rows: a sliding contact's impulse -sigma mu
+// lambda_N along its tangent joins its normal's column of B; a stuck one
+// adds the unknown lambda_T with the row t_f v+ = velocity_f.
+void add_tangent_rows(const mech::MechanicalModel& m, const std::vector<int>& A,
+                      FrictionImpactRows& s) {
+  const int a = static_cast<int>(A.size());
+  for (size_t k = 0; k < s.sliding.size(); ++k) {
+    const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(s.sliding[k])];
+    const auto i = std::find(A.begin(), A.end(), fc.contact) - A.begin();
+    s.B.col(i) -= s.sigma[k] * fc.mu * VectorXd(fc.tangent);
+  }
+  for (size_t k = 0; k < s.stuck.size(); ++k) {
+    const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(s.stuck[k])];
+    const Eigen::Index row = a + static_cast<Eigen::Index>(k);
+    s.X.row(row) = VectorXd(fc.tangent).transpose();
+    s.R.row(row) = s.X.row(row);
+    s.B.col(row) = VectorXd(fc.tangent);
+    s.c(row) = fc.velocity;
+  }
+}
+
+}  // namespace
+
+bool Sensitivity::friction_impact_map(double t, const EventResult::ImpactRound& rd, MatrixXd& J) {
+  const mech::MechanicalModel& m = *model_.mechanical;
+  if (!m.gap_inputs.empty() || rd.outcome.size() != static_cast<size_t>(m.num_constraints())) {
+    lose_all(t, rd.closed.empty() ? -1 : rd.closed.front(),
+             "an impact with friction on a moving stop: its derivative is not computed");
+    return false;
+  }
+  const MatrixXd E = MatrixXd(m.E);
+  const VectorXd& v = rd.v_before;
+  const VectorXd e = law_ == 'i' ? VectorXd::Zero(rd.restitution.size()) : rd.restitution;
+  double pmax = 0.0, amax = 0.0;
+  for (int r : rd.closed) {
+    pmax = std::max(pmax, std::abs(rd.impulse(r)));
+    amax = std::max(amax, std::abs(E.row(r).dot(v)));
+  }
+  std::vector<int> A;
+  for (int r : rd.closed)
+    if (rd.impulse(r) > kSqrtEps * pmax) A.push_back(r);
+  const int a = static_cast<int>(A.size());
+  FrictionImpactRows s;
+  for (size_t f = 0; f < m.friction.size(); ++f) {
+    const int row = m.friction[f].contact;
+    if (std::find(A.begin(), A.end(), row) == A.end()) continue;
+    const impact::ContactOutcome o = rd.outcome[static_cast<size_t>(row)];
+    if (o == impact::ContactOutcome::kStick) {
+      s.stuck.push_back(static_cast<int>(f));
+    } else if (o == impact::ContactOutcome::kSlipPositive ||
+               o == impact::ContactOutcome::kSlipNegative) {
+      s.sliding.push_back(static_cast<int>(f));
+      s.sigma.push_back(o == impact::ContactOutcome::kSlipPositive ? 1.0 : -1.0);
+    } else {
+      lose_all(t, row,
+               "an impact with friction whose outcome at this contact is not stick or slip");
+      return false;
+    }
+  }
+  const int ns = static_cast<int>(s.stuck.size()), na = a + ns;
+  s.X = MatrixXd::Zero(na, N_), s.R = MatrixXd::Zero(na, N_), s.B = MatrixXd::Zero(N_, na);
+  s.c = VectorXd::Zero(na);
+  for (int i = 0; i < a; ++i) {
+    const int r = A[static_cast<size_t>(i)];
+    const double ar = E.row(r).dot(v);
+    // e switches on with the approach (u_N- < 0): at u_N- = 0 the map has a kink.
+    if (e(r) != 0.0 && std::abs(ar) <= kSqrtEps * amax) {
+      lose_all(t, r,
+               "an impact with friction at a zero approach rate with restitution: not "
+               "differentiable");
+      return false;
+    }
+    s.X.row(i) = E.row(r);
+    s.R.row(i) = (1.0 + (ar < 0.0 ? e(r) : 0.0)) * E.row(r);
+    s.B.col(i) = E.row(r).transpose();
+  }
+  add_tangent_rows(m, A, s);
+  const MatrixXd GB = G_ * s.B;
+  const Eigen::FullPivLU<MatrixXd> W(s.X * GB);
+  if (na > 0 && !W.isInvertible()) {
+    lose_all(t, A.empty() ? -1 : A.front(),
+             "an impact with friction whose linear map at its outcome is singular");
+    return false;
+  }
+  const VectorXd lambda = na > 0 ? VectorXd(W.solve(s.c - s.R * v)) : VectorXd();
+  const VectorXd vplus = v + GB * lambda;
+  if (!friction_impact_regular(t, rd, A, s.stuck, s.sliding, lambda, vplus)) return false;
+  J = MatrixXd::Identity(n_, n_);
+  if (na > 0) {
+    J.block(N_, N_, N_, N_) -= GB * W.solve(s.R);
+    J.block(N_, 2 * N_, N_, 1) = GB * W.solve(s.c);
+  }
+  return true;
+}
+
+// The outcome is locally constant: the impulses reproduce the law's (to
+// 1e-8 of the largest), no stuck contact at the cone's edge, no sliding one
+// at a zero sliding velocity, no closed contact without impulse at a zero
+// separation rate.
+bool Sensitivity::friction_impact_regular(double t, const EventResult::ImpactRound& rd,
+                                          const std::vector<int>& A, const std::vector<int>& stuck,
+                                          const std::vector<int>& sliding, const VectorXd& lambda,
+                                          const VectorXd& vplus) {
+  const mech::MechanicalModel& m = *model_.mechanical;
+  const MatrixXd E = MatrixXd(m.E);
+  const int a = static_cast<int>(A.size());
+  const double pmax = a > 0 ? lambda.head(a).cwiseAbs().maxCoeff() : 0.0;
+  const double vmax = rd.v_before.cwiseAbs().maxCoeff() + vplus.cwiseAbs().maxCoeff();
+  for (int i = 0; i < a; ++i)
+    if (std::abs(lambda(i) - rd.impulse(A[static_cast<size_t>(i)])) > 1e-8 * pmax) {
+      lose_all(t, A[static_cast<size_t>(i)],
+               "an impact with friction whose impulses the linear map at its outcome does not "
+               "reproduce");
+      return false;
+    }
+  for (size_t k = 0; k < stuck.size(); ++k) {
+    const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(stuck[k])];
+    const auto i = std::find(A.begin(), A.end(), fc.contact) - A.begin();
+    const double lt = lambda(a + static_cast<Eigen::Index>(k)), ln = lambda(i);
+    if (std::abs(lt) >= (1.0 - kSqrtEps) * fc.mu * ln) {
+      lose_all(t, fc.contact,
+               "an impact with friction that sticks at the cone's edge (|P_T| = mu P_N): stick "
+               "and slip meet there, no derivative");
+      return false;
+    }
+  }
+  for (int f : sliding) {
+    const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(f)];
+    if (std::abs(fc.sliding(vplus)) <=
+        kSqrtEps * (vmax * VectorXd(fc.tangent).cwiseAbs().sum() + std::abs(fc.velocity))) {
+      lose_all(t, fc.contact,
+               "an impact with friction after which the contact slides at zero velocity: stick "
+               "and slip meet there, no derivative");
+      return false;
+    }
+  }
+  double amax = 0.0;
+  for (int r : rd.closed) amax = std::max(amax, std::abs(E.row(r).dot(rd.v_before)));
+  for (int r : rd.closed) {
+    if (std::find(A.begin(), A.end(), r) != A.end()) continue;
+    if (std::abs(E.row(r).dot(vplus)) <= kSqrtEps * amax) {
+      lose_all(t, r,
+               "degenerate impact: a zero impulse and a zero separation rate (the impact LCP's "
+               "active set is not locally constant)");
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace lcsim::sim::detail
