@@ -170,6 +170,29 @@ void zero_cancelled(const Ldcp& s, const Level& l, const Eigen::FullPivLU<Matrix
       qK(i) = 0.0;
 }
 
+// Lemma 4.6.1 needs q in the range of a singular S, and rounding leaves it
+// just outside: the NAO's two feet on four coplanar points each gave an S of
+// rank 1 whose rows for three corners of a foot were equal and whose q
+// differed in the 15th digit, so no complementary basis solved it. When the
+// LCP fails and q's part outside S's range is rounding of the terms that
+// formed q (as zero_cancelled judges each entry), the LCP is solved again on
+// q's part in the range. A solvable LCP never gets here, so its result is
+// unchanged. True when q_range is set.
+bool range_part(const Ldcp& s, const Level& l, const MatrixXd& S, const VectorXd& qK,
+                VectorXd& q_range) {
+  const Eigen::JacobiSVD<MatrixXd> svd(S, Eigen::ComputeThinU);
+  const double tol = rank_tolerance(S);
+  const Eigen::Index rank = (svd.singularValues().array() > tol).count();
+  if (rank == S.rows()) return false;  // regular S: its failure is not rounding
+  const MatrixXd U = svd.matrixU().leftCols(rank);
+  q_range = U * (U.transpose() * qK);
+  for (size_t i = 0; i < l.K.size(); ++i) {
+    const double rounding = s.opt.tol_rel * (l.scale(l.K[i]) + std::abs(qK(i))) + s.opt.tol_abs;
+    if (std::abs(q_range(i) - qK(i)) > rounding) return false;
+  }
+  return true;
+}
+
 // u_K from the LCP of the Schur complement of script M_II (3.49)-(3.50).
 // "" or why the LCP failed.
 std::string schur_lcp(const Ldcp& s, const Level& l, const Eigen::FullPivLU<MatrixXd>& luI,
@@ -187,8 +210,15 @@ std::string schur_lcp(const Ldcp& s, const Level& l, const Eigen::FullPivLU<Matr
   // solves (q in its range, Lemma 4.6.1); the motion is unique even where the
   // multipliers are not (Theorem 4.6.5).
   int attempts = 0;
-  const lcp::Result res = lcp::solve_with_fallbacks(s.solver, S, qK, lcp::Options{}, &attempts);
+  lcp::Result res = lcp::solve_with_fallbacks(s.solver, S, qK, lcp::Options{}, &attempts);
   lcp_solves += attempts;
+  if (!res.ok()) {
+    VectorXd q_range;
+    if (range_part(s, l, S, qK, q_range)) {
+      res = lcp::solve_with_fallbacks(s.solver, S, q_range, lcp::Options{}, &attempts);
+      lcp_solves += attempts;
+    }
+  }
   if (!res.ok())
     return "LCP at LDCP level " + std::to_string(l.p) +
            " failed: " + std::string(lcp::to_string(res.status, "solved")) +
@@ -244,6 +274,59 @@ double u_tolerance(const Ldcp& s, const Level& l, int r) {
   return tol;
 }
 
+// Dependent constraints (a box flat on its four coplanar corners: rows of
+// rank 3) let the LCP end on a solution that loads every row of a dependent
+// set (Lemke and the pivoting solvers may stop on a degenerate point that is
+// not a vertex: bullet3's cube_small.urdf dropped flat got four positive
+// multipliers). Those rows would all become active, script M_II would be
+// singular, and the mode's feedback could not be built. A direction z over
+// the loaded rows P and the active rows I with B z = 0 and D z = 0 moves no
+// state, no coefficient y of any level and no jump (every one is linear in
+// B u and D u, (3.42), (3.10)), so u^p - t z solves the same level: t is
+// taken to zero one multiplier of P and keep the others >= 0
+// (Caratheodory), until the columns of [B; D] over P and I are independent,
+// as a vertex's are. Multipliers on dependent rows are not unique anyway
+// (thesis §4.6.1); the motion is. A level whose columns are independent is
+// left exactly as it was.
+void drop_dependent_multipliers(const Ldcp& s, const Level& l, VectorXd& up) {
+  const int n = s.sys.n();
+  for (int round = 0; round < static_cast<int>(l.K.size()); ++round) {
+    std::vector<int> cols = l.I;
+    const size_t first_p = cols.size();
+    for (int r : l.K)
+      if (up(r) > u_tolerance(s, l, r)) cols.push_back(r);
+    if (cols.size() == first_p) return;
+    const auto m = static_cast<Eigen::Index>(cols.size());
+    MatrixXd G(n + s.sys.k(), m);
+    VectorXd scale(m);
+    for (Eigen::Index c = 0; c < m; ++c) {
+      G.col(c) << s.sys.B.col(cols[static_cast<size_t>(c)]),
+          s.sys.D.col(cols[static_cast<size_t>(c)]);
+      scale(c) = std::max(G.col(c).cwiseAbs().maxCoeff(), 1e-300);
+      G.col(c) /= scale(c);  // column units differ; a scaling keeps the null space's support
+    }
+    const Eigen::JacobiSVD<MatrixXd> svd(G, Eigen::ComputeFullV);
+    if (svd.singularValues()(m - 1) > rank_tolerance(G)) return;
+    VectorXd z = svd.matrixV().col(m - 1).cwiseQuotient(scale);
+    const auto pz = z.tail(m - static_cast<Eigen::Index>(first_p));
+    if (pz.size() == 0 || pz.cwiseAbs().maxCoeff() <= 1e-12 * z.cwiseAbs().maxCoeff()) return;
+    if (pz.maxCoeff() <= 0.0) z = -z;
+    double t = -1.0;
+    Eigen::Index zeroed = -1;
+    for (Eigen::Index c = static_cast<Eigen::Index>(first_p); c < m; ++c) {
+      if (z(c) <= 1e-12 * z.cwiseAbs().maxCoeff()) continue;
+      const double ratio = up(cols[static_cast<size_t>(c)]) / z(c);
+      if (zeroed < 0 || ratio < t) t = ratio, zeroed = c;
+    }
+    for (Eigen::Index c = 0; c < m; ++c) {
+      double& u = up(cols[static_cast<size_t>(c)]);
+      u -= t * z(c);
+      if (c >= static_cast<Eigen::Index>(first_p)) u = std::max(u, 0.0);  // rounding of t z
+    }
+    up(cols[static_cast<size_t>(zeroed)]) = 0.0;
+  }
+}
+
 // An undecided row becomes active when u_r^p > 0, inactive when y_r^p > 0
 // (the lexicographic signs of §3.5.2); u_r^p within rounding is set to 0.
 void classify_undecided(Ldcp& s, const Level& l, VectorXd& up) {
@@ -277,6 +360,7 @@ std::string solve_levels(Ldcp& s, int& lcp_solves) {
     if (l.K.empty() && l.I.empty()) break;  // every row decided inactive
     const std::string failed = solve_level(s, l, up, lcp_solves);
     if (!failed.empty()) return failed;
+    drop_dependent_multipliers(s, l, up);
     classify_undecided(s, l, up);
     // Once no row is undecided the mode is fixed; the impulsive levels (p <= 0)
     // are still needed for the jump, later levels are not.

@@ -96,9 +96,22 @@ void check_mass_matrix(const MatrixXd& M, const SceneJoints& joints, const std::
     // components: a unit vector has one of at least 1/sqrt(N)).
     const VectorXd v = es.eigenvectors().col(0).cwiseAbs();
     std::vector<std::string> which;
+    bool base_only = true;
     for (Eigen::Index i = 0; i < N; ++i)
-      if (v(i) >= 0.5 * v.maxCoeff())
+      if (v(i) >= 0.5 * v.maxCoeff()) {
         which.push_back("'" + joints.names[static_cast<std::size_t>(i)] + "'");
+        base_only = base_only && static_cast<std::size_t>(i) < joints.base;
+      }
+    // A floating body with zero <inertia> (bullet3's
+    // sphere_small_zeroinertia.urdf, a point mass) cannot turn: say so, not
+    // "joint", since no joint is involved.
+    if (base_only)
+      fail(source, "base",
+           "the mass matrix at q0 is not positive definite (smallest eigenvalue " +
+               format_number(es.eigenvalues().minCoeff()) + ", along the floating base's " +
+               join(which) +
+               "): the floating body has no rotational inertia about that axis (its links' "
+               "<inertia> is zero: a point mass); give its root link a rotational inertia");
     fail(source, "joints",
          "the mass matrix at q0 is not positive definite (smallest eigenvalue " +
              format_number(es.eigenvalues().minCoeff()) + ", along joint " + join(which) +

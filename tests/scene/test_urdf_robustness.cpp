@@ -237,5 +237,25 @@ TEST_F(UrdfRobustness, SingularMassMatrixNamesTheJoint) {
   EXPECT_NE(e.find("along joint 'j2')"), std::string::npos) << e;
 }
 
+TEST_F(UrdfRobustness, PointMassOnAFloatingBaseNamesTheBase) {
+  // bullet3's sphere_small_zeroinertia.urdf on a floating base: mass 0.1,
+  // inertia tensor zero. M is singular along the three rotations; the
+  // message says it is the floating base (key `base`), not a joint, and how
+  // to fix it. Before, it read "joints: ... along joint 'p.rx' ...: the joint
+  // moves no inertia about its axis".
+  const std::string u =
+      "<robot name='p'><link name='b'><inertial><mass value='0.1'/><inertia ixx='0' ixy='0' "
+      "ixz='0' iyy='0' iyz='0' izz='0'/></inertial><collision><geometry><sphere "
+      "radius='0.03'/></geometry></collision></link></robot>";
+  const std::string e = error(u, "base: {type: floating, pose: {xyz: [0, 0, 0.03]}}\n");
+  EXPECT_NE(e.find("s.yaml: base: the mass matrix at q0 is not positive definite"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("along the floating base's 'p.r"), std::string::npos) << e;
+  EXPECT_NE(e.find("no rotational inertia"), std::string::npos) << e;
+  EXPECT_EQ(e.find("joint"), std::string::npos) << e;
+  EXPECT_EQ(e.find('\n'), std::string::npos) << e;  // one line
+}
+
 }  // namespace
 }  // namespace lcsim
