@@ -170,7 +170,8 @@ std::string painleve_solved(const ImpactInput& in, const ClosedFriction& c, cons
   const VectorXd vv = in.v.cwiseAbs() + v_after.cwiseAbs();
   for (Eigen::Index f = 0; f < nf; ++f) {
     const int j = c.normal_of[static_cast<size_t>(f)];
-    msg += text(" ", in.closed[static_cast<size_t>(j)]);
+    const int row = in.closed[static_cast<size_t>(j)];
+    msg += text(" ", row, " ('", in.model->constraints[static_cast<size_t>(row)], "')");
     // Sliding after the impact (zero to the rounding of the terms of t'v,
     // as set_outcomes): sigma its sign, lambda_T = -sigma mu lambda_N, the
     // column -sigma mu W_g t; else it sticks (its row held).

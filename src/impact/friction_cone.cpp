@@ -247,7 +247,8 @@ std::string cone_painleve_solved(const mech::MechanicalModel& m, const ImpactInp
   const VectorXd vv = in.v.cwiseAbs() + v_after.cwiseAbs();
   for (size_t f = 0; f < c.index.size(); ++f) {
     const int j = c.normal_of[f], n = 2 * c.d[f], first = c.first[f];
-    which += text(" ", in.closed[static_cast<size_t>(j)]);
+    const int row = in.closed[static_cast<size_t>(j)];
+    which += text(" ", row, " ('", m.constraints[static_cast<size_t>(row)], "')");
     const std::optional<ConeFacet> facet = sliding_facet(m, c, f, v_after, vv);
     if (!facet) {
       stick.push_back(nj + first);
