@@ -34,13 +34,32 @@ double EventDriven::next_scheduled(double t) const {
 std::string EventDriven::swap_configuration(double t0, double t_b) {
   const std::size_t i = model_.interval_at(t0);
   if (i >= model_.switch_times.size() || model_.switch_times[i] != t_b) return "";
+  if (config_caches_.empty()) config_caches_.resize(model_.configurations.size());
+  ConfigCaches& before = config_caches_[static_cast<std::size_t>(config_)];
+  swap_caches(before);  // the old configuration's caches, kept
+  before.built = true;
   config_ = model_.switch_config[i + 1];
   sys_ = model_.configurations[static_cast<std::size_t>(config_)].lcs;
-  feedback_cache_.clear();
-  rho_cache_.clear();
-  ldcp_data_ = lcs::ldcp_data(sys_);
-  rho_A_ = spectral_radius_bound(sys_.A);
+  ConfigCaches& after = config_caches_[static_cast<std::size_t>(config_)];
+  if (after.built) {
+    swap_caches(after);
+    after.built = false;
+  } else {
+    feedback_cache_.clear();
+    rho_cache_.clear();
+    step_cache_.clear();
+    ldcp_data_ = lcs::ldcp_data(sys_);
+    rho_A_ = spectral_radius_bound(sys_.A);
+  }
   return model_.switch_notes[i];
+}
+
+void EventDriven::swap_caches(ConfigCaches& c) {
+  std::swap(c.ldcp, ldcp_data_);  // ldcp_.data points at ldcp_data_, which stays
+  std::swap(c.rho_A, rho_A_);
+  std::swap(c.feedback, feedback_cache_);
+  std::swap(c.rho, rho_cache_);
+  std::swap(c.step, step_cache_);
 }
 
 // The event at the breakpoint t_b that ended the phase pm: the state there,
