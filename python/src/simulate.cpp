@@ -46,12 +46,18 @@ struct SampleBuffers {
   // n x columns with 1 where the column's derivative exists.
   std::vector<double> dx;
   std::vector<std::uint8_t> dx_ok;
+  // A switched circuit's configuration per sample (sim::Sample::configuration,
+  // for the CSV's outputs); empty for every other model.
+  std::vector<int> configuration;
+  bool switched = false;
   py::ssize_t nx = 0, k = 0, nf = 0, nc = 0, nf3 = 0;  // nf3: nf with 3-D friction, else 0
   explicit SampleBuffers(const mech::Model& m)
       : nx(m.state_size()),
         k(m.num_constraints()),
         nf(m.is_mechanical() ? static_cast<py::ssize_t>(m.mechanical->friction.size()) : 0),
-        nf3(m.is_mechanical() && m.mechanical->has_friction_3d() ? nf : 0) {}
+        nf3(m.is_mechanical() && m.mechanical->has_friction_3d() ? nf : 0) {
+    switched = !m.configurations.empty();
+  }
   void reserve(std::size_t n) {
     const auto rows = [n](py::ssize_t w) { return n * static_cast<std::size_t>(w); };
     t.reserve(n);
@@ -68,6 +74,7 @@ struct SampleBuffers {
   }
   void add(const sim::Sample& s) {
     t.push_back(s.t);
+    if (switched) configuration.push_back(s.configuration);
     append(x, s.x, nx);
     append(u, s.u, k);
     append(y, s.y, k);
@@ -112,6 +119,7 @@ struct Run {
   py::array modes;                          // bool, n x k
   py::array_t<double> dx;                   // n x state x columns (SampleBuffers)
   py::array_t<std::uint8_t> dx_ok;          // n x columns
+  std::vector<int> configuration;           // SampleBuffers::configuration
 
   // The run as the library gives it, samples included (for the writers).
   sim::Sample sample(py::ssize_t i) const {
@@ -124,6 +132,8 @@ struct Run {
     // A row of NaN in u or y: the sample recorded none (blank cells).
     auto recorded = [](VectorXd v) { return v.array().isNaN().all() ? VectorXd() : v; };
     s.x = row(x), s.u = recorded(row(u)), s.y = recorded(row(y));
+    if (static_cast<std::size_t>(i) < configuration.size())
+      s.configuration = configuration[static_cast<std::size_t>(i)];
     if (u_t.shape(1) > 0) s.u_t = recorded(row(u_t));
     const py::ssize_t nf = friction_modes.shape(1);
     if (nf > 0 && friction_modes.at(i, 0) != kNoFrictionMode)
@@ -212,6 +222,7 @@ std::shared_ptr<Run> simulate(const ModelHandle& model, const std::optional<Vect
   run->friction_modes = numpy_owning(std::move(buf.friction_mode), {n, buf.nf});
   run->u_t2 = numpy_owning(std::move(buf.u_t2), {n, buf.nf3});
   run->facets = numpy_owning(std::move(buf.facet), {n, buf.nf3});
+  run->configuration = std::move(buf.configuration);
   run->modes =
       numpy_owning(std::move(buf.active), {n, buf.k}).attr("view")("bool").cast<py::array>();
   const py::ssize_t nc = static_cast<py::ssize_t>(run->traj.sensitivity_columns.size());

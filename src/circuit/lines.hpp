@@ -32,4 +32,10 @@ Lines split_lines(const std::string& text, const std::string& source);
 
 std::string lower(std::string s);
 
+// .param (src/circuit/params.cpp): removes the `.param` lines, evaluating
+// them in order, and replaces each `{expr}` on the other lines by its value.
+// InputError naming the line for an unknown parameter, an expression it
+// cannot read, or .param inside .subckt.
+void apply_params(Lines& lines, const std::string& source);
+
 }  // namespace lcsim::circuit::detail

@@ -1,6 +1,7 @@
 // The SPICE netlist reader (docs/circuits.md): element lines, .model,
 // .subckt/.ends with X instances, .ic, .tran, .end; what lcsim does not model
 // is refused by name.
+#include <algorithm>
 #include <cmath>
 #include <lcsim/circuit/circuit.hpp>
 #include <lcsim/core/format.hpp>
@@ -17,6 +18,11 @@ using detail::lower;
 
 struct DiodeModel {
   double von = 0.0, ron = 0.0;
+};
+
+// .model name SW(VT VH RON ROFF), SPICE's defaults (ngspice: ROFF = 1/GMIN).
+struct SwitchModel {
+  double vt = 0.0, vh = 0.0, ron = 1.0, roff = 1e12;
 };
 
 // A PULSE's arguments as written (NaN where omitted), turned into a
@@ -40,7 +46,8 @@ struct Reader {
   std::unordered_map<std::string, int> node_index;  // lower-case name -> index
   std::unordered_map<std::string, Subckt> subckts;  // by lower-case name
   std::unordered_map<std::string, DiodeModel> models;
-  std::vector<std::string> diode_model_of;  // per element (lower-case), for diodes
+  std::unordered_map<std::string, SwitchModel> switch_models;
+  std::vector<std::string> diode_model_of;  // per element (lower-case), for diodes and switches
   std::vector<Line> top;
   std::set<std::string> element_names;  // lower-case
   std::vector<PendingPulse> pulses;
@@ -149,6 +156,40 @@ mech::Input read_pwl(const Reader& r, const Line& l, const std::string& name,
   return in;
 }
 
+// PWL's options after its points, as ngspice reads them (either order):
+// td=value delays the whole sequence; r=value repeats it from the time point
+// `value` to the last one, over and over. lcsim repeats the whole sequence
+// only (r equal to the first time point, ngspice's usual r=0): a later r
+// would need a second exosystem per source, and is refused.
+void pwl_options(const Reader& r, const Line& l, const std::string& name, std::size_t& i,
+                 mech::Input& in) {
+  const auto& t = l.tokens;
+  std::optional<double> repeat, delay;
+  while (i + 2 < t.size() && (lower(t[i]) == "r" || lower(t[i]) == "td") && t[i + 1] == "=") {
+    std::optional<double>& o = lower(t[i]) == "r" ? repeat : delay;
+    if (o) r.fail(l, name, "PWL " + t[i] + "= given twice");
+    o = r.number(l, name, t[i + 2]);
+    i += 3;
+  }
+  if (delay) {
+    if (*delay < 0.0) r.fail(l, name, "PWL td must be >= 0 (got " + format_number(*delay) + " s)");
+    in.origin = *delay;
+  }
+  if (!repeat) return;
+  const double v = *repeat, start = in.times.front();
+  if (std::find(in.times.begin(), in.times.end(), v) == in.times.end())
+    r.fail(l, name, "PWL r= must be one of its time points (got " + format_number(v) + " s)");
+  if (v != start)
+    r.fail(l, name,
+           "PWL r= after the first time point is not yet supported (got " + format_number(v) +
+               " s; lcsim repeats the whole sequence, r = " + format_number(start) + " s)");
+  if (!(in.times.back() > v))
+    r.fail(l, name, "PWL r= needs points after it (the sequence to repeat has zero length)");
+  for (double& x : in.times) x -= start;  // one period, [0, Tn - T1], from origin td + T1
+  in.period = in.times.back();
+  in.origin += start;
+}
+
 // PULSE(V1 V2 [TD [TR [TF [PW [PER]]]]]): its arguments, checked; the
 // mech::Input is made once .tran is read (make_pulse).
 void read_pulse(Reader& r, const Line& l, const std::string& name,
@@ -195,6 +236,7 @@ Waveform read_source(Reader& r, const Line& l, const std::string& name, std::siz
       ++i;
       w.input = read_pwl(r, l, name, arguments(l, i));
       w.sine = false;
+      pwl_options(r, l, name, i, *w.input);
     } else if (k == "pulse") {
       ++i;
       read_pulse(r, l, name, arguments(l, i));
@@ -217,7 +259,7 @@ Waveform read_source(Reader& r, const Line& l, const std::string& name, std::siz
 }
 
 // The number of nodes of an element type, and its usage line.
-int node_count(char type) { return (type == 'e' || type == 'g') ? 4 : 2; }
+int node_count(char type) { return (type == 'e' || type == 'g' || type == 's') ? 4 : 2; }
 std::string usage(char type) {
   switch (type) {
     case 'e':
@@ -228,6 +270,8 @@ std::string usage(char type) {
       return "name n+ n- vcontrol gain";
     case 'd':
       return "name anode cathode model";
+    case 's':
+      return "name n+ n- nc+ nc- model [ON|OFF]";
     case 'v':
     case 'i':
       return "name n+ n- [DC] value | SIN(VO VA FREQ TD THETA PHASE) | PULSE(...) | PWL(...)";
@@ -279,6 +323,8 @@ ElementKind kind_of(char type) {
       return ElementKind::kVccs;
     case 'h':
       return ElementKind::kCcvs;
+    case 's':
+      return ElementKind::kSwitch;
     default:
       return ElementKind::kDiode;
   }
@@ -286,9 +332,13 @@ ElementKind kind_of(char type) {
 
 void refuse_type(const Reader& r, const Line& l, const std::string& name) {
   const char type = static_cast<char>(std::tolower(static_cast<unsigned char>(name[0])));
-  if (type == 's' || type == 'w')
-    r.fail(l, name, "switches are not yet supported: their state changes need scheduled events");
-  if (std::string("rclvidefghx").find(type) == std::string::npos)
+  if (type == 'w')
+    r.fail(l, name,
+           "current-controlled switches are not supported (lcsim reads S, whose control is a "
+           "voltage)");
+  // S is read too; the message predates it and existing tests assert it
+  // word for word (docs/circuits.md lists S).
+  if (std::string("rclvidefghxs").find(type) == std::string::npos)
     r.fail(l, name,
            "unknown element type '" + std::string(1, name[0]) +
                "' (lcsim reads R, C, L, V, I, E, F, G, H, D and X)");
@@ -341,6 +391,12 @@ void read_element(Reader& r, const Scope& s, const Line& l) {
       e.value = r.number(l, name, l.tokens[i++]);
       no_more(r, l, e, i);
       break;
+    case 's':  // model [ON|OFF]
+      model = lower(l.tokens[i++]);
+      if (i < l.tokens.size() && (lower(l.tokens[i]) == "on" || lower(l.tokens[i]) == "off"))
+        e.starts_on = lower(l.tokens[i++]) == "on";
+      no_more(r, l, e, i);
+      break;
     default:  // 'd'
       model = lower(l.tokens[i++]);
       no_more(r, l, e, i);
@@ -384,37 +440,74 @@ void expand(Reader& r, const std::vector<Line>& lines, const Scope& s, int depth
   }
 }
 
+// The name=value pairs of a .model line (the parentheses dropped), in order.
+std::vector<std::pair<std::string, double>> model_parameters(const Reader& r, const Line& l) {
+  const auto& t = l.tokens;
+  std::vector<std::pair<std::string, double>> p;
+  for (std::size_t i = 3; i < t.size(); ++i) {
+    if (t[i] == "(" || t[i] == ")") continue;
+    if (i + 2 >= t.size() || t[i + 1] != "=")
+      r.fail(l, ".model " + t[1] + ": expected name=value (got '" + t[i] + "')");
+    p.emplace_back(t[i], r.number(l, ".model " + t[1] + ": " + t[i], t[i + 2]));
+    i += 2;
+  }
+  return p;
+}
+
+// .model name SW(VT VH RON ROFF): RON and ROFF finite and > 0 (a switch is a
+// resistor in both states: docs/circuits.md), VH >= 0 (ngspice's negative
+// hysteresis is another state machine, not read).
+void read_switch_model(Reader& r, const Line& l) {
+  const std::string name = ".model " + l.tokens[1];
+  SwitchModel m;
+  for (const auto& [key_as_written, v] : model_parameters(r, l)) {
+    const std::string key = lower(key_as_written);
+    const std::string what = name + ": " + key_as_written;
+    if (key == "vt") {
+      m.vt = v;
+    } else if (key == "vh") {
+      if (v < 0.0) r.fail(l, what + " must be >= 0 (got " + format_number(v) + ")");
+      m.vh = v;
+    } else if (key == "ron" || key == "roff") {
+      if (!(v > 0.0)) r.fail(l, what + " must be > 0 (got " + format_number(v) + ")");
+      (key == "ron" ? m.ron : m.roff) = v;
+    } else {
+      r.fail(l, name + ": unknown switch parameter '" + key_as_written +
+                    "' (lcsim reads VT, VH, RON and ROFF; docs/circuits.md)");
+    }
+  }
+  r.switch_models[lower(l.tokens[1])] = m;
+}
+
 void read_model(Reader& r, const Line& l) {
   const auto& t = l.tokens;
-  if (t.size() < 3) r.fail(l, ".model: expected `.model name D(params)`");
+  if (t.size() < 3)
+    r.fail(l, ".model: expected `.model name D(params)` or `.model name SW(params)`");
   const std::string type = lower(t[2]);
-  if (type == "sw" || type == "csw")
+  if (type == "sw") return read_switch_model(r, l);
+  if (type == "csw")
     r.fail(l, ".model " + t[1] +
-                  ": switches are not yet supported: their state changes need "
-                  "scheduled events");
+                  ": current-controlled switches (CSW) are not supported (lcsim reads SW)");
   if (type != "d")
-    r.fail(l, ".model " + t[1] + ": model type '" + t[2] + "' is not supported (lcsim reads D)");
+    r.fail(l, ".model " + t[1] + ": model type '" + t[2] +
+                  "' is not supported (lcsim reads D and SW)");
   DiodeModel m;
   static const std::set<std::string> ignored = {"is", "n",    "cjo",   "cj0", "cj",  "vj", "m",
                                                 "tt", "bv",   "ibv",   "eg",  "xti", "kf", "af",
                                                 "fc", "tnom", "level", "js",  "pb",  "mj"};
-  for (std::size_t i = 3; i < t.size(); ++i) {
-    if (t[i] == "(" || t[i] == ")") continue;
-    const std::string key = lower(t[i]);
-    if (i + 2 >= t.size() || t[i + 1] != "=")
-      r.fail(l, ".model " + t[1] + ": expected name=value (got '" + t[i] + "')");
-    const double v = r.number(l, ".model " + t[1] + ": " + t[i], t[i + 2]);
+  for (const auto& [key_as_written, v] : model_parameters(r, l)) {
+    const std::string key = lower(key_as_written);
     if (key == "ron" || key == "rs") {
       if (v < 0.0)
-        r.fail(l, ".model " + t[1] + ": " + t[i] + " must be >= 0 (got " + format_number(v) + ")");
+        r.fail(l, ".model " + t[1] + ": " + key_as_written + " must be >= 0 (got " +
+                      format_number(v) + ")");
       m.ron = v;
     } else if (key == "von") {
       m.von = v;
     } else if (!ignored.count(key)) {
-      r.fail(l, ".model " + t[1] + ": unknown diode parameter '" + t[i] +
+      r.fail(l, ".model " + t[1] + ": unknown diode parameter '" + key_as_written +
                     "' (lcsim reads RON or RS, and VON; docs/circuits.md)");
     }
-    i += 2;
   }
   r.models[lower(t[1])] = m;
 }
@@ -548,9 +641,20 @@ void resolve(Reader& r) {
     if (e.kind == ElementKind::kDiode) {
       const auto it = r.models.find(r.diode_model_of[i]);
       if (it == r.models.end())
-        throw InputError(e.where + ": " + e.name + ": no .model '" + r.diode_model_of[i] + "'");
+        throw InputError(e.where + ": " + e.name + ": no .model '" + r.diode_model_of[i] + "'" +
+                         (r.switch_models.count(r.diode_model_of[i]) ? " of type D" : ""));
       e.von = it->second.von;
       e.ron = it->second.ron;
+    }
+    if (e.kind == ElementKind::kSwitch) {
+      const auto it = r.switch_models.find(r.diode_model_of[i]);
+      if (it == r.switch_models.end())
+        throw InputError(e.where + ": " + e.name + ": no .model '" + r.diode_model_of[i] +
+                         "' of type SW");
+      e.ron = it->second.ron;
+      e.roff = it->second.roff;
+      e.vt = it->second.vt;
+      e.vh = it->second.vh;
     }
     if (e.kind == ElementKind::kCccs || e.kind == ElementKind::kCcvs) {
       bool found = false;
@@ -584,7 +688,8 @@ Netlist parse_netlist(const std::string& text, const std::string& source) {
   r.source = source;
   r.net.source = source;
   r.net.nodes = {"0"};
-  const detail::Lines lines = detail::split_lines(text, source);
+  detail::Lines lines = detail::split_lines(text, source);
+  detail::apply_params(lines, source);
   r.net.title = lines.title;
   first_pass(r, lines.lines);
   std::vector<Line> elements, controls;

@@ -17,6 +17,7 @@
 #include <lcsim/circuit/circuit.hpp>
 #include <lcsim/core/format.hpp>
 #include <lcsim/io/yaml.hpp>
+#include <map>
 #include <numbers>
 
 #include "circuit/lines.hpp"
@@ -33,6 +34,7 @@ struct Layout {
   std::vector<int> state;                   // per element: its circuit state (-1: none)
   std::vector<int> pair;                    // per element: its complementarity pair (-1: none)
   std::vector<int> exo;                     // per element: its first exosystem state (sine), -1
+  std::vector<bool> on;                     // per element: a switch that is on (RON, else ROFF)
   int branches = 0, nc = 0, nw = 1, k = 0;  // nw: the constant state "1" first
   int n() const { return nc + nw; }
   int unknowns() const { return nodes + branches; }
@@ -46,6 +48,7 @@ Layout lay_out(const Netlist& net, const std::vector<DiodeForm>& forms) {
   L.state.assign(ne, -1);
   L.pair.assign(ne, -1);
   L.exo.assign(ne, -1);
+  L.on.assign(ne, false);
   for (std::size_t i = 0; i < ne; ++i) {
     const Element& e = net.elements[i];
     if (e.kind == ElementKind::kCapacitor || e.kind == ElementKind::kInductor) L.state[i] = L.nc++;
@@ -109,6 +112,12 @@ int control_branch(const Netlist& net, const Layout& L, const Element& e) {
   throw std::logic_error("control_branch: unresolved " + e.control);
 }
 
+// A resistor's value, or a switch's RON or ROFF in the configuration L.on.
+double resistance(const Element& e, const Layout& L, std::size_t i) {
+  if (e.kind != ElementKind::kSwitch) return e.value;
+  return L.on[i] ? e.ron : e.roff;
+}
+
 // Stamps one element (a long switch over the element kinds, one case each).
 void stamp(Mna& m, const Netlist& net, const Layout& L, std::size_t i) {
   const Element& e = net.elements[i];
@@ -116,9 +125,12 @@ void stamp(Mna& m, const Netlist& net, const Layout& L, std::size_t i) {
   const int P = L.n() + L.k;
   switch (e.kind) {
     case ElementKind::kResistor:
-      m.add(m.at(a), m.at(a), 1.0 / e.value), m.add(m.at(b), m.at(b), 1.0 / e.value);
-      m.add(m.at(a), m.at(b), -1.0 / e.value), m.add(m.at(b), m.at(a), -1.0 / e.value);
+    case ElementKind::kSwitch: {
+      const double g = 1.0 / resistance(e, L, i);
+      m.add(m.at(a), m.at(a), g), m.add(m.at(b), m.at(b), g);
+      m.add(m.at(a), m.at(b), -g), m.add(m.at(b), m.at(a), -g);
       break;
+    }
     case ElementKind::kCapacitor:
       m.branch(j, a, b);
       m.N(j, L.state[i]) = 1.0;
@@ -196,7 +208,8 @@ RowVector Quantities::current(std::size_t i) const {
   const int P = L->n() + L->k;
   switch (e.kind) {
     case ElementKind::kResistor:
-      return across(e) / e.value;
+    case ElementKind::kSwitch:
+      return across(e) / resistance(e, *L, i);
     case ElementKind::kInductor:
       return RowVector::Unit(P, L->state[i]);
     case ElementKind::kCurrentSource:
@@ -300,6 +313,114 @@ void name_and_output(Circuit& c, const Layout& L, const Quantities& q) {
   }
 }
 
+// Switch j's control v(nc+) - v(nc-) over p, in the configuration `on` (per
+// element).
+RowVector control_row(const Netlist& net, Layout& L, const std::vector<bool>& on, int element) {
+  L.on = on;
+  const Quantities q{&net, &L, solve_mna(net, L)};
+  const Element& e = net.elements[element];
+  return q.node(e.nodes[2]) - q.node(e.nodes[3]);
+}
+
+// Each switch's control as c + g . w(t) over the breakpoint inputs' states:
+// InputError naming the switch when it depends on the circuit's state (a
+// capacitor, an inductor, a diode), on a sine, or on another switch (the
+// control differs with every switch on and every switch off).
+std::vector<detail::SwitchControl> switch_controls(const Circuit& c, Layout& L) {
+  const Netlist& net = c.netlist;
+  std::vector<bool> none(net.elements.size(), false), all = none;
+  for (int i : c.switch_element) all[i] = true;
+  int inputs = 0;  // the breakpoint inputs' states, the last of the exosystem
+  for (const Element& e : net.elements)
+    if (e.wave.input) inputs += e.wave.input->exo_size();
+  std::vector<detail::SwitchControl> out;
+  for (int i : c.switch_element) {
+    const Element& e = net.elements[i];
+    const RowVector off = control_row(net, L, none, i), row = control_row(net, L, all, i);
+    const double tiny = 1e-12 * row.cwiseAbs().maxCoeff();
+    const auto fail = [&](const std::string& what) {
+      throw InputError(e.where + ": " + e.name + ": its control v(" + net.nodes[e.nodes[2]] + ", " +
+                       net.nodes[e.nodes[3]] + ") " + what +
+                       ": lcsim schedules a switch whose control sources alone fix "
+                       "(a DC, PULSE or PWL voltage source across nc+ nc-)");
+    };
+    for (int j = 0; j < L.nc; ++j)
+      if (std::abs(row(j)) > tiny)
+        fail("depends on the circuit's state " + net.elements[c.state_element[j]].name);
+    for (int p = 0; p < L.k; ++p)
+      if (std::abs(row(L.n() + p)) > tiny)
+        fail("depends on the diode " + net.elements[c.diode_element[p]].name);
+    for (int w = 1; w < L.nw - inputs; ++w)
+      if (std::abs(row(L.nc + w)) > tiny) fail("depends on a SIN source");
+    for (const Element& s : net.elements)
+      if (s.wave.input && s.wave.input->sine &&
+          !row.segment(L.nc + L.exo[&s - net.elements.data()], 3).isZero(tiny))
+        fail("depends on the delayed SIN source " + s.name);
+    if (!(row - off).isZero(tiny)) fail("depends on the state of a switch");
+    out.push_back({row(L.nc), row.segment(L.nc + L.nw - inputs, inputs).transpose()});
+  }
+  return out;
+}
+
+// L.on for configuration `config` (c.switch_on).
+void set_switches(const Circuit& c, Layout& L, int config) {
+  L.on.assign(c.netlist.elements.size(), false);
+  for (std::size_t j = 0; j < c.switch_element.size(); ++j)
+    L.on[c.switch_element[j]] = c.switch_on[config][j];
+}
+
+// The switches' schedule (mech::Model::switch_times and the rest), and
+// c.switch_on per configuration in the order the schedule visits them; L.on
+// left at configuration 0's. Nothing without switches.
+void schedule_switches(Circuit& c, Layout& L) {
+  const Netlist& net = c.netlist;
+  for (std::size_t i = 0; i < net.elements.size(); ++i)
+    if (net.elements[i].kind == ElementKind::kSwitch)
+      c.switch_element.push_back(static_cast<int>(i));
+  if (c.switch_element.empty()) return;
+  const Element& first = net.elements[c.switch_element[0]];
+  if (!net.tran)
+    throw InputError(first.where + ": " + first.name +
+                     ": a switch's on and off times are computed up to .tran's tstop, and there "
+                     "is no .tran");
+  const std::vector<detail::SwitchControl> controls = switch_controls(c, L);
+  std::vector<mech::Input> inputs;
+  for (const Element& e : net.elements)
+    if (e.wave.input) inputs.push_back(*e.wave.input);
+  const detail::SwitchSchedule s =
+      detail::switch_schedule(net, c.switch_element, controls, inputs, net.tstop);
+  std::map<std::vector<bool>, int> index;
+  const auto config_of = [&](const std::vector<bool>& on) {
+    const auto [it, added] = index.emplace(on, static_cast<int>(index.size()));
+    if (added) c.switch_on.push_back(on);
+    return it->second;
+  };
+  mech::Model& m = c.model;
+  m.switch_config.push_back(config_of(s.initial));
+  for (std::size_t t = 0; t < s.times.size(); ++t) {
+    m.switch_times.push_back(s.times[t]);
+    m.switch_config.push_back(config_of(s.after[t]));
+  }
+  m.switch_notes = s.notes;
+  m.switch_horizon = net.tstop;
+  set_switches(c, L, 0);
+}
+
+// Each configuration's LCS and outputs (mech::Model::configurations): the
+// same reduction with each switch's RON or ROFF.
+void build_configurations(Circuit& c, Layout& L) {
+  for (std::size_t j = 0; j < c.switch_on.size(); ++j) {
+    set_switches(c, L, static_cast<int>(j));
+    const Quantities q{&c.netlist, &L, solve_mna(c.netlist, L)};
+    Circuit scratch;
+    scratch.netlist = c.netlist;
+    name_and_output(scratch, L, q);
+    c.model.configurations.push_back(
+        {assemble(c.netlist, L, q, c.diode_form), scratch.model.output_x, scratch.model.output_u});
+  }
+  if (!c.switch_on.empty()) set_switches(c, L, 0);
+}
+
 }  // namespace
 
 std::vector<std::string> Circuit::conducting(const std::vector<int>& mode) const {
@@ -318,7 +439,16 @@ Circuit build_circuit(const Netlist& net) {
   Circuit c;
   c.netlist = net;
   c.diode_form = detail::diode_forms_and_cut_sets(net);
-  const Layout L = lay_out(net, c.diode_form);
+  Layout L = lay_out(net, c.diode_form);
+  c.circuit_states = L.nc;
+  for (std::size_t i = 0; i < net.elements.size(); ++i) {  // names for switch_controls' messages
+    if (L.state[i] >= 0) c.state_element.push_back(static_cast<int>(i));
+    if (L.pair[i] >= 0) c.diode_element.push_back(static_cast<int>(i));
+  }
+  schedule_switches(c, L);
+  c.state_element.clear();
+  c.diode_element.clear();
+  build_configurations(c, L);
   const Quantities q{&net, &L, solve_mna(net, L)};
   c.circuit_states = L.nc;
   c.model.lcs = assemble(net, L, q, c.diode_form);

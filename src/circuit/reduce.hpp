@@ -19,6 +19,24 @@ void check_voltage_loops(const Netlist& net);
 // inductors and current sources if any part is still apart from ground.
 std::vector<DiodeForm> diode_forms_and_cut_sets(const Netlist& net);
 
+// A switch's control voltage as a function of time: c + g . w(t), w the
+// states of the circuit's breakpoint inputs (mech::exosystem_states).
+struct SwitchControl {
+  double c = 0.0;
+  Eigen::VectorXd g;
+};
+// The switches' states at t = 0 and after each time at which some switch
+// changes, up to `horizon` (s), with a note per time ("S1 on, S2 off").
+struct SwitchSchedule {
+  std::vector<bool> initial;
+  std::vector<double> times;
+  std::vector<std::vector<bool>> after;
+  std::vector<std::string> notes;
+};
+SwitchSchedule switch_schedule(const Netlist& net, const std::vector<int>& switches,
+                               const std::vector<SwitchControl>& controls,
+                               const std::vector<mech::Input>& inputs, double horizon);
+
 // The circuit's initial state (circuit states then the exosystem): with uic
 // from IC= and .ic, else the operating point (docs/circuits.md). `note` says
 // which.

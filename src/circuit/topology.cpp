@@ -88,7 +88,13 @@ void check_floating(const Netlist& net) {
     if (e.nodes[1] != e.nodes[0]) at[e.nodes[1]].push_back(static_cast<int>(i));
     all.unite(e.nodes[0], e.nodes[1]);
   }
+  // A switch's control may be a voltage source that drives nothing else (a
+  // node only it touches): its voltage is the source's, and MNA stays regular.
+  std::vector<bool> sensed(nn, false);
+  for (const Element& e : net.elements)
+    if (e.kind == ElementKind::kSwitch) sensed[e.nodes[2]] = sensed[e.nodes[3]] = true;
   for (std::size_t v = 1; v < nn; ++v) {
+    if (at[v].size() == 1 && sensed[v] && voltage_defined(net.elements[at[v][0]].kind)) continue;
     if (at[v].empty())
       throw InputError(net.source + ": floating node '" + net.nodes[v] +
                        "': no element connects to it (it is only sensed by a controlled source)");
@@ -124,7 +130,8 @@ std::vector<DiodeForm> diode_forms_and_cut_sets(const Netlist& net) {
   const std::size_t nn = net.nodes.size();
   UnionFind uf(nn);
   for (const Element& e : net.elements)
-    if (voltage_defined(e.kind) || e.kind == ElementKind::kResistor)
+    if (voltage_defined(e.kind) || e.kind == ElementKind::kResistor ||
+        e.kind == ElementKind::kSwitch)  // a resistor of RON or ROFF
       uf.unite(e.nodes[0], e.nodes[1]);
   std::vector<DiodeForm> forms;
   for (const Element& e : net.elements)

@@ -287,7 +287,10 @@ void append_csv_outputs(std::string& out, const sim::Sample& s, const CsvOutputs
     out.append(static_cast<std::size_t>(o.names), ',');
     return;
   }
-  const VectorXd z = o.u.cols() > 0 ? VectorXd(o.x * s.x + o.u * s.u) : VectorXd(o.x * s.x);
+  const auto c = static_cast<std::size_t>(s.configuration);
+  const Eigen::MatrixXd& ox = c < o.config_x.size() ? o.config_x[c] : o.x;
+  const Eigen::MatrixXd& ou = c < o.config_u.size() ? o.config_u[c] : o.u;
+  const VectorXd z = ou.cols() > 0 ? VectorXd(ox * s.x + ou * s.u) : VectorXd(ox * s.x);
   for (Eigen::Index j = 0; j < z.size(); ++j) {
     out += ',';
     append_number(out, z(j), kCsvDigits);
@@ -295,7 +298,12 @@ void append_csv_outputs(std::string& out, const sim::Sample& s, const CsvOutputs
 }
 
 CsvOutputs csv_outputs(const mech::Model& model) {
-  return {static_cast<int>(model.output_names.size()), model.output_x, model.output_u};
+  CsvOutputs o{static_cast<int>(model.output_names.size()), model.output_x, model.output_u, {}, {}};
+  for (const mech::Model::Configuration& c : model.configurations) {
+    o.config_x.push_back(c.output_x);
+    o.config_u.push_back(c.output_u);
+  }
+  return o;
 }
 
 // Row `r` of the CSV: t, x, u, y, the outputs (LCS models that have them),

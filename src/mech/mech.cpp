@@ -213,6 +213,11 @@ int Model::state_size() const {
   return 0;
 }
 
+std::size_t Model::interval_at(double t) const {
+  return static_cast<std::size_t>(std::upper_bound(switch_times.begin(), switch_times.end(), t) -
+                                  switch_times.begin());
+}
+
 const std::vector<Input>& Model::scheduled_inputs() const {
   return mechanical ? mechanical->inputs : inputs;
 }

@@ -188,6 +188,20 @@ std::string refuse_friction_law(const mech::Model& model, const Options& opt,
 // sensitivities with inputs.
 std::string refuse_inputs(const mech::Model& model, const Options& opt, std::string_view method,
                           const OptionsUsed& used) {
+  // A switched circuit (mech::Model::configurations): the exact method swaps
+  // its matrices at the switch times, known up to switch_horizon; the
+  // time-stepping methods and the sensitivities do not follow the swaps.
+  if (model.is_switched()) {
+    if (!used.event_search)
+      return text("method '", method, "' does not simulate switched circuits (model '", model.name,
+                  "' has ideal switches); method 'event' does");
+    if (!opt.sensitivity.empty())
+      return text("sensitivities are not supported through switch times (model '", model.name,
+                  "' has ideal switches)");
+    if (*opt.t_end > model.switch_horizon)
+      return text("t_end = ", *opt.t_end, " s is beyond the switch schedule of model '", model.name,
+                  "', known up to .tran's tstop = ", model.switch_horizon, " s");
+  }
   // An `lcs:` model's inputs (a circuit's PULSE, PWL or delayed SIN sources):
   // their exosystems are re-initialised at the breakpoints by the exact
   // method's scheduled events; the time-stepping methods would integrate the

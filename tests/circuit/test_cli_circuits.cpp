@@ -70,6 +70,39 @@ TEST(CliCircuits, SourcesWithBreakpoints) {
   std::filesystem::remove(cir);
 }
 
+// Switches: a control that depends on the circuit's state is refused (exit
+// 2, one line naming the switch, nothing written); the buck converter runs
+// with the exact method and is refused by backward Euler (exit 2, nothing
+// written); its switch times are `schedule` events named by the switch.
+TEST(CliCircuits, Switches) {
+  const auto cir = private_temp("sw", ".cir"), csv = private_temp("sw", ".csv"),
+             err = private_temp("sw", ".err");
+  {
+    std::ofstream(cir) << "t\nV1 in 0 10\nR1 in b 1k\nC1 b 0 1u\nS1 in a b 0 sw\nR2 a 0 1k\n"
+                          ".model sw SW\n.tran 1u 2m\n";
+  }
+  auto r = run_lcsim("simulate '" + cir.string() + "' --out '" + csv.string() + "'", err);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "lcsim: error: " + cir.string() +
+                       ":5: S1: its control v(b, 0) depends on the circuit's state C1: lcsim "
+                       "schedules a switch whose control sources alone fix (a DC, PULSE or PWL "
+                       "voltage source across nc+ nc-)\n");
+  EXPECT_FALSE(std::filesystem::exists(csv));
+  const std::string buck = kCircuits + "buck_converter.cir";
+  r = run_lcsim("simulate " + buck + " --method euler --h 1e-8 --out '" + csv.string() + "'", err);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err,
+            "lcsim: error: method 'euler' does not simulate switched circuits (model "
+            "'buck_converter' has ideal switches); method 'event' does\n");
+  EXPECT_FALSE(std::filesystem::exists(csv));
+  r = run_lcsim("simulate " + buck + " --t-end 2e-5 --out '" + csv.string() + "'", err);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("switch: S1 on"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("switch: S1 off"), std::string::npos) << r.out;
+  std::filesystem::remove(csv);
+  std::filesystem::remove(cir);
+}
+
 TEST(CliCircuits, AnalyzeSaysPassiveAndWellPosed) {
   const auto err = private_temp("an", ".err");
   const auto r = run_lcsim("analyze " + kCircuits + "half_wave_rectifier.cir --json", err);

@@ -103,8 +103,8 @@ TEST(Netlist, RefusesBadInputOnOneLineNamingLineAndElement) {
       {"t\nV1 a 0 PWL(0 0 1m x)\nR1 a 0 1k\n", "bad.cir:2: V1: non-numeric value 'x'"},
       {"t\nV1 a 0 PULSE(0 1 0 -1n 1n 1m 2m)\nR1 a 0 1k\n",
        "bad.cir:2: V1: PULSE TR must be >= 0 (got -1e-09 s)"},
-      {"t\nV1 a 0 1\nS1 a 0 c 0 sw\nR1 a 0 1k\n",
-       "bad.cir:3: S1: switches are not yet supported: their state changes need scheduled events"},
+      // Switches are read now (test_switches.cpp); one without its .model is refused.
+      {"t\nV1 a 0 1\nS1 a 0 c 0 sw\nR1 a 0 1k\n", "bad.cir:3: S1: no .model 'sw' of type SW"},
       {"t\nV1 a 0 1\nD1 a 0 nomodel\n", "bad.cir:3: D1: no .model 'nomodel'"},
       {"t\nV1 a 0 1\nR1 a 0 1k\n.model d1 D(IS=1e-14 XYZ=1)\n",
        "bad.cir:4: .model d1: unknown diode parameter 'XYZ' (lcsim reads RON or RS, and VON; "

@@ -50,3 +50,30 @@ def test_pwl_source_breakpoints_are_scheduled_events(tmp_path):
     # exponentials (tests/circuit/test_sources.cpp).
     assert abs(scheduled[0].state_after[0] - math.exp(-1.0)) < 1e-12
     assert len(run.final_state) == 4
+
+
+def test_buck_converter_loads_and_switches(robots):
+    # circuits/buck_converter.cir: the switch S1 on at k T + 0.5 ns, off at
+    # k T + 5.0005 us (T = 10 us), each a scheduled event (tests/circuit,
+    # test_switches.cpp, checks the waveform against the closed form).
+    model = lcsim.load(str(robots.parent / "circuits" / "buck_converter.cir"))
+    run = lcsim.simulate(model, t_end=50e-6, dt_out=1e-6)
+    switches = [e for e in run.events if e.type == "schedule" and "switch: S1" in e.note]
+    assert len(switches) == 10
+    for k, e in enumerate(switches):
+        expected = (k // 2) * 10e-6 + (0.5e-9 if k % 2 == 0 else 5.0005e-6)
+        assert abs(e.t - expected) < 1e-15  # one division: a few ulp (test_switches.cpp)
+        assert e.note == "switch: S1 " + ("on" if k % 2 == 0 else "off")
+    # The CSV's outputs follow the configuration: V(sw) is Vin - RON i while
+    # S1 is on, 0 while D1 freewheels (1e-9 V: rounding of ~12 V).
+    rows = run.to_csv().splitlines()
+    header = rows[0].split(",")
+    t_col, sw_col, i_col = header.index("t"), header.index("V(sw)"), header.index("L1.i")
+    for line in rows[1:]:
+        cells = line.split(",")
+        t, vsw, i = float(cells[t_col]), float(cells[sw_col]), float(cells[i_col])
+        phase = t % 10e-6
+        if 1e-8 < phase < 5e-6:
+            assert abs(vsw - (12.0 - 0.01 * i)) < 1e-9
+        elif 5.1e-6 < phase < 9.9e-6:
+            assert abs(vsw) < 1e-9

@@ -40,6 +40,7 @@ enum class ElementKind {
   kVccs,           // G: i = value * v(nc+, nc-)
   kCcvs,           // H: v(n+, n-) = value * I(control)
   kDiode,          // D: ideal, with a forward voltage and an on-resistance
+  kSwitch,         // S: a resistor of RON (on) or ROFF (off) by its control v(nc+, nc-)
 };
 
 // A source's waveform: a constant, or SPICE's SIN(VO VA FREQ TD THETA PHASE)
@@ -59,12 +60,17 @@ struct Element {
   std::string name;  // as written, prefixed "X1." inside subcircuit instance X1
   ElementKind kind = ElementKind::kResistor;
   std::string where;            // "<file>:<line>" of its line, for messages
-  std::vector<int> nodes;       // indices into Netlist::nodes: n+, n- (then nc+, nc- for E, G)
+  std::vector<int> nodes;       // indices into Netlist::nodes: n+, n- (then nc+, nc- for E, G, S)
   double value = 0.0;           // R, C, L, or the gain of E, F, G, H
   std::string control;          // F, H: the voltage source whose current controls them
   std::optional<double> ic;     // C: IC= (V), L: IC= (A)
   Waveform wave;                // V, I
-  double von = 0.0, ron = 0.0;  // D: forward voltage (V) and on-resistance (ohm)
+  double von = 0.0, ron = 0.0;  // D: forward voltage (V) and on-resistance (ohm); S: RON
+  // S (.model SW): off resistance (ohm), threshold and hysteresis (V): on
+  // when v(nc+, nc-) > vt + vh, off when < vt - vh, else as it was; its state
+  // at t = 0 inside that window (`ON` on its line, else off).
+  double roff = 0.0, vt = 0.0, vh = 0.0;
+  bool starts_on = false;
 };
 
 // What a netlist says, subcircuits expanded.
@@ -102,6 +108,9 @@ struct Circuit {
   std::vector<int> state_element;  // the element of each circuit state
   std::vector<int> diode_element;  // the element of each complementarity pair
   std::vector<DiodeForm> diode_form;
+  std::vector<int> switch_element;  // the element of each switch (S), in netlist order
+  // Per configuration (mech::Model::configurations), which switches are on.
+  std::vector<std::vector<bool>> switch_on;
   MatrixXd energy;           // K: stored energy x'Kx / 2 (J) = diag(C, L)
   std::string initial_note;  // how the initial state was found
   // The diodes conducting in an LCS mode (the sorted indices of the pairs

@@ -39,6 +39,9 @@ std::vector<std::string> state_names(const mech::Model& model);
 struct CsvOutputs {
   int names = 0;
   Eigen::MatrixXd x, u;
+  // A switched circuit's outputs in each configuration (mech::Model::
+  // configurations), chosen by sim::Sample::configuration; empty otherwise.
+  std::vector<Eigen::MatrixXd> config_x, config_u;
 };
 
 class TrajectoryCsvWriter {

@@ -197,6 +197,29 @@ struct Model {
   //   exo_initial their states at t = 0); the exact method re-initialises
   //   them at each breakpoint (a scheduled event), as a mechanical model's.
   std::vector<Input> inputs;
+  // - switch configurations (a circuit's ideal switches; docs/circuits.md):
+  //   the LCS and outputs of each configuration a run visits (the state is
+  //   the same in every one), the times at which the one holding changes
+  //   (increasing, known up to switch_horizon, s), and the configuration on
+  //   each interval: switch_config[i] holds on [switch_times[i-1],
+  //   switch_times[i]) (one more entry than switch_times). `lcs`, output_x
+  //   and output_u are configuration switch_config[0]'s. The exact method
+  //   swaps the matrices at each time, a scheduled event named by
+  //   switch_notes[i] ("S1 on"). Empty: one configuration, as always.
+  struct Configuration {
+    lcs::Lcs lcs;
+    MatrixXd output_x, output_u;
+  };
+  std::vector<Configuration> configurations;
+  std::vector<double> switch_times;
+  std::vector<int> switch_config;
+  std::vector<std::string> switch_notes;
+  double switch_horizon = std::numeric_limits<double>::infinity();
+  bool is_switched() const { return !switch_times.empty(); }
+  // The index into switch_times of the first time > t (switch_times.size()
+  // when none): the configuration on the interval holding t is
+  // switch_config[interval_at(t)] (src/mech/mech.cpp).
+  std::size_t interval_at(double t) const;
   // The inputs whose breakpoints are scheduled events: mechanical->inputs
   // for a mechanical model, else `inputs`.
   const std::vector<Input>& scheduled_inputs() const;

@@ -58,6 +58,10 @@ struct Sample {
   VectorXd u;  // multipliers (regular part)
   VectorXd y;  // gaps / outputs
   IndexSet mode;
+  // The switch configuration holding (an index into mech::Model::
+  // configurations, whose outputs the CSV writes; a switched circuit's, set
+  // by the exact method); 0 for every other model.
+  int configuration = 0;
   // Tangential multipliers (mean friction force over the step, N), one per
   // entry of mechanical.friction in its order; empty for frictionless models.
   VectorXd u_t;

@@ -112,6 +112,7 @@ void EventDriven::record(Trajectory& tr, double t, const VectorXd& xa, const Pha
   s.u = multipliers(ph, xa);
   s.y = sys_.C * xa + sys_.D * s.u;
   s.mode = ph.mode;
+  s.configuration = config_;
   fill_friction(s, ph, xa);
   if (sens_) sens_->fill(t, s.dx, s.dx_exists);
   tr.record_sample(std::move(s), opt_);

@@ -504,6 +504,23 @@ class EventDriven {
   // t (+inf for a model without inputs), and the event there.
   double next_scheduled(double t) const;
   bool take_scheduled(RunState& r, PhaseMarch& pm, double t_b);
+  // A switched model (mech::Model::configurations): at a switch time t_b
+  // (the first after t0), the configuration after it replaces sys_ and the
+  // caches built on it; its note ("S1 on"), or "" when t_b is no switch time.
+  std::string swap_configuration(double t0, double t_b);
+  int config_ = 0;  // the configuration holding (index into model_.configurations)
+  // Per configuration, the caches built on its matrices while it does not
+  // hold (a switched circuit alternates between a few: each is built once).
+  struct ConfigCaches {
+    bool built = false;
+    lcs::LdcpData ldcp;
+    double rho_A = 0.0;
+    std::map<lcs::IndexSet, lcs::ModeFeedback> feedback;
+    std::map<std::pair<lcs::IndexSet, std::vector<FrictionMode>>, double> rho;
+    std::map<std::pair<lcs::IndexSet, std::vector<FrictionMode>>, StepExp> step;
+  };
+  std::vector<ConfigCaches> config_caches_;
+  void swap_caches(ConfigCaches& c);
   // Moving stops (mechanical.gap_inputs; schedule.cpp): the part of each gap
   // (G_w w) and of its rate (G_w S w) that the inputs give at xa, and the
   // velocity shift delta with E_J delta = that rate on the closed rows J, so

@@ -17,10 +17,49 @@ namespace lcsim::sim::detail {
 // A mechanical model's inputs, or an `lcs:` model's (a circuit's PULSE and
 // PWL sources, mech::Model::inputs): either way their exosystems are the last
 // states of the LCS, so one mechanism serves both.
+// A switched circuit's switch times (mech::Model::switch_times) are
+// scheduled events too.
 double EventDriven::next_scheduled(double t) const {
   const std::vector<mech::Input>& inputs = model_.scheduled_inputs();
-  if (inputs.empty()) return std::numeric_limits<double>::infinity();
-  return mech::next_breakpoint(inputs, t);
+  double next = std::numeric_limits<double>::infinity();
+  if (!inputs.empty()) next = mech::next_breakpoint(inputs, t);
+  const std::size_t i = model_.interval_at(t);
+  if (i < model_.switch_times.size()) next = std::min(next, model_.switch_times[i]);
+  return next;
+}
+
+// The state is the same in every configuration (a switch is a resistor of
+// RON or ROFF: no state jumps), so swapping the matrices is all; the mode is
+// selected again after (take_scheduled), on the new matrices.
+std::string EventDriven::swap_configuration(double t0, double t_b) {
+  const std::size_t i = model_.interval_at(t0);
+  if (i >= model_.switch_times.size() || model_.switch_times[i] != t_b) return "";
+  if (config_caches_.empty()) config_caches_.resize(model_.configurations.size());
+  ConfigCaches& before = config_caches_[static_cast<std::size_t>(config_)];
+  swap_caches(before);  // the old configuration's caches, kept
+  before.built = true;
+  config_ = model_.switch_config[i + 1];
+  sys_ = model_.configurations[static_cast<std::size_t>(config_)].lcs;
+  ConfigCaches& after = config_caches_[static_cast<std::size_t>(config_)];
+  if (after.built) {
+    swap_caches(after);
+    after.built = false;
+  } else {
+    feedback_cache_.clear();
+    rho_cache_.clear();
+    step_cache_.clear();
+    ldcp_data_ = lcs::ldcp_data(sys_);
+    rho_A_ = spectral_radius_bound(sys_.A);
+  }
+  return model_.switch_notes[i];
+}
+
+void EventDriven::swap_caches(ConfigCaches& c) {
+  std::swap(c.ldcp, ldcp_data_);  // ldcp_.data points at ldcp_data_, which stays
+  std::swap(c.rho_A, rho_A_);
+  std::swap(c.feedback, feedback_cache_);
+  std::swap(c.rho, rho_cache_);
+  std::swap(c.step, step_cache_);
 }
 
 // The event at the breakpoint t_b that ended the phase pm: the state there,
@@ -32,10 +71,11 @@ bool EventDriven::take_scheduled(RunState& r, PhaseMarch& pm, double t_b) {
   const std::vector<mech::Input>& inputs = model_.scheduled_inputs();
   const VectorXd x_minus = pm.state_at(t_b);
   const bool keep = static_cast<long>(tr.events.size()) < opt_.max_recorded_events;
-  if (keep) record(tr, t_b, x_minus, r.phase);
+  if (keep) record(tr, t_b, x_minus, r.phase);  // before a swap: the old configuration's
   std::string names;
   for (const mech::Input& in : inputs)
     if (in.next_breakpoint(pm.t0) == t_b) names += (names.empty() ? "'" : ", '") + in.name + "'";
+  const std::string switched = swap_configuration(pm.t0, t_b);
   r.t = t_b;
   // Sensitivities: a fixed time (dt_b/dtheta = 0), q and v continuous, w a
   // function of t alone (docs/sensitivities.md).
@@ -69,7 +109,8 @@ bool EventDriven::take_scheduled(RunState& r, PhaseMarch& pm, double t_b) {
   e.mode_after = ev.mode;
   e.impulse = ev.impulse;
   set_friction(e, ev);
-  e.note = "breakpoint of input " + names;
+  if (!names.empty()) e.note = "breakpoint of input " + names;
+  if (!switched.empty()) e.note += (names.empty() ? "switch: " : "; switch: ") + switched;
   if (sens_) sens_->fill_event(e);
   tr.events.push_back(std::move(e));
   record(tr, r.t, r.xa, r.phase);
