@@ -419,8 +419,9 @@ TEST(Friction3dImpact, PainleveIsJudgedOnTheSolvedModesWithManyContacts) {
       EXPECT_NEAR(Ns.determinant(), 1 - 1.44, 1e-12);
       EXPECT_TRUE(r.painleve) << at << ": " << r.message;
       EXPECT_FALSE(r.ok()) << at;
-      EXPECT_NE(r.message.find("Painlevé-type case at contacts 0 ('c1') (edge 0) 1 ('c2') (edge 0)"),
-                std::string::npos)
+      EXPECT_NE(
+          r.message.find("Painlevé-type case at contacts 0 ('c1') (edge 0) 1 ('c2') (edge 0)"),
+          std::string::npos)
           << r.message;
       // The three solutions of the frozen normal LCP w = Ns l + q >= 0, l >= 0.
       for (const Eigen::Vector2d& l : {Eigen::Vector2d(1, 0), Eigen::Vector2d(0, 1),
