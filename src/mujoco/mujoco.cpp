@@ -156,6 +156,12 @@ std::string bodies_refusal(const mech::MechanicalModel& m, const scene::Scene& s
   return "";
 }
 
+// Where a one-URDF scene has what MuJoCo's own URDF reader cannot take, the
+// same scene written as `bodies:` with one body can (mjcf_bodies.cpp).
+constexpr const char* kAsBodies =
+    " (write the scene as `bodies:` with this one body: lcsim then composes MuJoCo's model "
+    "itself, with explicit points, stops and frozen joints)";
+
 // What check_expressible refuses, or "" (the scene found).
 std::string refusal(const mech::Model& model, std::optional<scene::Scene>& sc) {
   sc = scene::scene_of(model);
@@ -174,11 +180,12 @@ std::string refusal(const mech::Model& model, std::optional<scene::Scene>& sc) {
   for (int i = 0; i < m.num_constraints(); ++i)
     if (!contact[static_cast<std::size_t>(i)])
       return where + "constraint '" + m.constraints[static_cast<std::size_t>(i)] +
-             "' is not a contact against a plane: MuJoCo runs contacts only";
+             "' is not a contact against a plane: MuJoCo runs contacts only" + kAsBodies;
   for (const auto& cf : sc->contacts)
     if (std::regex_search(cf.point.name, std::regex("\\.point[0-9]+$")))
       return where + "contact '" + cf.point.name +
-             "' has explicit points: MuJoCo collides the URDF's <collision> geometry only";
+             "' has explicit points: MuJoCo collides the URDF's <collision> geometry only" +
+             kAsBodies;
   if (!sc->base.floating && !sc->base.pose.isApprox(Eigen::Isometry3d::Identity(), 0.0))
     return where + "a fixed base at a pose: MuJoCo runs a fixed root at the identity only";
   std::vector<std::string> coords(m.coordinates.begin() + (sc->base.floating ? 6 : 0),
@@ -188,7 +195,7 @@ std::string refusal(const mech::Model& model, std::optional<scene::Scene>& sc) {
     if (j->mimic) return where + "joint '" + name + "' is a mimic: MuJoCo's URDF reader has none";
     if (std::find(coords.begin(), coords.end(), name) == coords.end())
       return where + "joint '" + name +
-             "' is frozen in the scene: MuJoCo would move it (simulate every movable joint)";
+             "' is frozen in the scene: MuJoCo's URDF reader would move it" + kAsBodies;
   }
   return "";
 }

@@ -279,5 +279,47 @@ TEST(MujocoBodies, RefusesAMimicJointInOneLine) {
   }
 }
 
+// A one-URDF scene with explicit contact points (the box of
+// robots/box_drop_scene.yaml on four points of its bottom face) is refused by
+// MuJoCo's URDF path in one line that names the way out: the same scene as
+// `bodies:` with one body runs, its points meeting the floor after the free
+// fall of 0.2 m, within 2 h of sqrt(2 0.2 / g) (the first force, above).
+TEST(MujocoBodies, OneUrdfSceneWithPointsRunsWrittenAsOneBody) {
+  const std::string points =
+      "points: [[0.05, 0.05, -0.05], [-0.05, -0.05, -0.05], [0.05, -0.05, -0.05], "
+      "[-0.05, 0.05, -0.05]], name: p}\n";
+  const std::string rest =
+      "planes: [{name: floor, point: [0, 0, 0], normal: [0, 0, 1]}]\n"
+      "initial: {q: {box.z: 0.25}}\nt_end: 0.5\n";
+  const std::string base = "base: {type: floating, pose: {xyz: [0, 0, 0.05]}}";
+  const std::string one = ::testing::TempDir() + "/box_points.yaml";
+  std::ofstream(one) << "urdf: " << kRobots << "box.urdf\n"
+                     << base << "\n"
+                     << rest << "contacts:\n  - {link: box, plane: floor, " << points;
+  try {
+    check_expressible(scene::load_model(one));
+    FAIL() << "explicit points on a one-URDF scene";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("contact 'p.point0' has explicit points"), std::string::npos) << what;
+    EXPECT_NE(what.find("write the scene as `bodies:` with this one body"), std::string::npos)
+        << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+  const std::string bodies = ::testing::TempDir() + "/box_points_bodies.yaml";
+  std::ofstream(bodies) << "bodies:\n  - {name: box, urdf: " << kRobots << "box.urdf, " << base
+                        << "}\n"
+                        << rest << "contacts:\n  - {link: box/box, plane: floor, " << points;
+  const mech::Model m = scene::load_model(bodies);
+  const double h = 1e-3;
+  const sim::Trajectory tr = simulate_mujoco(m, m.initial, options(m, h));
+  ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
+  const double t_star = std::sqrt(2.0 * 0.2 / kG);
+  for (int row = 0; row < 4; ++row) {
+    EXPECT_GT(first_contact(tr, row), t_star) << row;
+    EXPECT_LE(first_contact(tr, row), t_star + 2 * h) << row;
+  }
+}
+
 }  // namespace
 }  // namespace lcsim::mujoco
