@@ -181,6 +181,35 @@ std::string refuse_friction_law(const mech::Model& model, const Options& opt,
          "' has mechanical.friction); use impact law " + with;
 }
 
+// A switched model's schedule as mech::Model states it, or what is wrong
+// (a caller may build one by hand): one configuration index per interval,
+// each in range and of the model's dimensions, times increasing, one note
+// per time.
+std::string switched_structure(const mech::Model& model) {
+  const std::size_t n = model.switch_times.size();
+  const auto where = [&] { return text("model '", model.name, "': "); };
+  if (model.switch_config.size() != n + 1 || model.switch_notes.size() != n)
+    return text(where(), "switch_config has ", model.switch_config.size(),
+                " entries and switch_notes ", model.switch_notes.size(), " for ", n,
+                " switch_times (one more, and as many, are needed)");
+  if (!model.lcs) return text(where(), "switch_times on a model without an LCS (`lcs:`)");
+  const lcs::Lcs& base = *model.lcs;
+  for (std::size_t i = 0; i <= n; ++i) {
+    const int c = model.switch_config[i];
+    if (c < 0 || static_cast<std::size_t>(c) >= model.configurations.size())
+      return text(where(), "switch_config[", i, "] = ", c, " is not one of the ",
+                  model.configurations.size(), " configurations");
+    const lcs::Lcs& l = model.configurations[static_cast<std::size_t>(c)].lcs;
+    if (l.A.rows() != base.A.rows() || l.B.cols() != base.B.cols())
+      return text(where(), "configuration ", c, " has ", l.A.rows(), " states and ", l.B.cols(),
+                  " pairs, the model ", base.A.rows(), " and ", base.B.cols());
+    if (i > 0 && i < n && !(model.switch_times[i] > model.switch_times[i - 1]))
+      return text(where(), "switch_times[", i, "] = ", model.switch_times[i],
+                  " does not follow switch_times[", i - 1, "] = ", model.switch_times[i - 1]);
+  }
+  return "";
+}
+
 }  // namespace
 
 // A model with inputs (docs/inputs.md) needs a method that evaluates them;
@@ -192,6 +221,7 @@ std::string refuse_inputs(const mech::Model& model, const Options& opt, std::str
   // its matrices at the switch times, known up to switch_horizon; the
   // time-stepping methods and the sensitivities do not follow the swaps.
   if (model.is_switched()) {
+    if (std::string why = switched_structure(model); !why.empty()) return why;
     if (!used.event_search)
       return text("method '", method, "' does not simulate switched circuits (model '", model.name,
                   "' has ideal switches); method 'event' does");

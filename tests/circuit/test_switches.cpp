@@ -244,6 +244,26 @@ TEST(Switch, RunsThatCannotFollowTheSwapsAreRefused) {
             "tstop = 0.005 s");
 }
 
+// A switched model built or altered by hand (mech::Model's switch fields)
+// whose schedule is inconsistent is refused in one line before any run,
+// never read out of range.
+TEST(Switch, AnInconsistentScheduleIsRefusedNotRead) {
+  const Circuit c = circuit::parse_circuit(kRcSwitch, "rc.cir");
+  sim::Options opt;
+  opt.t_end = 1e-3;
+  mech::Model bad = c.model;
+  bad.switch_config.back() = 7;
+  sim::Trajectory tr = sim::simulate(bad, opt);
+  EXPECT_EQ(tr.status, Status::kInvalidInput);
+  EXPECT_NE(tr.message.find("model 'rc': switch_config["), std::string::npos) << tr.message;
+  EXPECT_NE(tr.message.find("] = 7 is not one of the"), std::string::npos) << tr.message;
+  bad = c.model;
+  bad.switch_notes.clear();
+  tr = sim::simulate(bad, opt);
+  EXPECT_EQ(tr.status, Status::kInvalidInput);
+  EXPECT_NE(tr.message.find("switch_notes 0 for"), std::string::npos) << tr.message;
+}
+
 }  // namespace
 }  // namespace lcsim
 
