@@ -309,15 +309,17 @@ void drop_dependent_multipliers(const Ldcp& s, const Level& l, VectorXd& up) {
     if (svd.singularValues()(m - 1) > rank_tolerance(G)) return;
     VectorXd z = svd.matrixV().col(m - 1).cwiseQuotient(scale);
     const auto pz = z.tail(m - static_cast<Eigen::Index>(first_p));
-    if (pz.size() == 0 || pz.cwiseAbs().maxCoeff() <= 1e-12 * z.cwiseAbs().maxCoeff()) return;
-    if (pz.maxCoeff() <= 0.0) z = -z;
+    const double tiny = 1e-12 * z.cwiseAbs().maxCoeff();
+    if (pz.size() == 0 || pz.cwiseAbs().maxCoeff() <= tiny) return;
+    if (pz.maxCoeff() <= tiny) z = -z;  // then some entry of P is above tiny
     double t = -1.0;
     Eigen::Index zeroed = -1;
     for (Eigen::Index c = static_cast<Eigen::Index>(first_p); c < m; ++c) {
-      if (z(c) <= 1e-12 * z.cwiseAbs().maxCoeff()) continue;
+      if (z(c) <= tiny) continue;
       const double ratio = up(cols[static_cast<size_t>(c)]) / z(c);
       if (zeroed < 0 || ratio < t) t = ratio, zeroed = c;
     }
+    if (zeroed < 0) return;  // not reached (above); never index with -1
     for (Eigen::Index c = 0; c < m; ++c) {
       double& u = up(cols[static_cast<size_t>(c)]);
       u -= t * z(c);
