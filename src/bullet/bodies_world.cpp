@@ -461,13 +461,9 @@ sim::Trajectory simulate_bodies(const mech::Model& model, const scene::Scene& se
   };
   const int N = m.dofs(), k = m.num_constraints();
   warn_explicit_damping(tr, m, opt.h, "joint torques");
-  VectorXd q_ref = VectorXd::Zero(N);
-  for (int j = 0; j < N; ++j)
-    if (const auto it = setup.q0.find(m.coordinates[static_cast<std::size_t>(j)]);
-        it != setup.q0.end())
-      q_ref(j) = it->second;
-  const MatrixXd K_s = MatrixXd(m.K) - setup.lin.K_g, D = MatrixXd(m.D);
-  const VectorXd f_s = m.f - setup.lin.tau_g - setup.lin.K_g * q_ref;
+  const SceneForces forces = scene_forces(setup, m);
+  const MatrixXd &K_s = forces.K_s, &D = forces.D;
+  const VectorXd& f_s = forces.f_s;
   VectorXd q = x0.head(N), v = x0.tail(N);
   const scene::Bodies bodies = scene::scene_bodies(setup);
   std::unique_ptr<BodiesWorld> w;

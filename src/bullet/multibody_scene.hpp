@@ -38,6 +38,15 @@ std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m, const st
 std::string multibody_description(const WorldSettings& s, bool contacts = false,
                                   bool friction = false);
 
+// The scene's own forces, tau = f_s - K_s q - D v: K and f without the
+// linearised gravity (Bullet's world has the nonlinear one), for the
+// one-URDF multibody and the scene of bodies (multibody_world.cpp).
+struct SceneForces {
+  Eigen::MatrixXd K_s, D;
+  Eigen::VectorXd f_s;
+};
+SceneForces scene_forces(const scene::Scene& setup, const mech::MechanicalModel& m);
+
 // The scene run as a btMultiBody (multibody_world.cpp); `limits` from
 // joint_limits_of. Never throws.
 sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene& setup,

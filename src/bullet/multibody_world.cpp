@@ -298,28 +298,6 @@ void warn(sim::Trajectory& tr, const mech::MechanicalModel& m, const MatrixXd& K
     }
 }
 
-// The scene's own forces, tau = f_s - K_s q - D v: K and f without the
-// linearised gravity (Bullet's world has the nonlinear one).
-struct SceneForces {
-  MatrixXd K_s, D;
-  VectorXd f_s;
-};
-
-SceneForces scene_forces(const scene::Scene& setup, const mech::MechanicalModel& m) {
-  const int N = m.dofs();
-  const scene::UrdfLinearisation& lin = setup.lin;
-  VectorXd q_ref = VectorXd::Zero(N);
-  for (int j = 0; j < N; ++j)
-    if (const auto it = setup.q0.find(m.coordinates[static_cast<std::size_t>(j)]);
-        it != setup.q0.end())
-      q_ref(j) = it->second;
-  SceneForces out;
-  out.K_s = MatrixXd(m.K) - lin.K_g;
-  out.f_s = m.f - lin.tau_g - lin.K_g * q_ref;
-  out.D = MatrixXd(m.D);
-  return out;
-}
-
 // One Bullet step of length h under the generalised forces tau (joint
 // torques; a floating base's six as its force and torque) from the state q;
 // the state it reached.
@@ -444,6 +422,21 @@ std::string multibody_description(const WorldSettings& s, bool contacts, bool fr
                                  " iterations)") +
          ", btMultiBodyJointLimitConstraint limits (ERP " + short_number(s.limit_erp) +
          ", max impulse " + short_number(s.limit_max_impulse) + ")" + planes;
+}
+
+SceneForces scene_forces(const scene::Scene& setup, const mech::MechanicalModel& m) {
+  const int N = m.dofs();
+  const scene::UrdfLinearisation& lin = setup.lin;
+  VectorXd q_ref = VectorXd::Zero(N);
+  for (int j = 0; j < N; ++j)
+    if (const auto it = setup.q0.find(m.coordinates[static_cast<std::size_t>(j)]);
+        it != setup.q0.end())
+      q_ref(j) = it->second;
+  SceneForces out;
+  out.K_s = MatrixXd(m.K) - lin.K_g;
+  out.f_s = m.f - lin.tau_g - lin.K_g * q_ref;
+  out.D = MatrixXd(m.D);
+  return out;
 }
 
 sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene& setup,
