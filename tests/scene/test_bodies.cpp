@@ -220,6 +220,31 @@ contacts:
   - {link: arm/base, against: pill/pill, points: [[1.0, 0.6, 0.3], [1.4, 0.2, 0.1], [0.9, 0.1, -0.2], [1.5, 0.9, 0.8]], radius: 0.01, name: pt}
 )";
 
+// Points ys given in the frame of the first pair contact's shape of `kind`
+// on body `body`, at q0, as points of the arm's base in the scene's text
+// ("[x, y, z], ..." to 17 digits): places them, through the poses, in a
+// chosen region of that shape.
+std::string base_points(const scene::Scene& s, const std::string& kind, std::size_t body,
+                        const std::vector<Vector3d>& ys) {
+  const scene::Bodies dyn = scene::scene_bodies(s);
+  const VectorXd q0 = dyn.reference();
+  const auto c = std::find_if(s.contacts.begin(), s.contacts.end(), [&](const auto& f) {
+    return f.against && f.against->kind == kind && f.against->body == body;
+  });
+  EXPECT_NE(c, s.contacts.end()) << kind;
+  if (c == s.contacts.end()) return "";
+  const Eigen::Isometry3d X =
+      dyn.link_pose(c->against->body, c->against->link, q0) * c->against->local;
+  const Eigen::Isometry3d base = dyn.link_pose(0, "base", q0);
+  std::ostringstream o;
+  o << std::setprecision(17);
+  for (std::size_t i = 0; i < ys.size(); ++i) {
+    const Vector3d b = base.inverse() * (X * ys[i]);
+    o << (i ? ", " : "") << "[" << b.x() << ", " << b.y() << ", " << b.z() << "]";
+  }
+  return o.str();
+}
+
 // kRound with one more contact: two points on the arm's base, computed from
 // the poses at q0, 0.2 m beyond the cylinder's +z end on its axis and beyond
 // its rim (0.1 m out radially, 0.1 m past the -z end), so that q0 itself
@@ -229,23 +254,9 @@ class RoundScenes : public BodyScenes {
   scene::Scene load_round() {
     write("pill.urdf", kPill);
     const scene::Scene first = load(kRound);
-    const scene::Bodies dyn = scene::scene_bodies(first);
-    const VectorXd q0 = dyn.reference();
-    const auto cyl = std::find_if(first.contacts.begin(), first.contacts.end(), [](const auto& c) {
-      return c.against && c.against->kind == "cylinder";
-    });
-    EXPECT_NE(cyl, first.contacts.end());
-    const Eigen::Isometry3d X =
-        dyn.link_pose(cyl->against->body, cyl->against->link, q0) * cyl->against->local;
-    const Eigen::Isometry3d base = dyn.link_pose(0, "base", q0);
-    const auto at = [&](const Vector3d& y) {
-      const Vector3d b = base.inverse() * (X * y);
-      std::ostringstream o;
-      o << std::setprecision(17) << "[" << b.x() << ", " << b.y() << ", " << b.z() << "]";
-      return o.str();
-    };
     return load(kRound + "  - {link: arm/base, against: pill/pill, points: [" +
-                at(Vector3d(0, 0, 0.35)) + ", " + at(Vector3d(0.25, 0, -0.25)) + "], name: far}\n");
+                base_points(first, "cylinder", 1, {{0, 0, 0.35}, {0.25, 0, -0.25}}) +
+                "], name: far}\n");
   }
 };
 
@@ -361,24 +372,10 @@ class BoxScenes : public BodyScenes {
  protected:
   scene::Scene load_box_regions() {
     const scene::Scene first = load(kTwoBodies);
-    const scene::Bodies dyn = scene::scene_bodies(first);
-    const VectorXd q0 = dyn.reference();
-    const auto box = std::find_if(first.contacts.begin(), first.contacts.end(), [](const auto& c) {
-      return c.against && c.against->kind == "box" && c.against->body == 1;
-    });
-    EXPECT_NE(box, first.contacts.end());
-    const Eigen::Isometry3d X =
-        dyn.link_pose(box->against->body, box->against->link, q0) * box->against->local;
-    const Eigen::Isometry3d base = dyn.link_pose(0, "base", q0);
-    const auto at = [&](const Vector3d& y) {
-      const Vector3d b = base.inverse() * (X * y);
-      std::ostringstream o;
-      o << std::setprecision(17) << "[" << b.x() << ", " << b.y() << ", " << b.z() << "]";
-      return o.str();
-    };
-    return load(kTwoBodies + "  - {link: arm/base, against: blk/block, points: [" +
-                at(Vector3d(0.45, 0.02, -0.03)) + ", " + at(Vector3d(0.4, -0.35, 0.01)) + ", " +
-                at(Vector3d(-0.4, 0.35, 0.3)) + "], name: far}\n");
+    return load(
+        kTwoBodies + "  - {link: arm/base, against: blk/block, points: [" +
+        base_points(first, "box", 1, {{0.45, 0.02, -0.03}, {0.4, -0.35, 0.01}, {-0.4, 0.35, 0.3}}) +
+        "], name: far}\n");
   }
 };
 
