@@ -213,8 +213,7 @@ std::string switched_structure(const mech::Model& model) {
 }  // namespace
 
 // A model with inputs (docs/inputs.md) needs a method that evaluates them;
-// a moving stop (gap_inputs) is the exact method's only, and so are
-// sensitivities with inputs.
+// a moving stop (gap_inputs) is the exact method's only.
 std::string refuse_inputs(const mech::Model& model, const Options& opt, std::string_view method,
                           const OptionsUsed& used) {
   // A switched circuit (mech::Model::configurations): the exact method swaps
@@ -256,11 +255,9 @@ std::string refuse_inputs(const mech::Model& model, const Options& opt, std::str
   if (!m.gap_inputs.empty() && m.has_friction())
     return text("model '", model.name,
                 "': mechanical.gap_inputs (a moving stop) with friction is not simulated yet");
-  // Sensitivities through scheduled events: the exact method's
-  // (docs/sensitivities.md); the schemes' step maps with inputs are not done.
-  if (!opt.sensitivity.empty() && !used.event_search)
-    return text("model '", model.name, "' has inputs: method '", method,
-                "' does not compute sensitivities with inputs (method 'event' does)");
+  // Sensitivities: the schemes' step maps take force inputs as the step's
+  // known forcing (step_sensitivity.cpp); the exact method's go through the
+  // scheduled events (docs/sensitivities.md).
   return "";
 }
 

@@ -381,14 +381,19 @@ TEST(SensitivityEvents, FrictionRefusals) {
   EXPECT_EQ(tr.status, Status::kInvalidInput);
 }
 
-// Methods other than the exact one refuse sensitivities with inputs.
-TEST(SensitivityEvents, SchemesRefuseInputs) {
-  const mech::Model m = load("robots/pwl_lift.yaml");
+// The schemes take force inputs (their derivative is tested in
+// test_sensitivity_stepping.cpp) and refuse a moving stop, which only the
+// exact method simulates, with or without sensitivities.
+TEST(SensitivityEvents, SchemesTakeForceInputsAndRefuseMovingStops) {
+  const mech::Model lift = load("robots/pwl_lift.yaml"), shaker = load("robots/shaker_table.yaml");
   sim::Options opt;
   opt.t_end = 0.1;
   opt.sensitivity = {"x0"};
   for (const char* method : {"euler", "moreau-jean"}) {
-    const sim::Trajectory tr = sim::simulate(m, m.initial, opt, method);
+    const sim::Trajectory ok = sim::simulate(lift, lift.initial, opt, method);
+    EXPECT_TRUE(ok.ok()) << method << ": " << ok.message;
+    EXPECT_EQ(ok.sensitivity_columns.size(), 2u) << method;
+    const sim::Trajectory tr = sim::simulate(shaker, shaker.initial, opt, method);
     EXPECT_EQ(tr.status, Status::kInvalidInput) << method;
     EXPECT_NE(tr.message.find("method 'event'"), std::string::npos) << tr.message;
   }

@@ -153,8 +153,13 @@ SensColumns parse_sensitivity(const mech::Model& model, const std::vector<std::s
 namespace {
 
 // What a time-stepping scheme's step map cannot differentiate: "" or why.
+// The schemes know the kinds f, K, D, M, g, e and a (step_sensitivity.cpp);
+// any other kind is refused by name, never taken as a zero column.
 std::string refuse_for_scheme(const detail::SensColumns& c, std::string_view method) {
   for (const detail::SensParam& p : c.params) {
+    if (std::string_view("fKDMgea").find(p.kind) == std::string_view::npos)
+      return "Options::sensitivity '" + p.name + "': method '" + std::string(method) +
+             "' does not compute it (the method 'event' does)";
     if (method == "moreau-jean" && p.kind == 'g')
       return "Options::sensitivity '" + p.name +
              "': method 'moreau-jean' does not compute it (its step map depends on the gap "
@@ -216,7 +221,7 @@ std::string check_sensitivity(const mech::Model& model, const Options& opt, std:
   if (!model.is_mechanical() && !c.params.empty() && !used.event_search)
     return "Options::sensitivity '" + c.params.front().name + "': method '" + std::string(method) +
            "' does not compute a general LCS's parameters (the method 'event' does)";
-  return refuse_for_scheme(c, method);
+  return used.event_search ? "" : refuse_for_scheme(c, method);
 }
 
 }  // namespace lcsim::sim

@@ -63,6 +63,17 @@ bool StepSensitivity::any_exists() const {
   return false;
 }
 
+VectorXd StepSensitivity::amplitude_force(int input, double t) const {
+  const mech::MechanicalModel& m = *model_.mechanical;
+  mech::Input unit = m.inputs[static_cast<size_t>(input)];
+  unit.offset = 0.0;
+  unit.amplitude = 1.0;
+  VectorXd out = VectorXd::Zero(m.dofs());
+  for (const mech::InputUse& use : m.force_inputs)
+    if (use.input == input) out += use.gain * unit.value(t);
+  return out;
+}
+
 void StepSensitivity::lose_all(double t, int row, const std::string& reason) {
   if (!any_exists()) return;
   SensitivityLoss l;
@@ -117,7 +128,7 @@ const Eigen::LLT<MatrixXd>& MjStepSensitivity::factor(double h) {
   return llt_[s];
 }
 
-void MjStepSensitivity::parameter_terms(double h, const VectorXd& q, const VectorXd& v,
+void MjStepSensitivity::parameter_terms(double t0, double h, const VectorXd& q, const VectorXd& v,
                                         const VectorXd& v_next, MatrixXd& R) const {
   const VectorXd qt = q + h * theta_ * v, dv = v_next - v;
   const double ht = h * theta_;
@@ -137,6 +148,10 @@ void MjStepSensitivity::parameter_terms(double h, const VectorXd& q, const Vecto
       case 'M':
         col -= unit_mass(N_, sp.i, sp.j) * dv;
         break;
+      case 'a':  // ops_.set_step's force, theta f(t0 + h) + (1 - theta) f(t0)
+        col += h * (theta_ * amplitude_force(sp.i, t0 + h) +
+                    (1.0 - theta_) * amplitude_force(sp.i, t0));
+        break;
       default:
         break;  // 'e' enters the active rows' equation
     }
@@ -152,7 +167,7 @@ void MjStepSensitivity::step(double t0, double h, const VectorXd& q, const Vecto
   // W dv+ = W dv + h drhs - dW (v+ - v) + E_S' dz_S.
   MatrixXd R = M_ * dV - h * (D_ * dV + K_ * (dQ + h * theta_ * dV)) + h * theta_ * D_ * dV +
                h * h * theta_ * theta_ * K_ * dV;
-  parameter_terms(h, q, v, v_next, R);
+  parameter_terms(t0, h, q, v, v_next, R);
   MatrixXd dVn = W.solve(R);
   if (!A.empty()) {
     const int na = static_cast<int>(A.size());
@@ -209,6 +224,8 @@ EulerStepSensitivity::EulerStepSensitivity(const mech::Model& model, const SensC
   const mech::MechanicalModel& m = *model.mechanical;
   const int N = m.dofs();
   const MatrixXd G = dense(m.M).inverse();
+  G_ = G;
+  dG_.assign(P, MatrixXd());
   for (size_t p = 0; p < P; ++p) {
     const SensParam& sp = cols_.params[p];
     MatrixXd dA = MatrixXd::Zero(n_, n_), dB = MatrixXd::Zero(n_, nu_),
@@ -228,6 +245,7 @@ EulerStepSensitivity::EulerStepSensitivity(const mech::Model& model, const SensC
         break;
       case 'M': {
         const MatrixXd dG = -G * unit_mass(N, sp.i, sp.j) * G;
+        dG_[p] = dG;
         dA.block(N, 0, N, N) = -dG * dense(m.K);
         dA.block(N, N, N, N) = -dG * dense(m.D);
         dA.block(N, 2 * N, N, 1) = dG * m.f;
@@ -243,15 +261,32 @@ EulerStepSensitivity::EulerStepSensitivity(const mech::Model& model, const SensC
   }
 }
 
+void EulerStepSensitivity::input_terms(double t1, double h, MatrixXd& R) const {
+  const mech::MechanicalModel& m = *model_.mechanical;
+  const int N = m.dofs();
+  VectorXd drive;  // f(t1) - f, formed once for the M columns
+  for (size_t p = 0; p < cols_.params.size(); ++p) {
+    const SensParam& sp = cols_.params[p];
+    auto col = R.col(nx0_ + static_cast<int>(p)).segment(N, N);
+    if (sp.kind == 'M') {
+      if (drive.size() == 0) drive = mech::force_at(m, t1) - m.f;
+      col += h * (dG_[p] * drive);
+    } else if (sp.kind == 'a') {
+      col += h * (G_ * amplitude_force(sp.i, t1));
+    }
+  }
+}
+
 void EulerStepSensitivity::step(double t0, double h, const MatrixXd& Phi, const MatrixXd& PhiB,
                                 const MatrixXd& G, const VectorXd& x_next, const VectorXd& u) {
   if (!any_exists()) return;
-  // (I - hA) dx+ = dx + h dA x+ + h dB u + h B du.
+  // (I - hA) dx+ = dx + h dA x+ + h dB u + h B du (+ h dd, the inputs' drive).
   MatrixXd R = Sa_;
   for (size_t p = 0; p < dA_.size(); ++p) {
     if (dA_[p].size() == 0) continue;
     R.col(nx0_ + static_cast<int>(p)) += h * (dA_[p] * x_next + dB_[p] * u);
   }
+  if (model_.is_mechanical() && model_.mechanical->has_inputs()) input_terms(t0 + h, h, R);
   Sa_ = Phi * R;
   if (nu_ > 0) {
     const VectorXd w = sys_.C * x_next + sys_.D * u;

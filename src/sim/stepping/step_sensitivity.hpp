@@ -38,6 +38,9 @@ class StepSensitivity {
   // Every column absent from t on (once), naming constraint `row`.
   void lose_all(double t, int row, const std::string& reason);
   bool any_exists() const;
+  // d f(t)/d amplitude of input `input` (the parameter kind 'a'): its force
+  // gains times the sine's unit waveform at t (docs/inputs.md).
+  VectorXd amplitude_force(int input, double t) const;
 
   const mech::Model& model_;
   SensColumns cols_;
@@ -63,8 +66,10 @@ class MjStepSensitivity : public StepSensitivity {
   const Eigen::LLT<MatrixXd>& factor(double h);
   // The parameters' part of W dv+ (before the impulses): h (df - dD v -
   // dK (q + h theta v)) - dW (v+ - v) for each parameter column.
-  void parameter_terms(double h, const VectorXd& q, const VectorXd& v, const VectorXd& v_next,
-                       MatrixXd& R) const;
+  // With inputs, the step's force theta f(t0 + h) + (1 - theta) f(t0) adds
+  // its amplitudes' columns.
+  void parameter_terms(double t0, double h, const VectorXd& q, const VectorXd& v,
+                       const VectorXd& v_next, MatrixXd& R) const;
 
   double theta_;
   int N_ = 0;
@@ -87,9 +92,15 @@ class EulerStepSensitivity : public StepSensitivity {
             const VectorXd& x_next, const VectorXd& u);
 
  private:
+  // A model with inputs: the step's drive h (0, M^{-1} (f(t1) - f), 0)
+  // (euler.cpp) moves the M and amplitude columns too.
+  void input_terms(double t1, double h, MatrixXd& R) const;
+
   const lcs::Lcs& sys_;
   int n_ = 0, nu_ = 0;
-  MatrixXd Sa_;  // S on the augmented state (its last row zero)
+  MatrixXd G_;                // M^{-1} (mechanical models)
+  std::vector<MatrixXd> dG_;  // dM^{-1} of each M column (else empty)
+  MatrixXd Sa_;               // S on the augmented state (its last row zero)
   // dA, dB, dC of each parameter column (mechanical models).
   std::vector<MatrixXd> dA_, dB_, dC_;
 };
