@@ -81,15 +81,24 @@ std::vector<sim::IndexSet> modes(const sim::Trajectory& tr) {
   return out;
 }
 
+// Stick or slip at every sample (empty without friction): with the modes,
+// the smooth piece of the step map a run is on.
+std::vector<std::vector<sim::FrictionMode>> friction_modes(const sim::Trajectory& tr) {
+  std::vector<std::vector<sim::FrictionMode>> out;
+  for (const auto& s : tr.samples) out.push_back(s.friction_mode);
+  return out;
+}
+
 // The scheme's derivative against its own central differences.
 void expect_matches_own_fd(const std::string& method, const mech::Model& m, const VectorXd& x0,
-                           double T, double h, const std::vector<Perturbation>& ps) {
+                           double T, double h, const std::vector<Perturbation>& ps,
+                           double theta = 0.5) {
   std::vector<std::string> names;
   for (const auto& p : ps) names.push_back(p.column.rfind("x0[", 0) == 0 ? "" : p.column);
   std::erase(names, "");
   const bool x0_cols = names.size() < ps.size();
   if (x0_cols) names.insert(names.begin(), "x0");
-  const sim::Trajectory tr = run(method, m, x0, T, h, names);
+  const sim::Trajectory tr = run(method, m, x0, T, h, names, theta);
   ASSERT_TRUE(tr.ok()) << tr.message;
   ASSERT_TRUE(tr.sensitivity_losses.empty()) << tr.sensitivity_losses.front().reason;
   const double xs = std::max(1.0, tr.final_state.cwiseAbs().maxCoeff());
@@ -104,9 +113,10 @@ void expect_matches_own_fd(const std::string& method, const mech::Model& m, cons
         mech::Model mm = m;
         VectorXd xx = x0;
         p.apply(mm, xx, s == 0 ? d : -d);
-        const sim::Trajectory t2 = run(method, mm, xx, T, h);
+        const sim::Trajectory t2 = run(method, mm, xx, T, h, {}, theta);
         EXPECT_TRUE(t2.ok()) << t2.message;
         EXPECT_EQ(modes(t2), modes(tr)) << p.column << ": the active sets differ";
+        EXPECT_EQ(friction_modes(t2), friction_modes(tr)) << p.column << ": stick / slip differ";
         out[s] = t2.final_state;
       }
       return VectorXd((out[0] - out[1]) / (2 * d));
@@ -371,6 +381,89 @@ TEST(StepSensitivity, WithAForceInputMatchesItsOwnDifferences) {
 // too).
 TEST(StepSensitivity, WithAForceInputConvergesToTheExactDerivative) {
   expect_converges(pushed(5.0), 4.0, {"x0", "amplitude[push]", "M[0][0]", "f[0]"});
+}
+
+}  // namespace
+}  // namespace lcsim
+
+namespace lcsim {
+namespace {
+
+// Moreau–Jean through planar stick / slip (docs/sensitivities.md): the
+// step map at each step's outcome (sliding: lambda_T = -sigma mu lambda_N;
+// stuck: the sliding velocity held at zero).
+//
+// A unit block sliding on the floor (robots/block_on_floor_friction.yaml,
+// mu = 0.4, v0 = 2 m/s) to T = 0.4 s < t* = 0.5097 s: it slides at a =
+// (f0 + mu f1) / M00 throughout, and theta = 1/2 integrates a constant
+// acceleration exactly (v+ = v + h a, q+ = q + h (v + v+) / 2, the normal
+// impulse -h f1 per step), so the step map's derivative is the closed
+// form's: dx/dv0 = T, dx/df0 = T^2 / (2 M00), dx/df1 = mu T^2 / (2 M00),
+// dv/df1 = mu T / M00, dx/dM00 = -a T^2 / (2 M00), to rounding (40 steps:
+// 1e-13 absolute, a hundred times the measured 1e-15).
+TEST(StepSensitivity, MoreauJeanSlidingBlockIsTheClosedForm) {
+  const mech::Model m = load("block_on_floor_friction.yaml");
+  const double T = 0.4, mu = 0.4, g = 9.81, a = -mu * g;
+  const sim::Trajectory tr =
+      run("moreau-jean", m, m.initial, T, 1e-2, {"x0", "f[0]", "f[1]", "M[0][0]"}, 0.5);
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  ASSERT_TRUE(tr.sensitivity_losses.empty()) << tr.sensitivity_losses.front().reason;
+  EXPECT_NEAR(tr.final_state(0), 2.0 * T + a * T * T / 2, 1e-13);
+  const MatrixXd& dx = tr.dx_final;  // rows x, y, vx, vy; columns x0 (4), f0, f1, M00
+  EXPECT_NEAR(dx(0, 0), 1.0, 1e-13);
+  EXPECT_NEAR(dx(0, 2), T, 1e-13);
+  EXPECT_NEAR(dx(2, 2), 1.0, 1e-13);
+  EXPECT_NEAR(dx(0, 4), T * T / 2, 1e-13);
+  EXPECT_NEAR(dx(0, 5), mu * T * T / 2, 1e-13);
+  EXPECT_NEAR(dx(2, 5), mu * T, 1e-13);
+  EXPECT_NEAR(dx(0, 6), -a * T * T / 2, 1e-13);
+  EXPECT_NEAR(dx(2, 6), -a * T, 1e-13);
+  EXPECT_NEAR(dx(1, 5), 0.0, 1e-13);  // the block stays on the floor
+}
+
+// The incline (robots/incline_friction.yaml): sliding down, then stuck
+// from about t* = 0.839 s to T = 2 (the stick's tangential impulse an
+// unknown of the step map): against Moreau–Jean's own central differences
+// with the same active sets and stick / slip at every step. The block lands
+// from 1 mm above the plane at 0.07 m/s (a plastic impact within the first
+// steps, after which Moreau–Jean holds that step's penetration, so the
+// contact stays active in every run: from a zero gap the activation of a
+// row whose predicted gap is zero to rounding is decided by the rounding,
+// see held_carts; so is the first step's at 0.1 m/s with theta = 1, whose
+// predicted gap 1e-3 - h 0.1 is zero).
+TEST(StepSensitivity, MoreauJeanThroughStickAndSlipMatchesItsOwnDifferences) {
+  const mech::Model m = load("incline_friction.yaml");
+  const Eigen::Vector4d x0(0.0, 1e-3, -1.5, -0.07);
+  const sim::Trajectory plain = run("moreau-jean", m, x0, 2.0, 1e-2);
+  ASSERT_TRUE(plain.ok()) << plain.message;
+  EXPECT_EQ(plain.samples[10].friction_mode[0], sim::FrictionMode::kSlipNegative);  // t = 0.1 s
+  EXPECT_EQ(plain.samples.back().friction_mode[0], sim::FrictionMode::kStick);
+  for (const double theta : {0.5, 1.0}) {
+    SCOPED_TRACE(theta);
+    expect_matches_own_fd("moreau-jean", m, x0, 2.0, 1e-2,
+                          {state(0, 1e-6), state(1, 1e-7), state(2, 1e-6), state(3, 1e-6),
+                           entry("f[0]", 'f', 0, 0, 1e-4), entry("f[1]", 'f', 1, 0, 1e-4),
+                           entry("M[0][0]", 'M', 0, 0, 1e-4)},
+                          theta);
+  }
+}
+
+// Pushed from rest exactly at the friction limit (f0 = mu |f1|): the first
+// step sticks with |lambda_T| = mu lambda_N, where stick and slip meet, so
+// the step map has no derivative: the run reports it (time 0, the floor)
+// and returns no number.
+TEST(StepSensitivity, MoreauJeanAtTheConesEdgeReportsNoDerivative) {
+  mech::Model m = load("block_on_floor_friction.yaml");
+  m.mechanical->f(0) = 0.4 * 9.81;
+  const sim::Trajectory tr =
+      run("moreau-jean", m, Eigen::Vector4d::Zero(), 0.1, 1e-2, {"x0", "f[0]"}, 0.5);
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  ASSERT_EQ(tr.sensitivity_losses.size(), 1u);
+  EXPECT_EQ(tr.sensitivity_losses.front().t, 0.0);
+  EXPECT_EQ(tr.sensitivity_losses.front().contact, "floor");
+  EXPECT_NE(tr.sensitivity_losses.front().reason.find("cone's edge"), std::string::npos)
+      << tr.sensitivity_losses.front().reason;
+  for (char e : tr.dx_final_exists) EXPECT_FALSE(e);
 }
 
 }  // namespace

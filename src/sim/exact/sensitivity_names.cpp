@@ -173,21 +173,25 @@ std::string refuse_for_scheme(const detail::SensColumns& c, std::string_view met
   return "";
 }
 
-// Friction: the exact method through planar stick / slip, x0 only (its
-// phases' dAcl/dtheta for a parameter would need the friction's columns);
-// "" or why not.
+// Friction: planar contacts only; Moreau–Jean's step map at its stick /
+// slip outcome (step_sensitivity.cpp, the columns the scheme knows), the
+// exact method through planar stick / slip, x0 only (its phases'
+// dAcl/dtheta for a parameter would need the friction's columns); "" or why
+// not.
 std::string refuse_friction(const mech::Model& model, const Options& opt, std::string_view method,
                             const OptionsUsed& used) {
   const std::string head =
       "Options::sensitivity: model '" + model.name + "' has mechanical.friction; ";
-  if (!used.event_search)
-    return head + "method '" + std::string(method) +
-           "' does not compute sensitivities through stick / slip (method 'event' does, x0 only)";
   const mech::MechanicalModel& m = *model.mechanical;
   for (size_t f = 0; f < m.friction.size(); ++f)
     if (m.friction[f].is_3d())
       return head + "mechanical.friction[" + std::to_string(f) +
              "] is a 3-D contact (tangent2): sensitivities through 3-D friction are not computed";
+  if (method == "moreau-jean") return "";
+  if (!used.event_search)
+    return head + "method '" + std::string(method) +
+           "' does not compute sensitivities through stick / slip (methods 'event' and "
+           "'moreau-jean' do)";
   for (const std::string& s : opt.sensitivity)
     if (s != "x0")
       return "Options::sensitivity '" + s + "': not computed with friction (model '" + model.name +

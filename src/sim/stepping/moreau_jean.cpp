@@ -232,7 +232,8 @@ class MjRun {
     } else if (!A_.empty()) {
       if (!contact_step(f, h, t0)) return false;
     }
-    if (sens_) sens_->step(t0, h, q_, v_, v_next_, A_, z_);
+    if (sens_)  // with friction, the step's tangential impulses (planar: checked)
+      sens_->step(t0, h, q_, v_, v_next_, A_, z_, friction_ ? &lambda_T_ : nullptr);
     return advance(j, last, h);
   }
 

@@ -6,6 +6,7 @@
 // step).
 #include "sim/stepping/step_sensitivity.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -159,53 +160,128 @@ void MjStepSensitivity::parameter_terms(double t0, double h, const VectorXd& q, 
 }
 
 void MjStepSensitivity::step(double t0, double h, const VectorXd& q, const VectorXd& v,
-                             const VectorXd& v_next, const IndexSet& A, const VectorXd& z) {
+                             const VectorXd& v_next, const IndexSet& A, const VectorXd& z,
+                             const VectorXd* lambda_T) {
   if (!any_exists()) return;
   const Eigen::LLT<MatrixXd>& W = factor(h);
   const auto dQ = S_.topRows(N_);
   const auto dV = S_.bottomRows(N_);
-  // W dv+ = W dv + h drhs - dW (v+ - v) + E_S' dz_S.
+  // W dv+ = W dv + h drhs - dW (v+ - v) + B dlambda.
   MatrixXd R = M_ * dV - h * (D_ * dV + K_ * (dQ + h * theta_ * dV)) + h * theta_ * D_ * dV +
                h * h * theta_ * theta_ * K_ * dV;
   parameter_terms(t0, h, q, v, v_next, R);
   MatrixXd dVn = W.solve(R);
-  if (!A.empty()) {
-    const int na = static_cast<int>(A.size());
-    MatrixXd EA(na, N_);
-    for (int a = 0; a < na; ++a) EA.row(a) = E_.row(A[static_cast<size_t>(a)]);
-    const MatrixXd Y = W.solve(EA.transpose());
-    const MatrixXd G = EA * Y;
-    const VectorXd Ev = EA * v, Evn = EA * v_next;
-    VectorXd w(na);
-    for (int a = 0; a < na; ++a) w(a) = Evn(a) + e_(A[static_cast<size_t>(a)]) * Ev(a);
-    const double scale = std::max({Ev.cwiseAbs().maxCoeff(), Evn.cwiseAbs().maxCoeff(),
-                                   (G.diagonal().cwiseProduct(z)).cwiseAbs().maxCoeff()});
-    std::vector<int> act;
-    if (const int bad = classify(z, w, G.diagonal(), scale, act); bad >= 0) {
-      lose_all(t0, A[static_cast<size_t>(bad)],
-               "degenerate step LCP (moreau-jean): zero impulse and zero velocity");
-      return;
-    }
-    if (!act.empty()) {
-      const int ns = static_cast<int>(act.size());
-      MatrixXd GS(ns, ns), rhs(ns, m_);
-      MatrixXd YS(N_, ns);
-      for (int a = 0; a < ns; ++a) {
-        const int r = A[static_cast<size_t>(act[a])];
-        YS.col(a) = Y.col(act[a]);
-        for (int b = 0; b < ns; ++b) GS(a, b) = G(act[a], act[b]);
-        // E_S dv+ = -e_S (E_S dv) - de_S (E_S v)
-        rhs.row(a) = -e_(r) * (E_.row(r) * dV) - E_.row(r) * dVn;
-        for (size_t p = 0; p < cols_.params.size(); ++p)
-          if (cols_.params[p].kind == 'e' && cols_.params[p].i == r)
-            rhs(a, nx0_ + static_cast<int>(p)) -= Ev(act[a]);
-      }
-      dVn += YS * GS.ldlt().solve(rhs);
-    }
-  }
+  if (!A.empty() && !impulse_terms(t0, W, v, v_next, A, z, lambda_T, dVn)) return;
   const MatrixXd dQn = dQ + h * ((1.0 - theta_) * dV + theta_ * dVn);
   S_.topRows(N_) = dQn;
   S_.bottomRows(N_) = dVn;
+}
+
+bool MjStepSensitivity::impulse_terms(double t0, const Eigen::LLT<MatrixXd>& W, const VectorXd& v,
+                                      const VectorXd& v_next, const IndexSet& A, const VectorXd& z,
+                                      const VectorXd* lambda_T, MatrixXd& dVn) {
+  const int na = static_cast<int>(A.size());
+  MatrixXd EA(na, N_);
+  for (int a = 0; a < na; ++a) EA.row(a) = E_.row(A[static_cast<size_t>(a)]);
+  const VectorXd Gd = (EA * W.solve(EA.transpose())).diagonal();
+  const VectorXd Ev = EA * v, Evn = EA * v_next;
+  VectorXd w(na);
+  for (int a = 0; a < na; ++a) w(a) = Evn(a) + e_(A[static_cast<size_t>(a)]) * Ev(a);
+  const double scale = std::max({Ev.cwiseAbs().maxCoeff(), Evn.cwiseAbs().maxCoeff(),
+                                 (Gd.cwiseProduct(z)).cwiseAbs().maxCoeff()});
+  std::vector<int> act;
+  if (const int bad = classify(z, w, Gd, scale, act); bad >= 0) {
+    lose_all(t0, A[static_cast<size_t>(bad)],
+             "degenerate step LCP (moreau-jean): zero impulse and zero velocity");
+    return false;
+  }
+  const int ns = static_cast<int>(act.size());
+  std::vector<int> rows(static_cast<size_t>(ns)), stuck, sliding;
+  std::vector<double> sigma;
+  VectorXd lambda_N(ns);
+  for (int a = 0; a < ns; ++a) {
+    rows[static_cast<size_t>(a)] = A[static_cast<size_t>(act[a])];
+    lambda_N(a) = z(act[a]);
+  }
+  if (lambda_T &&
+      !friction_outcome(t0, rows, lambda_N, *lambda_T, v_next, scale, stuck, sliding, sigma))
+    return false;
+  const mech::MechanicalModel& m = *model_.mechanical;
+  const int nu = ns + static_cast<int>(stuck.size());
+  if (nu == 0) return true;
+  // Unknowns: the normal impulses of S, then the stuck contacts' tangential
+  // ones; X the rows held (E_S, t_stuck), B the impulses' columns.
+  MatrixXd X(nu, N_), B(N_, nu), rhs(nu, m_);
+  const auto dV = S_.bottomRows(N_);
+  for (int a = 0; a < ns; ++a) {
+    const int r = rows[static_cast<size_t>(a)];
+    X.row(a) = E_.row(r);
+    B.col(a) = E_.row(r).transpose();
+    // E_S dv+ = -e_S (E_S dv) - de_S (E_S v)
+    rhs.row(a) = -e_(r) * (E_.row(r) * dV) - E_.row(r) * dVn;
+    for (size_t p = 0; p < cols_.params.size(); ++p)
+      if (cols_.params[p].kind == 'e' && cols_.params[p].i == r)
+        rhs(a, nx0_ + static_cast<int>(p)) -= Ev(act[a]);
+  }
+  for (size_t k = 0; k < sliding.size(); ++k) {
+    const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(sliding[k])];
+    const auto a = std::find(rows.begin(), rows.end(), fc.contact) - rows.begin();
+    B.col(a) -= sigma[k] * fc.mu * VectorXd(fc.tangent);
+  }
+  for (size_t k = 0; k < stuck.size(); ++k) {
+    const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(stuck[k])];
+    const int i = ns + static_cast<int>(k);
+    X.row(i) = VectorXd(fc.tangent).transpose();
+    B.col(i) = VectorXd(fc.tangent);
+    rhs.row(i) = -X.row(i) * dVn;  // the stuck sliding velocity stays zero
+  }
+  const MatrixXd WB = W.solve(B);
+  const Eigen::FullPivLU<MatrixXd> lu(X * WB);
+  if (!lu.isInvertible()) {
+    lose_all(t0, rows.front(),
+             "a step LCP (moreau-jean) whose linear map at its active set is singular");
+    return false;
+  }
+  dVn += WB * lu.solve(rhs);
+  return true;
+}
+
+bool MjStepSensitivity::friction_outcome(double t0, const std::vector<int>& rows,
+                                         const VectorXd& lambda_N, const VectorXd& lambda_T,
+                                         const VectorXd& v_next, double scale,
+                                         std::vector<int>& stuck, std::vector<int>& sliding,
+                                         std::vector<double>& sigma) {
+  const mech::MechanicalModel& m = *model_.mechanical;
+  const double vmax = v_next.cwiseAbs().maxCoeff();
+  for (size_t f = 0; f < m.friction.size(); ++f) {
+    const mech::FrictionalContact& fc = m.friction[f];
+    const auto it = std::find(rows.begin(), rows.end(), fc.contact);
+    if (it == rows.end() || fc.mu == 0.0) continue;  // open, or frictionless at this contact
+    const double ln = lambda_N(it - rows.begin()), lt = lambda_T(fc.contact);
+    const double s = fc.sliding(v_next);
+    const bool edge = std::abs(lt) >= (1.0 - kDegenerate) * fc.mu * ln;
+    const bool still =
+        std::abs(s) <=
+        kDegenerate *
+            (std::max(scale, vmax) * VectorXd(fc.tangent).cwiseAbs().sum() + std::abs(fc.velocity));
+    if (edge && still) {
+      lose_all(t0, fc.contact,
+               "a step (moreau-jean) that sticks at the cone's edge: stick and slip meet there");
+      return false;
+    }
+    if (still) {
+      stuck.push_back(static_cast<int>(f));
+    } else if (edge && lt * s < 0.0) {
+      sliding.push_back(static_cast<int>(f));
+      sigma.push_back(s > 0.0 ? 1.0 : -1.0);
+    } else {
+      lose_all(
+          t0, fc.contact,
+          "a step (moreau-jean) whose friction impulse is not Coulomb's at its sliding velocity");
+      return false;
+    }
+  }
+  return true;
 }
 
 // ---- backward Euler ----

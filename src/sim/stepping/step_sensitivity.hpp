@@ -58,11 +58,27 @@ class MjStepSensitivity : public StepSensitivity {
  public:
   MjStepSensitivity(const mech::Model& model, const SensColumns& cols, double theta);
   // The step of length h starting at t0 from (q, v) to v_next with the
-  // impulses z on the active set A.
+  // impulses z on the active set A; lambda_T (per constraint, null without
+  // friction) the planar friction's tangential impulses of the step.
   void step(double t0, double h, const VectorXd& q, const VectorXd& v, const VectorXd& v_next,
-            const IndexSet& A, const VectorXd& z);
+            const IndexSet& A, const VectorXd& z, const VectorXd* lambda_T = nullptr);
 
  private:
+  // The impulses' part of dv+ (added to dVn): the strictly active normal
+  // rows S as equalities, and with friction each frictional contact on S
+  // stuck (t_f dv+ = 0, its tangential impulse an unknown) or sliding
+  // (lambda_T = -sigma mu lambda_N); false when the step map has no
+  // derivative (a loss recorded).
+  bool impulse_terms(double t0, const Eigen::LLT<MatrixXd>& W, const VectorXd& v,
+                     const VectorXd& v_next, const IndexSet& A, const VectorXd& z,
+                     const VectorXd* lambda_T, MatrixXd& dVn);
+  // The stuck and sliding contacts on the strictly active rows `rows`
+  // (constraint indices; their normal impulses lambda_N): false (a loss
+  // recorded) where stick and slip meet or the impulses are not Coulomb's.
+  bool friction_outcome(double t0, const std::vector<int>& rows, const VectorXd& lambda_N,
+                        const VectorXd& lambda_T, const VectorXd& v_next, double scale,
+                        std::vector<int>& stuck, std::vector<int>& sliding,
+                        std::vector<double>& sigma);
   const Eigen::LLT<MatrixXd>& factor(double h);
   // The parameters' part of W dv+ (before the impulses): h (df - dD v -
   // dK (q + h theta v)) - dW (v+ - v) for each parameter column.
