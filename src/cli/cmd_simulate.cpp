@@ -225,7 +225,8 @@ void setup(CLI::App& app) {
                       sim::short_number(defaults.max_output_bytes));
   cmd->add_flag("--json", a->json, "Print the run summary as JSON");
   cmd->add_option("--sensitivity", a->sensitivity,
-                  "Forward sensitivities of the exact method, comma-separated: x0, f[i], g[c], "
+                  "Forward sensitivities (euler and moreau-jean: of their step map), "
+                  "comma-separated: x0, f[i], g[c], "
                   "e[c], K[i][j], D[i][j], M[i][j], amplitude[input]; a general LCS's A[i][j], "
                   "B[i][j], C[i][j], D[i][j] (docs/sensitivities.md); in --json, and with "
                   "--out in <out>.sensitivity.csv");
