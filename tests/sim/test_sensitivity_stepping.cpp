@@ -83,9 +83,18 @@ std::vector<sim::IndexSet> modes(const sim::Trajectory& tr) {
 
 // Stick or slip at every sample (empty without friction): with the modes,
 // the smooth piece of the step map a run is on.
-std::vector<std::vector<sim::FrictionMode>> friction_modes(const sim::Trajectory& tr) {
-  std::vector<std::vector<sim::FrictionMode>> out;
-  for (const auto& s : tr.samples) out.push_back(s.friction_mode);
+// 3-D contacts: the facet (edge, face) of each sliding one too.
+std::vector<std::string> friction_modes(const sim::Trajectory& tr) {
+  std::vector<std::string> out;
+  for (const auto& s : tr.samples) {
+    std::string m;
+    for (size_t f = 0; f < s.friction_mode.size(); ++f)
+      m += sim::friction_mode_text(s.friction_mode[f], f < s.friction_facet.size()
+                                                           ? s.friction_facet[f]
+                                                           : impact::ConeFacet{}) +
+           " ";
+    out.push_back(m);
+  }
   return out;
 }
 
@@ -461,9 +470,83 @@ TEST(StepSensitivity, MoreauJeanAtTheConesEdgeReportsNoDerivative) {
   ASSERT_EQ(tr.sensitivity_losses.size(), 1u);
   EXPECT_EQ(tr.sensitivity_losses.front().t, 0.0);
   EXPECT_EQ(tr.sensitivity_losses.front().contact, "floor");
-  EXPECT_NE(tr.sensitivity_losses.front().reason.find("cone's edge"), std::string::npos)
+  EXPECT_NE(tr.sensitivity_losses.front().reason.find("cone's boundary"), std::string::npos)
       << tr.sensitivity_losses.front().reason;
   for (char e : tr.dx_final_exists) EXPECT_FALSE(e);
+}
+
+}  // namespace
+}  // namespace lcsim
+
+namespace lcsim {
+namespace {
+
+// A unit point mass on the floor z >= 0 with 3-D friction (mu = 0.4, a
+// cone of d = 4: edges at the angles pi i / 4 from x), sliding from (vx,
+// vy), written and read back as a user's file; from z0 = 1 mm at -0.07 m/s
+// it lands first (see the incline above).
+mech::Model point_on_floor_3d() {
+  const std::filesystem::path p = std::filesystem::temp_directory_path() /
+                                  ("lcsim_step_point3d_" + std::to_string(::getpid()) + ".yaml");
+  std::ofstream(p) << "name: point3d\nmechanical:\n"
+                      "  M: [[1, 0, 0], [0, 1, 0], [0, 0, 1]]\n  E: [[0, 0, 1]]\n"
+                      "  f: [0, 0, -9.81]\n  coordinates: [x, y, z]\n  constraints: [floor]\n"
+                      "  friction:\n"
+                      "    - {contact: floor, tangents: [[1, 0, 0], [0, 1, 0]], mu: 0.4, d: 4}\n"
+                      "initial: [0, 0, 0, 2, 0, 0]\nt_end: 1\n";
+  mech::Model m = scene::load_model(p.string());
+  std::filesystem::remove(p);
+  return m;
+}
+
+// Sliding along the cone's edge D_4 = -x (heading psi = 0) from the floor:
+// the friction impulse stays on that vertex for any nearby heading (its
+// region spans pi/4), so a sideways velocity is not braked at all: the
+// polyhedral cone's anisotropy, in the derivative. At theta = 1/2 the
+// constant deceleration mu g is integrated exactly, so to T = 0.4 s (before
+// the stop at 0.51 s): dx/dvx0 = dy/dvy0 = T, dvy/dvy0 = 1, dvx/dvy0 = 0,
+// dx/df0 = dy/df1 = T^2 / 2, dx/df2 = mu T^2 / 2 (the normal force's share),
+// to 1e-13 (40 steps of rounding).
+TEST(StepSensitivity, MoreauJean3dVertexSlidingIsTheClosedForm) {
+  const mech::Model m = point_on_floor_3d();
+  const double T = 0.4, mu = 0.4;
+  const sim::Trajectory tr =
+      run("moreau-jean", m, m.initial, T, 1e-2, {"x0", "f[0]", "f[1]", "f[2]"}, 0.5);
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  ASSERT_TRUE(tr.sensitivity_losses.empty()) << tr.sensitivity_losses.front().reason;
+  EXPECT_EQ(friction_modes(tr).back(), "slip-edge-4 ");
+  const MatrixXd& dx = tr.dx_final;  // rows x y z vx vy vz; columns x0 (6), f0, f1, f2
+  EXPECT_NEAR(dx(0, 3), T, 1e-13);
+  EXPECT_NEAR(dx(1, 4), T, 1e-13);
+  EXPECT_NEAR(dx(4, 4), 1.0, 1e-13);
+  EXPECT_NEAR(dx(3, 4), 0.0, 1e-13);
+  EXPECT_NEAR(dx(0, 6), T * T / 2, 1e-13);
+  EXPECT_NEAR(dx(1, 7), T * T / 2, 1e-13);
+  EXPECT_NEAR(dx(0, 8), mu * T * T / 2, 1e-13);
+  EXPECT_NEAR(dx(1, 8), 0.0, 1e-13);
+}
+
+// Landing, then sliding on an edge (psi = 0.3 rad: the vertex D_4 = -x
+// brakes x alone until the heading reaches the face between D_4 and D_5),
+// on a face (psi = pi/8, its bisector: the velocity held along the face's
+// normal), and to rest: against Moreau–Jean's own central differences
+// with the same active sets, modes and facets at every sample.
+TEST(StepSensitivity, MoreauJean3dThroughVerticesFacesAndStickMatchesItsOwnDifferences) {
+  const mech::Model m = point_on_floor_3d();
+  const double pi = std::acos(-1.0);
+  for (const double psi : {0.3, pi / 8}) {
+    SCOPED_TRACE(psi);
+    VectorXd x0(6);
+    x0 << 0, 0, 1e-3, 2 * std::cos(psi), 2 * std::sin(psi), -0.07;
+    const sim::Trajectory plain = run("moreau-jean", m, x0, 0.8, 1e-2);
+    ASSERT_TRUE(plain.ok()) << plain.message;
+    const std::vector<std::string> fm = friction_modes(plain);
+    EXPECT_EQ(fm[10], psi == 0.3 ? "slip-edge-4 " : "slip-face-4 ");
+    EXPECT_EQ(fm.back(), "stick ");
+    expect_matches_own_fd("moreau-jean", m, x0, 0.8, 1e-2,
+                          {state(0, 1e-6), state(1, 1e-6), state(3, 1e-6), state(4, 1e-6),
+                           entry("f[0]", 'f', 0, 0, 1e-4), entry("f[2]", 'f', 2, 0, 1e-4)});
+  }
 }
 
 }  // namespace

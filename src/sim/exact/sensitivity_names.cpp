@@ -173,21 +173,23 @@ std::string refuse_for_scheme(const detail::SensColumns& c, std::string_view met
   return "";
 }
 
-// Friction: planar contacts only; Moreau–Jean's step map at its stick /
-// slip outcome (step_sensitivity.cpp, the columns the scheme knows), the
-// exact method through planar stick / slip, x0 only (its phases'
+// Friction: Moreau–Jean's step map at its stick / slip outcome, planar or
+// 3-D (step_sensitivity.cpp, the columns the scheme knows); the exact
+// method through planar stick / slip, x0 only (its phases'
 // dAcl/dtheta for a parameter would need the friction's columns); "" or why
 // not.
 std::string refuse_friction(const mech::Model& model, const Options& opt, std::string_view method,
                             const OptionsUsed& used) {
   const std::string head =
       "Options::sensitivity: model '" + model.name + "' has mechanical.friction; ";
+  if (method == "moreau-jean") return "";
   const mech::MechanicalModel& m = *model.mechanical;
   for (size_t f = 0; f < m.friction.size(); ++f)
     if (m.friction[f].is_3d())
       return head + "mechanical.friction[" + std::to_string(f) +
-             "] is a 3-D contact (tangent2): sensitivities through 3-D friction are not computed";
-  if (method == "moreau-jean") return "";
+             "] is a 3-D contact (tangent2): sensitivities through 3-D friction are not computed "
+             "by the method '" +
+             std::string(method) + "' (moreau-jean's step map is)";
   if (!used.event_search)
     return head + "method '" + std::string(method) +
            "' does not compute sensitivities through stick / slip (methods 'event' and "

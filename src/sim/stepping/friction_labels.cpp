@@ -54,16 +54,20 @@ bool strictly_inside_cone(double p1, double p2, double mu_pn, int d) {
 // 10^4 times that residual and ~10^7 eps; sliding that slow moves a contact
 // by 1e-9 V h per step.
 constexpr double kStickBand = 1e-9;
-FrictionMode friction_mode_after_step(const mech::FrictionalContact& fc, int d, double p_n,
-                                      double p1, double p2, const VectorXd& v, double V) {
-  const double s = fc.sliding(v);
-  const double s2 = fc.is_3d() ? fc.tangent2.dot(v) : 0.0;
+double stick_band(const mech::FrictionalContact& fc, double V) {
   double t_size = 0.0;
   for (Eigen::SparseVector<double>::InnerIterator it(fc.tangent); it; ++it)
     t_size += std::abs(it.value());
   for (Eigen::SparseVector<double>::InnerIterator it(fc.tangent2); it; ++it)
     t_size += std::abs(it.value());
-  const double band = kStickBand * (t_size * V + std::abs(fc.velocity));
+  return kStickBand * (t_size * V + std::abs(fc.velocity));
+}
+
+FrictionMode friction_mode_after_step(const mech::FrictionalContact& fc, int d, double p_n,
+                                      double p1, double p2, const VectorXd& v, double V) {
+  const double s = fc.sliding(v);
+  const double s2 = fc.is_3d() ? fc.tangent2.dot(v) : 0.0;
+  const double band = stick_band(fc, V);
   // A 3-D contact with d = 1 has a flat polygon (the segment [-t, t]): no
   // friction along t2, so it sticks only if it does not slide along t2.
   const bool inside = strictly_inside_cone(p1, p2, fc.mu * p_n, d) &&

@@ -14,6 +14,11 @@ namespace lcsim::sim::detail {
 // its gauge below 1 - 1e-9 (friction_labels.cpp says why).
 bool strictly_inside_cone(double p1, double p2, double mu_pn, int d);
 
+// The rounding band of a contact's sliding velocity (m/s) at the step's
+// velocity scale V (m/s): kStickBand (|t|_1 + |t2|_1) V + |velocity|
+// (friction_labels.cpp says why).
+double stick_band(const mech::FrictionalContact& fc, double V);
+
 // A closed contact's mode after a step (normal impulse p_n > 0, friction
 // impulses p1, p2 along t, t2, end velocity v, V the step's velocity scale
 // (m/s): the largest |v_free|, |v+| of the model): stick when the impulse

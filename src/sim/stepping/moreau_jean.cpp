@@ -232,9 +232,20 @@ class MjRun {
     } else if (!A_.empty()) {
       if (!contact_step(f, h, t0)) return false;
     }
-    if (sens_)  // with friction, the step's tangential impulses (planar: checked)
-      sens_->step(t0, h, q_, v_, v_next_, A_, z_, friction_ ? &lambda_T_ : nullptr);
+    if (sens_) sensitivity_step(t0, h);
     return advance(j, last, h);
+  }
+
+  // The step map's derivative (step_sensitivity.hpp), with the step's
+  // friction impulses and velocity scale (label_modes') where there are any.
+  void sensitivity_step(double t0, double h) {
+    MjStepSensitivity::Friction fr;
+    if (friction_) {
+      fr.t = &lambda_T_;
+      fr.t2 = u_t2_.size() > 0 ? &friction_->lambda_T2() : nullptr;
+      fr.V = std::max(v_free_size_, v_next_.size() > 0 ? v_next_.lpNorm<Eigen::Infinity>() : 0.0);
+    }
+    sens_->step(t0, h, q_, v_, v_next_, A_, z_, friction_ ? &fr : nullptr);
   }
 
   // v_next_ = v + h W^{-1} (f - D v - K (q + h theta v)): the free velocity.

@@ -8,7 +8,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <lcsim/impact/impact.hpp>
 #include <limits>
+#include <string>
+
+#include "sim/stepping/friction_labels.hpp"
 
 namespace lcsim::sim::detail {
 
@@ -161,7 +165,7 @@ void MjStepSensitivity::parameter_terms(double t0, double h, const VectorXd& q, 
 
 void MjStepSensitivity::step(double t0, double h, const VectorXd& q, const VectorXd& v,
                              const VectorXd& v_next, const IndexSet& A, const VectorXd& z,
-                             const VectorXd* lambda_T) {
+                             const Friction* friction) {
   if (!any_exists()) return;
   const Eigen::LLT<MatrixXd>& W = factor(h);
   const auto dQ = S_.topRows(N_);
@@ -171,7 +175,7 @@ void MjStepSensitivity::step(double t0, double h, const VectorXd& q, const Vecto
                h * h * theta_ * theta_ * K_ * dV;
   parameter_terms(t0, h, q, v, v_next, R);
   MatrixXd dVn = W.solve(R);
-  if (!A.empty() && !impulse_terms(t0, W, v, v_next, A, z, lambda_T, dVn)) return;
+  if (!A.empty() && !impulse_terms(t0, W, v, v_next, A, z, friction, dVn)) return;
   const MatrixXd dQn = dQ + h * ((1.0 - theta_) * dV + theta_ * dVn);
   S_.topRows(N_) = dQn;
   S_.bottomRows(N_) = dVn;
@@ -179,7 +183,7 @@ void MjStepSensitivity::step(double t0, double h, const VectorXd& q, const Vecto
 
 bool MjStepSensitivity::impulse_terms(double t0, const Eigen::LLT<MatrixXd>& W, const VectorXd& v,
                                       const VectorXd& v_next, const IndexSet& A, const VectorXd& z,
-                                      const VectorXd* lambda_T, MatrixXd& dVn) {
+                                      const Friction* friction, MatrixXd& dVn) {
   const int na = static_cast<int>(A.size());
   MatrixXd EA(na, N_);
   for (int a = 0; a < na; ++a) EA.row(a) = E_.row(A[static_cast<size_t>(a)]);
@@ -196,21 +200,18 @@ bool MjStepSensitivity::impulse_terms(double t0, const Eigen::LLT<MatrixXd>& W, 
     return false;
   }
   const int ns = static_cast<int>(act.size());
-  std::vector<int> rows(static_cast<size_t>(ns)), stuck, sliding;
-  std::vector<double> sigma;
+  std::vector<int> rows(static_cast<size_t>(ns));
   VectorXd lambda_N(ns);
   for (int a = 0; a < ns; ++a) {
     rows[static_cast<size_t>(a)] = A[static_cast<size_t>(act[a])];
     lambda_N(a) = z(act[a]);
   }
-  if (lambda_T &&
-      !friction_outcome(t0, rows, lambda_N, *lambda_T, v_next, scale, stuck, sliding, sigma))
-    return false;
-  const mech::MechanicalModel& m = *model_.mechanical;
-  const int nu = ns + static_cast<int>(stuck.size());
+  Pieces pc;
+  if (friction && !friction_pieces(t0, rows, lambda_N, *friction, v_next, pc)) return false;
+  const int nu = ns + static_cast<int>(pc.cols.size());
   if (nu == 0) return true;
-  // Unknowns: the normal impulses of S, then the stuck contacts' tangential
-  // ones; X the rows held (E_S, t_stuck), B the impulses' columns.
+  // Unknowns: the normal impulses of S, then the pieces' (stuck tangents,
+  // faces); X the rows held, B the impulses' columns.
   MatrixXd X(nu, N_), B(N_, nu), rhs(nu, m_);
   const auto dV = S_.bottomRows(N_);
   for (int a = 0; a < ns; ++a) {
@@ -223,17 +224,12 @@ bool MjStepSensitivity::impulse_terms(double t0, const Eigen::LLT<MatrixXd>& W, 
       if (cols_.params[p].kind == 'e' && cols_.params[p].i == r)
         rhs(a, nx0_ + static_cast<int>(p)) -= Ev(act[a]);
   }
-  for (size_t k = 0; k < sliding.size(); ++k) {
-    const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(sliding[k])];
-    const auto a = std::find(rows.begin(), rows.end(), fc.contact) - rows.begin();
-    B.col(a) -= sigma[k] * fc.mu * VectorXd(fc.tangent);
-  }
-  for (size_t k = 0; k < stuck.size(); ++k) {
-    const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(stuck[k])];
+  for (const auto& [a, col] : pc.normal) B.col(a) += col;
+  for (size_t k = 0; k < pc.cols.size(); ++k) {
     const int i = ns + static_cast<int>(k);
-    X.row(i) = VectorXd(fc.tangent).transpose();
-    B.col(i) = VectorXd(fc.tangent);
-    rhs.row(i) = -X.row(i) * dVn;  // the stuck sliding velocity stays zero
+    X.row(i) = pc.rows[k].transpose();
+    B.col(i) = pc.cols[k];
+    rhs.row(i) = -X.row(i) * dVn;  // the held velocity stays as it is
   }
   const MatrixXd WB = W.solve(B);
   const Eigen::FullPivLU<MatrixXd> lu(X * WB);
@@ -246,41 +242,78 @@ bool MjStepSensitivity::impulse_terms(double t0, const Eigen::LLT<MatrixXd>& W, 
   return true;
 }
 
-bool MjStepSensitivity::friction_outcome(double t0, const std::vector<int>& rows,
-                                         const VectorXd& lambda_N, const VectorXd& lambda_T,
-                                         const VectorXd& v_next, double scale,
-                                         std::vector<int>& stuck, std::vector<int>& sliding,
-                                         std::vector<double>& sigma) {
+bool MjStepSensitivity::friction_pieces(double t0, const std::vector<int>& rows,
+                                        const VectorXd& lambda_N, const Friction& fr,
+                                        const VectorXd& v_next, Pieces& out) {
   const mech::MechanicalModel& m = *model_.mechanical;
-  const double vmax = v_next.cwiseAbs().maxCoeff();
-  for (size_t f = 0; f < m.friction.size(); ++f) {
-    const mech::FrictionalContact& fc = m.friction[f];
+  for (const mech::FrictionalContact& fc : m.friction) {
     const auto it = std::find(rows.begin(), rows.end(), fc.contact);
     if (it == rows.end() || fc.mu == 0.0) continue;  // open, or frictionless at this contact
-    const double ln = lambda_N(it - rows.begin()), lt = lambda_T(fc.contact);
-    const double s = fc.sliding(v_next);
-    const bool edge = std::abs(lt) >= (1.0 - kDegenerate) * fc.mu * ln;
-    const bool still =
-        std::abs(s) <=
-        kDegenerate *
-            (std::max(scale, vmax) * VectorXd(fc.tangent).cwiseAbs().sum() + std::abs(fc.velocity));
-    if (edge && still) {
-      lose_all(t0, fc.contact,
-               "a step (moreau-jean) that sticks at the cone's edge: stick and slip meet there");
+    const int a = static_cast<int>(it - rows.begin());
+    const double p2 = fr.t2 ? (*fr.t2)(fc.contact) : 0.0;
+    if (!contact_piece(t0, fc, a, lambda_N(a), (*fr.t)(fc.contact), p2, v_next, fr.V, out))
       return false;
-    }
-    if (still) {
-      stuck.push_back(static_cast<int>(f));
-    } else if (edge && lt * s < 0.0) {
-      sliding.push_back(static_cast<int>(f));
-      sigma.push_back(s > 0.0 ? 1.0 : -1.0);
-    } else {
-      lose_all(
-          t0, fc.contact,
-          "a step (moreau-jean) whose friction impulse is not Coulomb's at its sliding velocity");
-      return false;
-    }
   }
+  return true;
+}
+
+// Coulomb's law at the step's end (friction_labels.hpp's tests): stuck
+// (impulse strictly inside the cone, velocity in the stick band), sliding
+// (impulse on the boundary, velocity above the band) on a vertex of the
+// cone (impulse mu P_N D_i) or a face (impulse between D_i and D_i+1, the
+// velocity along the face's normal: (D_i+1 - D_i).u = 0 held). A planar
+// contact, or a 3-D one with d = 1 (a flat cone), has friction along t only.
+bool MjStepSensitivity::contact_piece(double t0, const mech::FrictionalContact& fc, int a,
+                                      double ln, double p1, double p2, const VectorXd& v_next,
+                                      double V, Pieces& out) {
+  const int d = model_.mechanical->edges_of(fc);
+  const bool flat = !fc.is_3d() || d == 1;
+  const double s = fc.sliding(v_next), s2 = flat ? 0.0 : fc.tangent2.dot(v_next);
+  const double mu_pn = fc.mu * ln;
+  const bool inside = strictly_inside_cone(p1, flat ? 0.0 : p2, mu_pn, flat ? 1 : d);
+  const bool still = std::max(std::abs(s), std::abs(s2)) <= stick_band(fc, V);
+  auto lose = [&](const char* why) {
+    lose_all(t0, fc.contact, std::string("a step (moreau-jean) ") + why);
+    return false;
+  };
+  if (!inside && still)
+    return lose("that sticks on its cone's boundary: stick and slip meet there");
+  if (inside && !still) return lose("whose friction impulse is not Coulomb's at its velocity");
+  const VectorXd t = fc.tangent;
+  if (inside) {
+    out.cols.push_back(t), out.rows.push_back(t);
+    if (!flat) out.cols.push_back(VectorXd(fc.tangent2)), out.rows.push_back(VectorXd(fc.tangent2));
+    return true;
+  }
+  if (flat) {
+    if (p1 * s >= 0.0) return lose("whose friction impulse does not oppose its sliding");
+    out.normal.emplace_back(a, -(s > 0.0 ? 1.0 : -1.0) * fc.mu * t);
+    return true;
+  }
+  const impact::ConeFacet f = impact::cone_facet(s, s2, d);
+  const VectorXd t2 = fc.tangent2;
+  auto D = [&](int i) {
+    const auto [c, sn] = impact::cone_edge(i % (2 * d), d);
+    return std::pair<double, double>{c, sn};
+  };
+  const auto [c0, s0] = D(f.edge);
+  const VectorXd Di = c0 * t + s0 * t2;
+  if (!f.face) {
+    if (std::hypot(p1 - mu_pn * c0, p2 - mu_pn * s0) > kDegenerate * mu_pn)
+      return lose("whose friction impulse is not its cone's vertex opposing the sliding");
+    out.normal.emplace_back(a, fc.mu * Di);
+    return true;
+  }
+  // On the face: (p1, p2) = mu (ln D_i + b (D_i+1 - D_i)), 0 < b < ln.
+  const auto [c1, s1] = D(f.edge + 1);
+  const double dc = c1 - c0, ds = s1 - s0;
+  const double b =
+      ((p1 / fc.mu - ln * c0) * dc + (p2 / fc.mu - ln * s0) * ds) / (dc * dc + ds * ds);
+  if (!(b > kDegenerate * ln && b < (1.0 - kDegenerate) * ln))
+    return lose("sliding where a vertex and a face of its cone meet");
+  const VectorXd Dd = dc * t + ds * t2;
+  out.normal.emplace_back(a, fc.mu * Di);
+  out.cols.push_back(fc.mu * Dd), out.rows.push_back(Dd);
   return true;
 }
 

@@ -57,28 +57,44 @@ class StepSensitivity {
 class MjStepSensitivity : public StepSensitivity {
  public:
   MjStepSensitivity(const mech::Model& model, const SensColumns& cols, double theta);
+  // A step's friction: the tangential impulses per constraint along t and
+  // t2 (N s; t2 null for a planar model) and the step's velocity scale V
+  // (m/s; friction_labels.hpp's stick band).
+  struct Friction {
+    const VectorXd* t = nullptr;
+    const VectorXd* t2 = nullptr;
+    double V = 0.0;
+  };
   // The step of length h starting at t0 from (q, v) to v_next with the
-  // impulses z on the active set A; lambda_T (per constraint, null without
-  // friction) the planar friction's tangential impulses of the step.
+  // impulses z on the active set A (and its friction, null without).
   void step(double t0, double h, const VectorXd& q, const VectorXd& v, const VectorXd& v_next,
-            const IndexSet& A, const VectorXd& z, const VectorXd* lambda_T = nullptr);
+            const IndexSet& A, const VectorXd& z, const Friction* friction = nullptr);
 
  private:
+  // The friction's part of the step map at the step's outcome: impulse
+  // columns added to a strictly active normal's (a sliding contact's mu D,
+  // D its cone's vertex) and further unknowns, each a column with the row
+  // it holds (a stuck contact's tangents; a contact sliding on a face of
+  // its cone, the face's direction).
+  struct Pieces {
+    std::vector<std::pair<int, VectorXd>> normal;  // (position in S, column)
+    std::vector<VectorXd> cols, rows;
+  };
   // The impulses' part of dv+ (added to dVn): the strictly active normal
-  // rows S as equalities, and with friction each frictional contact on S
-  // stuck (t_f dv+ = 0, its tangential impulse an unknown) or sliding
-  // (lambda_T = -sigma mu lambda_N); false when the step map has no
-  // derivative (a loss recorded).
+  // rows S as equalities with the friction's pieces; false when the step
+  // map has no derivative (a loss recorded).
   bool impulse_terms(double t0, const Eigen::LLT<MatrixXd>& W, const VectorXd& v,
                      const VectorXd& v_next, const IndexSet& A, const VectorXd& z,
-                     const VectorXd* lambda_T, MatrixXd& dVn);
-  // The stuck and sliding contacts on the strictly active rows `rows`
-  // (constraint indices; their normal impulses lambda_N): false (a loss
-  // recorded) where stick and slip meet or the impulses are not Coulomb's.
-  bool friction_outcome(double t0, const std::vector<int>& rows, const VectorXd& lambda_N,
-                        const VectorXd& lambda_T, const VectorXd& v_next, double scale,
-                        std::vector<int>& stuck, std::vector<int>& sliding,
-                        std::vector<double>& sigma);
+                     const Friction* friction, MatrixXd& dVn);
+  // The pieces of the frictional contacts on S (`rows`, constraint indices,
+  // normal impulses lambda_N); false (a loss recorded) where two outcomes
+  // meet or the impulse is not Coulomb's at the velocity.
+  bool friction_pieces(double t0, const std::vector<int>& rows, const VectorXd& lambda_N,
+                       const Friction& fr, const VectorXd& v_next, Pieces& out);
+  // One contact's piece: fc on S at position a with normal impulse ln and
+  // friction impulse (p1, p2).
+  bool contact_piece(double t0, const mech::FrictionalContact& fc, int a, double ln, double p1,
+                     double p2, const VectorXd& v_next, double V, Pieces& out);
   const Eigen::LLT<MatrixXd>& factor(double h);
   // The parameters' part of W dv+ (before the impulses): h (df - dD v -
   // dK (q + h theta v)) - dW (v+ - v) for each parameter column.
