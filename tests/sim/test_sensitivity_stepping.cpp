@@ -13,15 +13,14 @@
 // - Convergence to the exact method's derivative on runs without impacts.
 // - The ball through its impacts: the O(1) error the docs record.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <functional>
 #include <iostream>
+#include <lcsim/io/model_file.hpp>
 #include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -347,21 +346,18 @@ namespace {
 // exact method's amplitude test's model, tests/sim/test_sensitivity_events)
 // against a plastic stop at -gap: the schemes take the input as the step's
 // known forcing, so x0, f, K, M and the sine's amplitude have the discrete
-// map's derivative. The model file is written and read back, as a user's.
+// map's derivative. The model is read from its file text, as a user's.
 mech::Model pushed(double gap) {
-  const std::filesystem::path p = std::filesystem::temp_directory_path() /
-                                  ("lcsim_step_pushed_" + std::to_string(::getpid()) + ".yaml");
-  std::ofstream(p) << "name: pushed\ninputs:\n"
-                      "  - {name: push, kind: sine, amplitude: 2, frequency: 0.3, damping: 0.1}\n"
-                      "mechanical:\n  M: [[1]]\n  K: [[1]]\n  f: [-0.8]\n  E: [[1]]\n"
-                      "  g: ["
-                   << gap
-                   << "]\n  restitution: [0]\n  constraints: [stop]\n"
-                      "  coordinates: [x]\n  force_inputs: [{input: push, gain: [1]}]\n"
-                      "initial: [0, 0]\nt_end: 8\n";
-  mech::Model m = scene::load_model(p.string());
-  std::filesystem::remove(p);
-  return m;
+  std::ostringstream text;
+  text << "name: pushed\ninputs:\n"
+          "  - {name: push, kind: sine, amplitude: 2, frequency: 0.3, damping: 0.1}\n"
+          "mechanical:\n  M: [[1]]\n  K: [[1]]\n  f: [-0.8]\n  E: [[1]]\n"
+          "  g: ["
+       << gap
+       << "]\n  restitution: [0]\n  constraints: [stop]\n"
+          "  coordinates: [x]\n  force_inputs: [{input: push, gain: [1]}]\n"
+          "initial: [0, 0]\nt_end: 8\n";
+  return io::parse_matrix_model(text.str(), "pushed.yaml");
 }
 
 Perturbation amplitude() {
@@ -483,20 +479,17 @@ namespace {
 
 // A unit point mass on the floor z >= 0 with 3-D friction (mu = 0.4, a
 // cone of d = 4: edges at the angles pi i / 4 from x), sliding from (vx,
-// vy), written and read back as a user's file; from z0 = 1 mm at -0.07 m/s
+// vy), read from its file text; from z0 = 1 mm at -0.07 m/s
 // it lands first (see the incline above).
 mech::Model point_on_floor_3d() {
-  const std::filesystem::path p = std::filesystem::temp_directory_path() /
-                                  ("lcsim_step_point3d_" + std::to_string(::getpid()) + ".yaml");
-  std::ofstream(p) << "name: point3d\nmechanical:\n"
-                      "  M: [[1, 0, 0], [0, 1, 0], [0, 0, 1]]\n  E: [[0, 0, 1]]\n"
-                      "  f: [0, 0, -9.81]\n  coordinates: [x, y, z]\n  constraints: [floor]\n"
-                      "  friction:\n"
-                      "    - {contact: floor, tangents: [[1, 0, 0], [0, 1, 0]], mu: 0.4, d: 4}\n"
-                      "initial: [0, 0, 0, 2, 0, 0]\nt_end: 1\n";
-  mech::Model m = scene::load_model(p.string());
-  std::filesystem::remove(p);
-  return m;
+  return io::parse_matrix_model(
+      "name: point3d\nmechanical:\n"
+      "  M: [[1, 0, 0], [0, 1, 0], [0, 0, 1]]\n  E: [[0, 0, 1]]\n"
+      "  f: [0, 0, -9.81]\n  coordinates: [x, y, z]\n  constraints: [floor]\n"
+      "  friction:\n"
+      "    - {contact: floor, tangents: [[1, 0, 0], [0, 1, 0]], mu: 0.4, d: 4}\n"
+      "initial: [0, 0, 0, 2, 0, 0]\nt_end: 1\n",
+      "point3d.yaml");
 }
 
 // Sliding along the cone's edge D_4 = -x (heading psi = 0) from the floor:
