@@ -164,9 +164,10 @@ void EventDriven::project_onto(const std::vector<int>& rows, VectorXd& xa, bool 
 // decides their forces. Returns how the limit was taken (Event::note).
 std::string EventDriven::take_accumulation_limit(int r, double t, const GeometricTail& tail,
                                                  const VectorXd& gap, const VectorXd& gap_scale,
-                                                 const VectorXd& rate, VectorXd& xa) const {
+                                                 const VectorXd& rate, VectorXd& xa,
+                                                 lcs::IndexSet& joined) const {
   const double since = tail.since, ratio = tail.ratio, t_star = tail.t_star;
-  std::vector<int> joined;
+  joined.clear();
   std::string names;
   for (int s = 0; s < k_; ++s) {
     const auto& h = impact_times_[s];

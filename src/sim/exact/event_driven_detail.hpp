@@ -206,6 +206,12 @@ struct EventResult : OutcomeStartingAs<Status::kNumericalFailure> {
   bool accumulation = false;
   double t_star = 0.0;  // extrapolated accumulation time (accumulation only)
   std::string note;     // how an accumulation's limit was taken (Event::note)
+  // An accumulation's limit (sensitivities only): the contacts projected
+  // onto E_J q + g_J = 0, E_J v = 0, after the first limit_round rounds,
+  // from the state limit_x (take_accumulation_limit).
+  lcs::IndexSet limit_rows;
+  size_t limit_round = 0;
+  VectorXd limit_x;
   long lcp_solves = 0;
   std::vector<WarningCount> warnings;  // counted into Trajectory::warnings
   // Forward sensitivities only (sensitivity.cpp): each round of the impact
@@ -421,7 +427,8 @@ class EventDriven {
                            VectorXd& xa, EventResult& out);
   std::string take_accumulation_limit(int r, double t, const GeometricTail& tail,
                                       const VectorXd& gap, const VectorXd& gap_scale,
-                                      const VectorXd& rate, VectorXd& xa) const;
+                                      const VectorXd& rate, VectorXd& xa,
+                                      lcs::IndexSet& joined) const;
   EventResult process_lcs(const VectorXd& xa);
   void record(Trajectory& tr, double t, const VectorXd& xa, const Phase& ph) const;
   // A phase's start, per monitor: the noise level of its value, the order m0

@@ -175,8 +175,10 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0,
       limit_taken = true;
       out.accumulation = true;
       out.t_star = scan.tail.t_star;
+      out.limit_round = out.rounds.size();
+      out.limit_x = xa;
       out.note = take_accumulation_limit(scan.accumulating, t, scan.tail, scan.gap, scan.gap_scale,
-                                         scan.rate, xa);
+                                         scan.rate, xa, out.limit_rows);
       continue;
     }
     if (!scan.approaching) break;

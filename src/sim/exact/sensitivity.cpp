@@ -548,8 +548,14 @@ bool Sensitivity::impact_map(double t, const EventResult::ImpactRound& rd, Matri
 void Sensitivity::after_event(const EventResult& ev, const Phase& next, double t,
                               const VectorXd& x_plus, const lcs::IndexSet& held, int trigger) {
   MatrixXd J = MatrixXd::Identity(n_, n_), dR = MatrixXd::Zero(n_, m_);
-  if (ev.accumulation)
-    lose_all(t, trigger, "accumulation of impacts: the derivative of its limit is not computed");
+  // An accumulation's limit, composed where the run took it among the rounds.
+  auto limit = [&](size_t round) {
+    if (!mech_ || !ev.accumulation || ev.limit_round != round) return;
+    MatrixXd Jl, dRl;
+    if (!limit_map(t, ev, Jl, dRl)) return;
+    J = Jl * J;
+    dR = Jl * dR + dRl;
+  };
   if (!mech_ && ev.jumped) {
     for (const EventResult::LcsJump& jump : ev.lcs_jumps) {
       MatrixXd Jr, dRr;
@@ -570,13 +576,16 @@ void Sensitivity::after_event(const EventResult& ev, const Phase& next, double t
     for (int r : ev.rounds.front().closed)
       if (r != trigger && t > 0.0 && std::find(held.begin(), held.end(), r) == held.end())
         lose_all(t, r, "coinciding events: this contact closes at the same time as another");
-    for (const auto& rd : ev.rounds) {
+    for (size_t i = 0; i < ev.rounds.size(); ++i) {
+      limit(i);
+      const auto& rd = ev.rounds[i];
       MatrixXd Jr, dRr = MatrixXd::Zero(n_, m_);
       if (friction ? !friction_impact_map(t, rd, Jr) : !impact_map(t, rd, Jr, dRr)) break;
       J = Jr * J;
       dR = Jr * dR + dRr;
     }
   }
+  limit(ev.rounds.size());
   const VectorXd xdot_plus = next.Acl * x_plus;
   MatrixXd S = J * S_minus_ + (J * xdot_minus_ - xdot_plus) * dtau_ + dR;
   begin_phase(next, t, x_plus, S);

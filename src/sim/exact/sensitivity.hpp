@@ -86,6 +86,10 @@ class Sensitivity {
   void start_on_boundary(const VectorXd& xa);
   const MatrixXd& at_dense(double t, double tau);
   bool impact_map(double t, const EventResult::ImpactRound& round, MatrixXd& J, MatrixXd& dR);
+  // An accumulation's limit as the run takes it (sensitivity_accumulation.cpp):
+  // the M-orthogonal projection onto E_J q + g_J = 0, E_J v = 0 from
+  // ev.limit_x; false (every column lost) where it has no derivative.
+  bool limit_map(double t, const EventResult& ev, MatrixXd& J, MatrixXd& dR);
   // An impact round with planar friction (sensitivity_friction.cpp): J at
   // its outcome (x0 only: parameters are refused with friction); false, with
   // every column lost, where the outcome is not locally constant.
