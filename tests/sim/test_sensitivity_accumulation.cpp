@@ -62,8 +62,7 @@ TEST(SensitivityAccumulation, BallAtRestHasZeroDerivative) {
 // sequence of bounces, t_inf = t1 + 2 e w / (|a_z| (1 - e))): dx/dx0 = 1, dx/dz0 = m01 / 2 =
 // 0.25, dx/dvx0 = T, dvx/dvx0 = 1, dx/dvz0 = m01 T / 2 = 0.625, dvx/dvz0 =
 // m01 / 2, dx/df0 = T^2 / 4, dvx/df0 = T / 2, and zero for f1 and e (the
-// limit does not depend on them), dx/dM01 = z0 / 2 = 0.25. A projection that
-// were not M-orthogonal would move (M v)_x and fail all of these. The run
+// limit does not depend on them), dx/dM01 = z0 / 2 = 0.25. The run
 // takes the limit at its last resolved impact, the remaining geometric tail
 // below accumulation_tail = 1e-6 s; the tail changes the run's derivative by
 // at most its length times the rates' derivative (O(1) here): tolerance
