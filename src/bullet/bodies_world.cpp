@@ -53,6 +53,7 @@
 #include <utility>
 
 #include "bullet/multibody_scene.hpp"
+#include "bullet/pipeline.hpp"
 #include "bullet/run_recorder.hpp"
 #include "bullet/step_loop.hpp"
 #include "bullet/urdf_multibody.hpp"
@@ -106,13 +107,9 @@ struct Placed {
 };
 
 // Members in construction order: destruction runs limits -> colliders ->
-// multibodies -> world -> solver (the destructor removes them first).
-struct BodiesWorld {
-  std::unique_ptr<btDefaultCollisionConfiguration> config;
-  std::unique_ptr<btCollisionDispatcher> dispatcher;
-  std::unique_ptr<btDbvtBroadphase> broadphase;
-  std::unique_ptr<btMultiBodyConstraintSolver> solver;
-  std::unique_ptr<btMultiBodyDynamicsWorld> world;
+// multibodies, then the Pipeline's world -> solver -> ... (the destructor
+// removes them from the world first).
+struct BodiesWorld : Pipeline<btMultiBodyConstraintSolver, btMultiBodyDynamicsWorld> {
   PairFilter filter;
   std::vector<Part> parts;
   std::vector<std::unique_ptr<btCollisionShape>> shapes;

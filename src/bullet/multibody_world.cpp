@@ -58,6 +58,7 @@
 #include <utility>
 
 #include "bullet/multibody_scene.hpp"
+#include "bullet/pipeline.hpp"
 #include "bullet/run_recorder.hpp"
 #include "bullet/step_loop.hpp"
 #include "bullet/urdf_multibody.hpp"
@@ -93,13 +94,8 @@ std::vector<FollowingMimic> following_mimics(const scene::Scene& setup,
 // The multibody's world (the step loop's calls, step_loop.hpp, are
 // take_step and the two beside it); members in construction order, so that
 // destruction runs limits -> colliders -> multibody -> world -> solvers.
-struct MbWorld {
-  std::unique_ptr<btDefaultCollisionConfiguration> config;
-  std::unique_ptr<btCollisionDispatcher> dispatcher;  // make_dispatcher's with contacts
-  std::unique_ptr<btDbvtBroadphase> broadphase;
-  std::unique_ptr<btDantzigSolver> dantzig;
-  std::unique_ptr<btMultiBodyConstraintSolver> solver;
-  std::unique_ptr<btMultiBodyDynamicsWorld> world;
+// The dispatcher is make_dispatcher's with contacts.
+struct MbWorld : Pipeline<btMultiBodyConstraintSolver, btMultiBodyDynamicsWorld> {
   std::unique_ptr<btSphereShape> shape;
   UrdfMultiBody mb;
   int nb = 0;                 // the floating base's coordinates (6), first in q; else 0
@@ -151,8 +147,8 @@ std::unique_ptr<MbWorld> make_world(const scene::Scene& setup, const WorldSettin
     w->dispatcher = make_dispatcher(w->config.get(), s.contact_threshold);
   w->broadphase = std::make_unique<btDbvtBroadphase>();
   if (s.multibody_mlcp) {
-    w->dantzig = std::make_unique<btDantzigSolver>();
-    w->solver = std::make_unique<btMultiBodyMLCPConstraintSolver>(w->dantzig.get());
+    w->mlcp = std::make_unique<btDantzigSolver>();
+    w->solver = std::make_unique<btMultiBodyMLCPConstraintSolver>(w->mlcp.get());
   } else {
     w->solver = std::make_unique<btMultiBodyConstraintSolver>();
   }

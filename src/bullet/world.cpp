@@ -55,6 +55,7 @@
 #include <utility>
 
 #include "bullet/multibody_scene.hpp"
+#include "bullet/pipeline.hpp"
 #include "bullet/run_recorder.hpp"
 #include "bullet/step_loop.hpp"
 
@@ -151,13 +152,8 @@ using TransposeQR = Eigen::SparseQR<mech::SparseMatrix, Eigen::COLAMDOrdering<in
 // The Bullet world (the step loop's calls, step_loop.hpp, just before
 // simulate_rb6: the model's forces, Bullet's step, the multipliers from the
 // momentum balance); members in construction order so that destruction
-// runs constraints -> bodies -> world -> solver -> ... .
-struct World {
-  std::unique_ptr<btDefaultCollisionConfiguration> config;
-  std::unique_ptr<btCollisionDispatcher> dispatcher;
-  std::unique_ptr<btDbvtBroadphase> broadphase;
-  std::unique_ptr<btSequentialImpulseConstraintSolver> solver;
-  std::unique_ptr<btDiscreteDynamicsWorld> world;
+// runs constraints -> bodies, then the Pipeline's world -> solver -> ... .
+struct World : Pipeline<btSequentialImpulseConstraintSolver, btDiscreteDynamicsWorld> {
   std::unique_ptr<btSphereShape> shape;
   std::vector<std::unique_ptr<btRigidBody>> bodies;
   std::vector<std::unique_ptr<btGeneric6DofSpring2Constraint>> constraints;
