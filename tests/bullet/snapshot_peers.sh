@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
-# Snapshot of every Bullet run the project ships, for a refactoring of
-# src/bullet that must keep Bullet's behaviour byte for byte: for each model
+# Snapshot of every peer run (Bullet, MuJoCo) the project ships, for a
+# refactoring of src/bullet or src/mujoco that must keep the peers' behaviour
+# byte for byte: for each model
 # and scene in robots/ (lcp_example is an LCP, not a model), `simulate
 # --method bullet` (JSON less wall_time_s, and the CSV of --out) and `compare
 # --peer bullet` (JSON less timings, and the peer's samples of --peer-out) with
 # each of Bullet's friction models (cone, box, one-direction), and once more
 # with stop ERP 1 and 20 solver iterations (the rb6 limits' and the solvers'
-# settings). examples/ holds no model files (its YAML files are studies).
+# settings); `compare --peer mujoco` with each of MuJoCo's cones (pyramidal,
+# elliptic). examples/ holds no model files (its YAML files are studies).
 #
-#   tests/bullet/snapshot_bullet.sh LCSIM_BINARY OUT_DIR   # one snapshot
+#   tests/bullet/snapshot_peers.sh LCSIM_BINARY OUT_DIR    # one snapshot
 #   diff -r OUT_BEFORE OUT_AFTER                           # compare two
 #
 # A command that refuses a model (exit 2) or fails (exit 3) is recorded with
@@ -32,10 +34,14 @@ for model in robots/*.yaml; do
   done
   run "$m.compare.erp1.json" "$bin" compare "$model" --peer bullet --json --stop-erp 1 \
     --iterations 20 --peer-out "$out/$m.compare.erp1.csv"
+  for cone in pyramidal elliptic; do
+    run "$m.mujoco.$cone.json" "$bin" compare "$model" --peer mujoco --json --mujoco-cone "$cone" \
+      --peer-out "$out/$m.mujoco.$cone.csv"
+  done
 done
 # Each refused or failed command: its file, exit status and first line.
 for err in "$out"/*.err; do
   status=$(tail -1 "$err")
   [ "$status" != "exit 0" ] && echo "$(basename "$err" .err): $status: $(head -1 "$err")"
 done >"$out/refused.txt"
-echo "snapshot_bullet: $(ls "$out" | wc -l) files in $out, $(grep -c . "$out/refused.txt") refused"
+echo "snapshot_peers: $(ls "$out" | wc -l) files in $out, $(grep -c . "$out/refused.txt") refused"
