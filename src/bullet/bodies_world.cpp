@@ -47,11 +47,15 @@
 #include <lcsim/scene/bodies.hpp>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <stdexcept>
+#include <utility>
 
 #include "bullet/multibody_scene.hpp"
+#include "bullet/pipeline.hpp"
 #include "bullet/run_recorder.hpp"
+#include "bullet/step_loop.hpp"
 #include "bullet/urdf_multibody.hpp"
 
 namespace lcsim::bullet {
@@ -103,13 +107,9 @@ struct Placed {
 };
 
 // Members in construction order: destruction runs limits -> colliders ->
-// multibodies -> world -> solver (the destructor removes them first).
-struct BodiesWorld {
-  std::unique_ptr<btDefaultCollisionConfiguration> config;
-  std::unique_ptr<btCollisionDispatcher> dispatcher;
-  std::unique_ptr<btDbvtBroadphase> broadphase;
-  std::unique_ptr<btMultiBodyConstraintSolver> solver;
-  std::unique_ptr<btMultiBodyDynamicsWorld> world;
+// multibodies, then the Pipeline's world -> solver -> ... (the destructor
+// removes them from the world first).
+struct BodiesWorld : Pipeline<btMultiBodyConstraintSolver, btMultiBodyDynamicsWorld> {
   PairFilter filter;
   std::vector<Part> parts;
   std::vector<std::unique_ptr<btCollisionShape>> shapes;
@@ -118,7 +118,9 @@ struct BodiesWorld {
   std::map<const btCollisionObject*, int> row_of;  // a contact point's collider -> its row
   std::vector<std::unique_ptr<btMultiBodyJointLimitConstraint>> limits;
   std::vector<JointLimit> limit_rows;
-  std::vector<Vector3d> row_t1, row_t2;  // each row's world tangents (scene::ContactFrame)
+  std::vector<Vector3d> row_t1, row_t2;     // each row's world tangents (scene::ContactFrame)
+  SceneForces torques;                      // tau = f_s - K_s q - D v
+  std::optional<scene::Bodies> kinematics;  // the scene's, where the colliders are placed
   ~BodiesWorld() {
     for (auto& c : limits) world->removeMultiBodyConstraint(c.get());
     for (auto& o : objects) world->removeCollisionObject(o.get());
@@ -149,12 +151,7 @@ void set_state(BodiesWorld& w, const VectorXd& q, const VectorXd& v) {
       b.setJointPos(link, q(p.offset + c));
       b.setJointVel(link, v(p.offset + c));
     }
-    btAlignedObjectArray<btQuaternion> world_to_local;
-    btAlignedObjectArray<btVector3> local_origin;
-    world_to_local.resize(b.getNumLinks() + 1);
-    local_origin.resize(b.getNumLinks() + 1);
-    b.forwardKinematics(world_to_local, local_origin);
-    b.updateCollisionObjectWorldTransforms(world_to_local, local_origin);
+    place_link_colliders(b);
   }
 }
 
@@ -281,15 +278,7 @@ void add_bodies(BodiesWorld& w, const scene::Scene& setup, const std::vector<Joi
     p.base = sb.base;
     if (p.size > 0) {
       p.mb = build_urdf_multibody(*sb.urdf, sb.joints, sb.q0, sb.base);
-      btMultiBody& b = *p.mb.body;
-      b.setLinearDamping(0);
-      b.setAngularDamping(0);
-      b.setUseGyroTerm(true);
-      b.setMaxCoordinateVelocity(1e30);
-      b.setCanSleep(false);
-      b.setHasSelfCollision(false);
-      b.useGlobalVelocities(false);
-      w.world->addMultiBody(&b, btBroadphaseProxy::DefaultFilter, 0);
+      add_pinned_multibody(*w.world, *p.mb.body);
     }
     w.parts.push_back(std::move(p));
   }
@@ -311,14 +300,7 @@ void add_bodies(BodiesWorld& w, const scene::Scene& setup, const std::vector<Joi
   }
   for (const JointLimit& L : limits) {
     const auto [part, link] = link_of(w, L.coordinate);
-    const double lo = L.lower ? L.bound : L.bound - s.limit_range;
-    const double hi = L.lower ? L.bound + s.limit_range : L.bound;
-    auto c = std::make_unique<btMultiBodyJointLimitConstraint>(w.parts[part].mb.body.get(), link,
-                                                               lo, hi);
-    c->finalizeMultiDof();
-    c->setMaxAppliedImpulse(s.limit_max_impulse);
-    w.world->addMultiBodyConstraint(c.get());
-    w.limits.push_back(std::move(c));
+    w.limits.push_back(add_joint_limit(*w.world, w.parts[part].mb.body.get(), link, L, s));
     w.limit_rows.push_back(L);
   }
 }
@@ -342,8 +324,8 @@ std::unique_ptr<BodiesWorld> build(const scene::Scene& setup, const mech::Mechan
 
 // One step of length h under the generalised forces tau from q: the state
 // it reached.
-void step(BodiesWorld& w, const scene::Bodies& bodies, const VectorXd& q, const VectorXd& tau,
-          double h, VectorXd& q_next, VectorXd& v_next) {
+void take_step(BodiesWorld& w, const VectorXd& q, const VectorXd& tau, double h, VectorXd& q_next,
+               VectorXd& v_next) {
   for (Part& p : w.parts) {
     if (!p.moving()) continue;
     btMultiBody& b = *p.mb.body;
@@ -352,11 +334,8 @@ void step(BodiesWorld& w, const scene::Bodies& bodies, const VectorXd& q, const 
     for (int c = p.nb; c < p.size; ++c)
       b.addJointTorque(p.mb.link[static_cast<std::size_t>(c - p.nb)], tau(p.offset + c));
   }
-  for (auto& c : w.limits) {
-    c->internalSetAppliedImpulse(0, 0.0);
-    c->internalSetAppliedImpulse(1, 0.0);
-  }
-  place_colliders(w, bodies, q);
+  reset_limit_impulses(w.limits);
+  place_colliders(w, *w.kinematics, q);
   w.world->stepSimulation(h, 0, h);  // exactly one step of length h
   q_next = q;
   v_next.setZero();
@@ -377,7 +356,8 @@ void step(BodiesWorld& w, const scene::Bodies& bodies, const VectorXd& q, const 
 // contact point along the row's tangents t1, t2 (scene::ContactFrame).
 // Bullet's friction impulses act on body A along its friction directions
 // and on body B against them; m_normalWorldOnB points from B to A.
-void impulses(BodiesWorld& w, VectorXd& normal, VectorXd& t1, VectorXd& t2) {
+bool step_impulses(BodiesWorld& w, const StepTaken& /*taken*/, VectorXd& normal, VectorXd& t1,
+                   VectorXd& t2) {
   normal.setZero();
   t1.setZero();
   t2.setZero();
@@ -404,6 +384,12 @@ void impulses(BodiesWorld& w, VectorXd& normal, VectorXd& t1, VectorXd& t2) {
     const JointLimit& L = w.limit_rows[i];
     normal(L.row) = w.limits[i]->getAppliedImpulse(L.lower ? 0 : 1) / std::abs(L.c);
   }
+  return true;  // friction along t1, t2 (zero where no contact has friction)
+}
+
+// The scene's own torques (SceneForces).
+void step_forces(BodiesWorld& w, const VectorXd& q, const VectorXd& v, VectorXd& tau) {
+  tau = w.torques.f_s - w.torques.K_s * q - w.torques.D * v;
 }
 
 }  // namespace
@@ -443,58 +429,26 @@ std::string bodies_description(const WorldSettings& s, bool friction) {
          "filter letting only the scene's pairs collide";
 }
 
-// It is one piece: the step loop's stages (forces, step, impulses, record)
-// share the run's state and read in order, as simulate_multibody's.
 sim::Trajectory simulate_bodies(const mech::Model& model, const scene::Scene& setup,
                                 const std::vector<JointLimit>& limits, const VectorXd& x0,
                                 const sim::Options& opt, const WorldSettings& s) {
-  sim::Trajectory tr;
   const mech::MechanicalModel& m = *model.mechanical;
-  tr.method = "bullet " + bodies_description(s, m.has_friction());
+  sim::Trajectory tr = started_run("bullet " + bodies_description(s, m.has_friction()), x0, opt);
   tr.dynamics = "the URDFs' nonlinear multibodies (Bullet)";
-  tr.t_end = *opt.t_end;
-  tr.final_state = x0;
-  auto fail = [&](const std::string& msg) {
-    tr.status = sim::RunStatus::kNumericalFailure;
-    tr.message = msg;
-    return std::move(tr);
-  };
-  const int N = m.dofs(), k = m.num_constraints();
+  const int N = m.dofs();
   warn_explicit_damping(tr, m, opt.h, "joint torques");
-  const SceneForces forces = scene_forces(setup, m);
-  const MatrixXd &K_s = forces.K_s, &D = forces.D;
-  const VectorXd& f_s = forces.f_s;
-  VectorXd q = x0.head(N), v = x0.tail(N);
-  const scene::Bodies bodies = scene::scene_bodies(setup);
+  SceneForces forces = scene_forces(setup, m);
+  scene::Bodies bodies = scene::scene_bodies(setup);
   std::unique_ptr<BodiesWorld> w;
   try {
     w = build(setup, m, limits, s);
-    set_state(*w, q, v);
+    set_state(*w, x0.head(N), x0.tail(N));
   } catch (const std::exception& e) {
-    return fail(std::string("bullet: ") + e.what());
+    return failed_run(std::move(tr), std::string("bullet: ") + e.what());
   }
-  RunRecorder rec(model, opt, tr, q, v, m.has_friction());
-  const sim::StepGrid grid = sim::StepGrid::of(*opt.t_end, opt.h);
-  VectorXd tau(N), q_next(N), v_next(N), impulse(k), t1(k), t2(k);
-  for (long j = 1; j <= grid.n; ++j) {
-    const bool last = j == grid.n;
-    if (opt.progress && j % sim::Options::kProgressSteps == 0) opt.progress(j * opt.h);
-    const double h = last ? grid.h_last : grid.h;
-    tau = f_s - K_s * q - D * v;
-    step(*w, bodies, q, tau, h, q_next, v_next);
-    impulses(*w, impulse, t1, t2);
-    rec.friction(t1, t2);
-    const double tiny =
-        1e-10 * (1.0 + (m.M * v).cwiseAbs().maxCoeff() + h * tau.cwiseAbs().maxCoeff());
-    if (std::string why =
-            rec.step(last ? *opt.t_end : j * opt.h, h, last, q_next, v_next, impulse, tiny);
-        !why.empty())
-      return fail("bullet: " + why);
-    q = q_next;
-    v = v_next;
-  }
-  rec.finish();
-  return tr;
+  w->torques = std::move(forces);
+  w->kinematics.emplace(std::move(bodies));
+  return run_steps(*w, model, x0, opt, std::move(tr), m.has_friction());
 }
 
 }  // namespace lcsim::bullet

@@ -70,6 +70,8 @@
 #include <memory>
 #include <string>
 
+#include "bullet/pipeline.hpp"
+
 namespace lcsim::bullet {
 
 namespace {
@@ -77,14 +79,9 @@ namespace {
 // btBoxShape's collision margin (Bullet's default, CONVEX_DISTANCE_MARGIN).
 constexpr double kBoxMargin = 0.04;
 
-// Members in construction order, so that destruction runs bodies -> world ->
-// solver -> broadphase -> dispatcher -> config.
-struct BoxWorld {
-  std::unique_ptr<btDefaultCollisionConfiguration> config;
-  std::unique_ptr<btCollisionDispatcher> dispatcher;
-  std::unique_ptr<btDbvtBroadphase> broadphase;
-  std::unique_ptr<btSequentialImpulseConstraintSolver> solver;
-  std::unique_ptr<btDiscreteDynamicsWorld> world;
+// Members in construction order, so that destruction runs bodies, then the
+// Pipeline's world -> solver -> broadphase -> dispatcher -> config.
+struct BoxWorld : Pipeline<btSequentialImpulseConstraintSolver, btDiscreteDynamicsWorld> {
   std::unique_ptr<btStaticPlaneShape> plane_shape;
   std::unique_ptr<btBoxShape> box_shape;
   std::unique_ptr<btRigidBody> plane, box;

@@ -197,8 +197,14 @@ ContactColliders make_contact_colliders(const scene::Scene& setup, const UrdfMul
   return out;
 }
 
-void contact_impulses(btCollisionDispatcher& d, const ContactColliders& c,
-                      Eigen::VectorXd& impulse) {
+namespace {
+
+// Calls visit(row, pt, sign) for each contact point of the dispatcher's
+// manifolds between one link collider and another object that is a row of
+// E in c (by the link's compound child), manifold by manifold: sign is 1
+// when the link is the manifold's body A, -1 when it is body B.
+template <class Visit>
+void for_each_contact_row(btCollisionDispatcher& d, const ContactColliders& c, Visit visit) {
   for (int i = 0; i < d.getNumManifolds(); ++i) {
     const btPersistentManifold* pm = d.getManifoldByIndexInternal(i);
     const auto* l0 = btMultiBodyLinkCollider::upcast(pm->getBody0());
@@ -207,34 +213,31 @@ void contact_impulses(btCollisionDispatcher& d, const ContactColliders& c,
     if (!link || (l0 && l1)) continue;
     for (int j = 0; j < pm->getNumContacts(); ++j) {
       const btManifoldPoint& pt = pm->getContactPoint(j);
-      const int child = l0 ? pt.m_index0 : pt.m_index1;
-      const auto row = c.row_of.find({link->m_link, child});
-      if (row != c.row_of.end()) impulse(row->second) += pt.m_appliedImpulse;
+      const auto row = c.row_of.find({link->m_link, l0 ? pt.m_index0 : pt.m_index1});
+      if (row != c.row_of.end()) visit(row->second, pt, l0 ? 1.0 : -1.0);
     }
   }
+}
+
+}  // namespace
+
+void contact_impulses(btCollisionDispatcher& d, const ContactColliders& c,
+                      Eigen::VectorXd& impulse) {
+  for_each_contact_row(d, c, [&](int row, const btManifoldPoint& pt, double /*sign*/) {
+    impulse(row) += pt.m_appliedImpulse;
+  });
 }
 
 void contact_friction_impulses(btCollisionDispatcher& d, const ContactColliders& c,
                                Eigen::VectorXd& t1, Eigen::VectorXd& t2) {
   t1.setZero();
   t2.setZero();
-  for (int i = 0; i < d.getNumManifolds(); ++i) {
-    const btPersistentManifold* pm = d.getManifoldByIndexInternal(i);
-    const auto* l0 = btMultiBodyLinkCollider::upcast(pm->getBody0());
-    const auto* l1 = btMultiBodyLinkCollider::upcast(pm->getBody1());
-    const btMultiBodyLinkCollider* link = l0 ? l0 : l1;
-    if (!link || (l0 && l1)) continue;
-    const double sign = l0 ? 1.0 : -1.0;  // the link is body A, or B
-    for (int j = 0; j < pm->getNumContacts(); ++j) {
-      const btManifoldPoint& pt = pm->getContactPoint(j);
-      const auto row = c.row_of.find({link->m_link, l0 ? pt.m_index0 : pt.m_index1});
-      if (row == c.row_of.end()) continue;
-      const Vector3d f = sign * (pt.m_appliedImpulseLateral1 * eig(pt.m_lateralFrictionDir1) +
-                                 pt.m_appliedImpulseLateral2 * eig(pt.m_lateralFrictionDir2));
-      t1(row->second) += c.t1_of.at(row->second).dot(f);
-      t2(row->second) += c.t2_of.at(row->second).dot(f);
-    }
-  }
+  for_each_contact_row(d, c, [&](int row, const btManifoldPoint& pt, double sign) {
+    const Vector3d f = sign * (pt.m_appliedImpulseLateral1 * eig(pt.m_lateralFrictionDir1) +
+                               pt.m_appliedImpulseLateral2 * eig(pt.m_lateralFrictionDir2));
+    t1(row) += c.t1_of.at(row).dot(f);
+    t2(row) += c.t2_of.at(row).dot(f);
+  });
 }
 
 std::unique_ptr<btCollisionDispatcher> make_dispatcher(btCollisionConfiguration* config,

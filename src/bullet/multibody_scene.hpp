@@ -13,6 +13,10 @@
 #include <string>
 #include <vector>
 
+class btMultiBody;
+class btMultiBodyDynamicsWorld;
+class btMultiBodyJointLimitConstraint;
+
 namespace lcsim::bullet {
 
 // Row `row` of E, c q_j + g >= 0 with j = coordinate: the bound -g/c on q_j
@@ -58,6 +62,27 @@ sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene&
 // early exit, slop 0, warm starting without the articulated one, and with
 // `friction` WorldSettings::friction's flags.
 void pin_solver_info(btContactSolverInfo& info, const WorldSettings& s, bool friction);
+
+// Adds b to `world` colliding with nothing (mask 0), with the settings both
+// multibody scenes pin (multibody_world.cpp's header): damping 0, the
+// gyroscopic term, max coordinate velocity 1e30, no sleeping, no
+// self-collision, local velocities.
+void add_pinned_multibody(btMultiBodyDynamicsWorld& world, btMultiBody& b);
+// Places b's link colliders at its joint positions (Bullet's forward
+// kinematics), as after a step.
+void place_link_colliders(btMultiBody& b);
+// Adds the btMultiBodyJointLimitConstraint of L on Bullet link `link` of b to
+// `world`: the bound on its side, the other side limit_range away, max
+// impulse limit_max_impulse.
+std::unique_ptr<btMultiBodyJointLimitConstraint> add_joint_limit(btMultiBodyDynamicsWorld& world,
+                                                                 btMultiBody* b, int link,
+                                                                 const JointLimit& L,
+                                                                 const WorldSettings& s);
+// Zeroes both rows' applied impulses of each limit before a step: a limit
+// row exists only in steps that start at or past its bound, and its impulse
+// from an earlier step would otherwise be read again.
+void reset_limit_impulses(
+    const std::vector<std::unique_ptr<btMultiBodyJointLimitConstraint>>& limits);
 
 // ---- A scene of several bodies (bodies_world.cpp) ----
 

@@ -55,9 +55,12 @@
 #include <lcsim/scene/scene.hpp>
 #include <memory>
 #include <stdexcept>
+#include <utility>
 
 #include "bullet/multibody_scene.hpp"
+#include "bullet/pipeline.hpp"
 #include "bullet/run_recorder.hpp"
+#include "bullet/step_loop.hpp"
 #include "bullet/urdf_multibody.hpp"
 
 namespace lcsim::bullet {
@@ -88,15 +91,11 @@ std::vector<FollowingMimic> following_mimics(const scene::Scene& setup,
   return out;
 }
 
-// Members in construction order, so that destruction runs limits ->
-// colliders -> multibody -> world -> solvers.
-struct MbWorld {
-  std::unique_ptr<btDefaultCollisionConfiguration> config;
-  std::unique_ptr<btCollisionDispatcher> dispatcher;  // make_dispatcher's with contacts
-  std::unique_ptr<btDbvtBroadphase> broadphase;
-  std::unique_ptr<btDantzigSolver> dantzig;
-  std::unique_ptr<btMultiBodyConstraintSolver> solver;
-  std::unique_ptr<btMultiBodyDynamicsWorld> world;
+// The multibody's world (the step loop's calls, step_loop.hpp, are
+// take_step and the two beside it); members in construction order, so that
+// destruction runs limits -> colliders -> multibody -> world -> solvers.
+// The dispatcher is make_dispatcher's with contacts.
+struct MbWorld : Pipeline<btMultiBodyConstraintSolver, btMultiBodyDynamicsWorld> {
   std::unique_ptr<btSphereShape> shape;
   UrdfMultiBody mb;
   int nb = 0;                 // the floating base's coordinates (6), first in q; else 0
@@ -107,6 +106,8 @@ struct MbWorld {
   std::vector<std::unique_ptr<btMultiBodyJointLimitConstraint>> limits;
   std::vector<FollowingMimic> mimics;
   std::vector<std::unique_ptr<btMultiBodyGearConstraint>> gears;  // one per mimic
+  std::vector<JointLimit> limit_rows;                             // limits[i]'s row of E
+  SceneForces torques;                                            // tau = f_s - K_s q - D v
   ~MbWorld() {
     for (auto& c : gears) world->removeMultiBodyConstraint(c.get());
     for (auto& c : limits) world->removeMultiBodyConstraint(c.get());
@@ -131,12 +132,7 @@ void set_state(MbWorld& w, const VectorXd& q, const VectorXd& v) {
     b.setJointPos(f.link, f.a * q(w.nb + f.leader) + f.b);
     b.setJointVel(f.link, f.a * v(w.nb + f.leader));
   }
-  btAlignedObjectArray<btQuaternion> world_to_local;
-  btAlignedObjectArray<btVector3> local_origin;
-  world_to_local.resize(b.getNumLinks() + 1);
-  local_origin.resize(b.getNumLinks() + 1);
-  b.forwardKinematics(world_to_local, local_origin);
-  b.updateCollisionObjectWorldTransforms(world_to_local, local_origin);
+  place_link_colliders(b);
 }
 
 // An empty world with the scene's gravity and the pinned settings (the
@@ -151,8 +147,8 @@ std::unique_ptr<MbWorld> make_world(const scene::Scene& setup, const WorldSettin
     w->dispatcher = make_dispatcher(w->config.get(), s.contact_threshold);
   w->broadphase = std::make_unique<btDbvtBroadphase>();
   if (s.multibody_mlcp) {
-    w->dantzig = std::make_unique<btDantzigSolver>();
-    w->solver = std::make_unique<btMultiBodyMLCPConstraintSolver>(w->dantzig.get());
+    w->mlcp = std::make_unique<btDantzigSolver>();
+    w->solver = std::make_unique<btMultiBodyMLCPConstraintSolver>(w->mlcp.get());
   } else {
     w->solver = std::make_unique<btMultiBodyConstraintSolver>();
   }
@@ -201,14 +197,7 @@ void add_multibody(MbWorld& w, const scene::Scene& setup, const mech::Mechanical
   for (std::size_t i = 0; i < w.mimics.size(); ++i) w.mimics[i].link = w.mb.link[joints.size() + i];
   w.contacts = make_contact_colliders(setup, w.mb, m);
   btMultiBody& b = *w.mb.body;
-  b.setLinearDamping(0);
-  b.setAngularDamping(0);
-  b.setUseGyroTerm(true);
-  b.setMaxCoordinateVelocity(1e30);
-  b.setCanSleep(false);
-  b.setHasSelfCollision(false);
-  b.useGlobalVelocities(false);
-  w.world->addMultiBody(&b, btBroadphaseProxy::DefaultFilter, 0);
+  add_pinned_multibody(*w.world, b);
   w.shape = std::make_unique<btSphereShape>(0.01);
   w.shape->setMargin(0.0);
   if (w.contacts.shape_of.count(-1) > 0) {
@@ -242,20 +231,11 @@ void add_gears(MbWorld& w) {
   }
 }
 
-// One btMultiBodyJointLimitConstraint per joint limit: the bound on its side,
-// the other side limit_range away.
+// One btMultiBodyJointLimitConstraint per joint limit.
 void add_limits(MbWorld& w, const std::vector<JointLimit>& limits, const WorldSettings& s) {
   for (const JointLimit& L : limits) {
-    const double lo = L.lower ? L.bound : L.bound - s.limit_range;
-    const double hi = L.lower ? L.bound + s.limit_range : L.bound;
-    auto c = std::make_unique<btMultiBodyJointLimitConstraint>(w.mb.body.get(),
-                                                               link_of(w, L.coordinate), lo, hi);
-    // Allocates the rows' storage (else done lazily in the first step, after
-    // simulate_multibody has reset the applied impulses).
-    c->finalizeMultiDof();
-    c->setMaxAppliedImpulse(s.limit_max_impulse);
-    w.world->addMultiBodyConstraint(c.get());
-    w.limits.push_back(std::move(c));
+    w.limits.push_back(add_joint_limit(*w.world, w.mb.body.get(), link_of(w, L.coordinate), L, s));
+    w.limit_rows.push_back(L);
   }
 }
 
@@ -301,18 +281,13 @@ void warn(sim::Trajectory& tr, const mech::MechanicalModel& m, const MatrixXd& K
 // One Bullet step of length h under the generalised forces tau (joint
 // torques; a floating base's six as its force and torque) from the state q;
 // the state it reached.
-void step(MbWorld& w, const VectorXd& q, const VectorXd& tau, double h, VectorXd& q_next,
-          VectorXd& v_next) {
+void take_step(MbWorld& w, const VectorXd& q, const VectorXd& tau, double h, VectorXd& q_next,
+               VectorXd& v_next) {
   btMultiBody& b = *w.mb.body;
   const auto N = static_cast<int>(tau.size());
   if (w.nb > 0) add_floating_base_force(b, w.mb, w.base, q.head<6>(), tau.head<6>());
   for (int c = w.nb; c < N; ++c) b.addJointTorque(link_of(w, c), tau(c));
-  // A limit row exists only in steps that start at or past its bound;
-  // its impulse from an earlier step would otherwise be read again.
-  for (auto& c : w.limits) {
-    c->internalSetAppliedImpulse(0, 0.0);
-    c->internalSetAppliedImpulse(1, 0.0);
-  }
+  reset_limit_impulses(w.limits);
   // maxSubSteps = 0: exactly one step of length h (no interpolation).
   w.world->stepSimulation(h, 0, h);
   if (w.nb > 0) get_floating_base(b, w.mb, w.base, q_next.head<6>(), v_next.head<6>());
@@ -322,17 +297,26 @@ void step(MbWorld& w, const VectorXd& q, const VectorXd& tau, double h, VectorXd
   }
 }
 
+// The scene's own torques (SceneForces).
+void step_forces(MbWorld& w, const VectorXd& q, const VectorXd& v, VectorXd& tau) {
+  tau = w.torques.f_s - w.torques.K_s * q - w.torques.D * v;
+}
+
 // The step's impulses by row of E. Row 0 of a limit pushes +q (the lower
 // bound), row 1 -q; lcsim's row is c e_j, so the impulse P on the joint is
-// |c| h u.
-void limit_impulses(MbWorld& w, const std::vector<JointLimit>& limits, VectorXd& impulse) {
+// |c| h u. With friction, each contact's friction along its tangents.
+bool step_impulses(MbWorld& w, const StepTaken& /*taken*/, VectorXd& impulse, VectorXd& t1,
+                   VectorXd& t2) {
   if (w.contacts.rows > 0) {
     impulse.setZero();
     contact_impulses(*w.dispatcher, w.contacts, impulse);
   }
-  for (std::size_t i = 0; i < limits.size(); ++i)
-    impulse(limits[i].row) =
-        w.limits[i]->getAppliedImpulse(limits[i].lower ? 0 : 1) / std::abs(limits[i].c);
+  for (std::size_t i = 0; i < w.limit_rows.size(); ++i) {
+    const JointLimit& L = w.limit_rows[i];
+    impulse(L.row) = w.limits[i]->getAppliedImpulse(L.lower ? 0 : 1) / std::abs(L.c);
+  }
+  if (w.contacts.friction) contact_friction_impulses(*w.dispatcher, w.contacts, t1, t2);
+  return w.contacts.friction;
 }
 
 }  // namespace
@@ -351,6 +335,49 @@ void pin_solver_info(btContactSolverInfo& info, const WorldSettings& s, bool fri
     info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
   if (friction && s.friction == WorldSettings::Friction::kBox)
     info.m_solverMode |= SOLVER_DISABLE_IMPLICIT_CONE_FRICTION;
+}
+
+void add_pinned_multibody(btMultiBodyDynamicsWorld& world, btMultiBody& b) {
+  b.setLinearDamping(0);
+  b.setAngularDamping(0);
+  b.setUseGyroTerm(true);
+  b.setMaxCoordinateVelocity(1e30);
+  b.setCanSleep(false);
+  b.setHasSelfCollision(false);
+  b.useGlobalVelocities(false);
+  world.addMultiBody(&b, btBroadphaseProxy::DefaultFilter, 0);
+}
+
+void place_link_colliders(btMultiBody& b) {
+  btAlignedObjectArray<btQuaternion> world_to_local;
+  btAlignedObjectArray<btVector3> local_origin;
+  world_to_local.resize(b.getNumLinks() + 1);
+  local_origin.resize(b.getNumLinks() + 1);
+  b.forwardKinematics(world_to_local, local_origin);
+  b.updateCollisionObjectWorldTransforms(world_to_local, local_origin);
+}
+
+std::unique_ptr<btMultiBodyJointLimitConstraint> add_joint_limit(btMultiBodyDynamicsWorld& world,
+                                                                 btMultiBody* b, int link,
+                                                                 const JointLimit& L,
+                                                                 const WorldSettings& s) {
+  const double lo = L.lower ? L.bound : L.bound - s.limit_range;
+  const double hi = L.lower ? L.bound + s.limit_range : L.bound;
+  auto c = std::make_unique<btMultiBodyJointLimitConstraint>(b, link, lo, hi);
+  // Allocates the rows' storage (else done lazily in the first step, after
+  // the step loop has reset the applied impulses).
+  c->finalizeMultiDof();
+  c->setMaxAppliedImpulse(s.limit_max_impulse);
+  world.addMultiBodyConstraint(c.get());
+  return c;
+}
+
+void reset_limit_impulses(
+    const std::vector<std::unique_ptr<btMultiBodyJointLimitConstraint>>& limits) {
+  for (const auto& c : limits) {
+    c->internalSetAppliedImpulse(0, 0.0);
+    c->internalSetAppliedImpulse(1, 0.0);
+  }
 }
 
 std::vector<JointLimit> joint_limits_of(const mech::MechanicalModel& m, const std::string& source,
@@ -442,58 +469,23 @@ SceneForces scene_forces(const scene::Scene& setup, const mech::MechanicalModel&
 sim::Trajectory simulate_multibody(const mech::Model& model, const scene::Scene& setup,
                                    const std::vector<JointLimit>& limits, const VectorXd& x0,
                                    const sim::Options& opt, const WorldSettings& s) {
-  sim::Trajectory tr;
-  tr.method = "bullet " +
-              multibody_description(s, !setup.contacts.empty(), model.mechanical->has_friction());
+  sim::Trajectory tr =
+      started_run("bullet " + multibody_description(s, !setup.contacts.empty(),
+                                                    model.mechanical->has_friction()),
+                  x0, opt);
   tr.dynamics = "the URDF's nonlinear multibody (Bullet)";
-  tr.t_end = *opt.t_end;
-  tr.final_state = x0;
-  auto fail = [&](const std::string& msg) {
-    tr.status = sim::RunStatus::kNumericalFailure;
-    tr.message = msg;
-    return std::move(tr);  // only ever returned from the run: no copy of the samples
-  };
   const mech::MechanicalModel& m = *model.mechanical;
-  const int N = m.dofs(), k = m.num_constraints();
-
-  const SceneForces forces = scene_forces(setup, m);
-  const MatrixXd &K_s = forces.K_s, &D = forces.D;
-  const VectorXd& f_s = forces.f_s;
-  warn(tr, m, K_s, opt, limits);
-
-  VectorXd q = x0.head(N), v = x0.tail(N);
+  const int N = m.dofs();
+  SceneForces forces = scene_forces(setup, m);
+  warn(tr, m, forces.K_s, opt, limits);
   std::unique_ptr<MbWorld> w;
   try {
-    w = build(setup, m, limits, q, v, s);
+    w = build(setup, m, limits, x0.head(N), x0.tail(N), s);
   } catch (const std::exception& e) {
-    return fail(std::string("bullet: ") + e.what());
+    return failed_run(std::move(tr), std::string("bullet: ") + e.what());
   }
-  RunRecorder rec(model, opt, tr, q, v, w->contacts.friction);
-  const sim::StepGrid grid = sim::StepGrid::of(*opt.t_end, opt.h);
-  VectorXd tau(N), q_next(N), v_next(N), impulse(k), t1(k), t2(k);
-  for (long j = 1; j <= grid.n; ++j) {
-    const bool last = j == grid.n;
-    if (opt.progress && j % sim::Options::kProgressSteps == 0) opt.progress(j * opt.h);
-    const double h = last ? grid.h_last : grid.h;
-    tau = f_s - K_s * q - D * v;
-    step(*w, q, tau, h, q_next, v_next);
-    limit_impulses(*w, limits, impulse);
-    if (w->contacts.friction) {  // each contact's friction along its tangents
-      contact_friction_impulses(*w->dispatcher, w->contacts, t1, t2);
-      rec.friction(t1, t2);
-    }
-    // Round-off in an impulse is ~1e-16 of the momentum; real ones are O(h).
-    const double tiny =
-        1e-10 * (1.0 + (m.M * v).cwiseAbs().maxCoeff() + h * tau.cwiseAbs().maxCoeff());
-    if (std::string why =
-            rec.step(last ? *opt.t_end : j * opt.h, h, last, q_next, v_next, impulse, tiny);
-        !why.empty())
-      return fail("bullet: " + why);
-    q = q_next;
-    v = v_next;
-  }
-  rec.finish();
-  return tr;
+  w->torques = std::move(forces);
+  return run_steps(*w, model, x0, opt, std::move(tr), w->contacts.friction);
 }
 
 }  // namespace lcsim::bullet

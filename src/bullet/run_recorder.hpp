@@ -1,6 +1,7 @@
-// Internal to src/bullet: what both Bullet scenes (the rigid bodies of
-// world.cpp, the multibody of multibody_world.cpp) report after each step,
-// so that both fill the same sim::Trajectory in the same way.
+// Internal to src/bullet: what the Bullet scenes (the rigid bodies of
+// world.cpp, the multibody of multibody_world.cpp, the scene of bodies of
+// bodies_world.cpp) report after each step, through their one step loop
+// (step_loop.hpp), so that all fill the same sim::Trajectory in the same way.
 #pragma once
 
 #include <Eigen/Dense>

@@ -55,7 +55,9 @@
 #include <utility>
 
 #include "bullet/multibody_scene.hpp"
+#include "bullet/pipeline.hpp"
 #include "bullet/run_recorder.hpp"
+#include "bullet/step_loop.hpp"
 
 namespace lcsim::bullet {
 
@@ -139,17 +141,24 @@ std::vector<Limit> limits_of(const mech::Model& model, double range) {
   return out;
 }
 
-// The Bullet world; members in construction order so that destruction runs
-// constraints -> bodies -> world -> solver -> ... .
-struct World {
-  std::unique_ptr<btDefaultCollisionConfiguration> config;
-  std::unique_ptr<btCollisionDispatcher> dispatcher;
-  std::unique_ptr<btDbvtBroadphase> broadphase;
-  std::unique_ptr<btSequentialImpulseConstraintSolver> solver;
-  std::unique_ptr<btDiscreteDynamicsWorld> world;
+// Multipliers from the momentum balance M (v+ - v) = h F + E' (h u):
+// h u = least-squares solution of E' x = M (v+ - v) - h F, exact when E has
+// full row rank (with dependent rows, one basic solution: the split of an
+// impulse among them is not unique). A sparse QR of E' (O(nnz) per step
+// for a chain); the dense decomposition it replaces cost O(N k) per step
+// and O(N k^2) to set up, and was most of the "Bullet" time at N = 1000.
+using TransposeQR = Eigen::SparseQR<mech::SparseMatrix, Eigen::COLAMDOrdering<int>>;
+
+// The Bullet world (the step loop's calls, step_loop.hpp, just before
+// simulate_rb6: the model's forces, Bullet's step, the multipliers from the
+// momentum balance); members in construction order so that destruction
+// runs constraints -> bodies, then the Pipeline's world -> solver -> ... .
+struct World : Pipeline<btSequentialImpulseConstraintSolver, btDiscreteDynamicsWorld> {
   std::unique_ptr<btSphereShape> shape;
   std::vector<std::unique_ptr<btRigidBody>> bodies;
   std::vector<std::unique_ptr<btGeneric6DofSpring2Constraint>> constraints;
+  const mech::MechanicalModel* m = nullptr;  // the model the world is built from
+  TransposeQR Et;                            // E' factored (factor_transpose)
   ~World() {
     for (auto& c : constraints) world->removeConstraint(c.get());
     for (auto& b : bodies) world->removeRigidBody(b.get());
@@ -383,14 +392,6 @@ void warn_restitution_lost(sim::Trajectory& tr, const mech::MechanicalModel& m,
     }
 }
 
-// Multipliers from the momentum balance M (v+ - v) = h F + E' (h u):
-// h u = least-squares solution of E' x = M (v+ - v) - h F, exact when E has
-// full row rank (with dependent rows, one basic solution: the split of an
-// impulse among them is not unique). A sparse QR of E' (O(nnz) per step
-// for a chain); the dense decomposition it replaces cost O(N k) per step
-// and O(N k^2) to set up, and was most of the "Bullet" time at N = 1000.
-using TransposeQR = Eigen::SparseQR<mech::SparseMatrix, Eigen::COLAMDOrdering<int>>;
-
 // Factors E' into `Et` (nothing without constraints); false if it fails.
 bool factor_transpose(const mech::MechanicalModel& m, TransposeQR& Et) {
   const int N = m.dofs(), k = m.num_constraints();
@@ -402,8 +403,15 @@ bool factor_transpose(const mech::MechanicalModel& m, TransposeQR& Et) {
   return Et.info() == Eigen::Success;
 }
 
+// The step loop's calls (step_loop.hpp).
+
+void step_forces(World& w, const VectorXd& q, const VectorXd& v, VectorXd& F) {
+  F = w.m->f - w.m->K * q - w.m->D * v;
+}
+
 // One Bullet step of length h under the forces F; the state it reached.
-void step(World& w, const VectorXd& F, double h, VectorXd& q_next, VectorXd& v_next) {
+void take_step(World& w, const VectorXd& /*q*/, const VectorXd& F, double h, VectorXd& q_next,
+               VectorXd& v_next) {
   const auto N = static_cast<int>(F.size());
   for (int i = 0; i < N; ++i) w.bodies[i]->applyCentralForce(btVector3(F(i), 0, 0));
   // maxSubSteps = 0: exactly one step of length h (no interpolation).
@@ -414,54 +422,28 @@ void step(World& w, const VectorXd& F, double h, VectorXd& q_next, VectorXd& v_n
   }
 }
 
+// The multipliers of the momentum balance (TransposeQR); no friction.
+bool step_impulses(World& w, const StepTaken& s, VectorXd& impulse, VectorXd& /*t1*/,
+                   VectorXd& /*t2*/) {
+  impulse.setZero();
+  if (w.m->num_constraints() > 0)
+    impulse = w.Et.solve(VectorXd(w.m->M * (s.v_next - s.v) - s.h * s.F));
+  return false;
+}
+
 sim::Trajectory simulate_rb6(const mech::Model& model, const std::vector<Limit>& limits,
                              const VectorXd& x0, const sim::Options& opt, const WorldSettings& s) {
-  sim::Trajectory tr;
-  tr.method = "bullet " + rb6_description(s);
-  tr.t_end = *opt.t_end;
-  tr.final_state = x0;
-  auto fail = [&](const std::string& msg) {
-    tr.status = sim::RunStatus::kNumericalFailure;
-    tr.message = msg;
-    return std::move(tr);  // only ever returned from the run: no copy of the samples
-  };
+  sim::Trajectory tr = started_run("bullet " + rb6_description(s), x0, opt);
   const mech::MechanicalModel& m = *model.mechanical;
-  const int N = m.dofs(), k = m.num_constraints();
-  VectorXd q = x0.head(N), v = x0.tail(N);
+  const int N = m.dofs();
   warn_explicit_damping(tr, m, opt.h, "forces");
   warn_explicit_springs(tr, m, opt.h);
   warn_restitution_lost(tr, m, s);
-
-  // The grid of the time-stepping methods: n steps of h, the last shortened.
-  const sim::StepGrid grid = sim::StepGrid::of(*opt.t_end, opt.h);
-
-  std::unique_ptr<World> w = build(m, limits, q, v, s);
-  TransposeQR Et;
-  if (!factor_transpose(m, Et)) return fail("bullet: cannot factor E' for the multipliers");
-
-  RunRecorder rec(model, opt, tr, q, v);
-  VectorXd F(N), q_next(N), v_next(N);
-  for (long j = 1; j <= grid.n; ++j) {
-    const bool last = j == grid.n;
-    if (opt.progress && j % sim::Options::kProgressSteps == 0) opt.progress(j * opt.h);
-    const double h = last ? grid.h_last : grid.h;
-    F = m.f - m.K * q - m.D * v;
-    step(*w, F, h, q_next, v_next);
-    VectorXd impulse = VectorXd::Zero(k);
-    if (k > 0) impulse = Et.solve(VectorXd(m.M * (v_next - v) - h * F));
-    // Round-off in the momentum balance is ~1e-16 |M v|; impulses of real
-    // contacts are O(h).
-    const double tiny =
-        1e-10 * (1.0 + (m.M * v).cwiseAbs().maxCoeff() + h * F.cwiseAbs().maxCoeff());
-    if (std::string why =
-            rec.step(last ? *opt.t_end : j * opt.h, h, last, q_next, v_next, impulse, tiny);
-        !why.empty())
-      return fail("bullet: " + why);
-    q = q_next;
-    v = v_next;
-  }
-  rec.finish();
-  return tr;
+  std::unique_ptr<World> w = build(m, limits, x0.head(N), x0.tail(N), s);
+  w->m = &m;
+  if (!factor_transpose(m, w->Et))
+    return failed_run(std::move(tr), "bullet: cannot factor E' for the multipliers");
+  return run_steps(*w, model, x0, opt, std::move(tr), false);
 }
 
 }  // namespace

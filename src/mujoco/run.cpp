@@ -38,7 +38,8 @@ struct Run {
   MjModelPtr m;
   MjDataPtr d;
   std::vector<FreeBase> bases;  // one per floating base
-  std::vector<int> qadr, vadr;  // coordinate c -> qpos / qvel address (-1: a base's)
+  std::vector<int> qadr,
+      vadr;  // coordinate c -> qpos / qvel address (-1: a base's)
   MatrixXd K_s, D;
   VectorXd f_s;
   std::vector<int> row_body;        // contact row -> MuJoCo body of its link (-1: none)
@@ -63,6 +64,16 @@ int id_or_throw(const mjModel* m, int type, const std::string& name, const char*
   return id;
 }
 
+// Entry i of a soft constraint's MuJoCo arrays (a pair's, a geom's, a
+// joint's), per Settings: solref the time constant tc and the damping
+// ratio, solimp (dmin, dmax, width, midpoint 0.5, power 2).
+void soften(mjtNum* solref, mjtNum* solimp, int i, double tc, const Settings& s) {
+  solref[2 * i] = tc;
+  solref[2 * i + 1] = s.damping_ratio;
+  const double imp[5] = {s.dmin, s.dmax, s.width, 0.5, 2.0};
+  std::copy(imp, imp + 5, solimp + 5 * i);
+}
+
 // A scene of bodies' contact pairs (mjcf_bodies.cpp: pair i is contact i of
 // setup.contacts): condim 3 with the row's mu (sliding only) or 1, soft as
 // the geoms below, no margin or gap. Its geoms have contype = conaffinity =
@@ -78,10 +89,7 @@ void configure_pairs(Run& r, const scene::Scene& setup, const std::vector<double
     m->pair_dim[p] = mu >= 0.0 ? 3 : 1;
     const double fr[5] = {std::max(mu, 0.0), std::max(mu, 0.0), 0.0, 0.0, 0.0};
     std::copy(fr, fr + 5, m->pair_friction + 5 * p);
-    m->pair_solref[2 * p] = tc;
-    m->pair_solref[2 * p + 1] = s.damping_ratio;
-    const double imp[5] = {s.dmin, s.dmax, s.width, 0.5, 2.0};
-    std::copy(imp, imp + 5, m->pair_solimp + 5 * p);
+    soften(m->pair_solref, m->pair_solimp, p, tc, s);
     m->pair_margin[p] = 0.0;
     m->pair_gap[p] = 0.0;
   }
@@ -99,7 +107,8 @@ void configure(Run& r, const scene::Scene& setup, const mech::MechanicalModel& m
   m->opt.integrator = mjINT_EULER;
   for (int i = 0; i < 3; ++i) m->opt.gravity[i] = setup.gravity(i);
   std::vector<bool> contact_body(static_cast<std::size_t>(m->nbody), false);
-  // Each contact body's mu (check_expressible: one per link), -1 without friction.
+  // Each contact body's mu (check_expressible: one per link), -1 without
+  // friction.
   std::vector<double> body_mu(static_cast<std::size_t>(m->nbody), -1.0);
   std::vector<double> row_mu(static_cast<std::size_t>(mm.num_constraints()), -1.0);
   for (const mech::FrictionalContact& f : mm.friction)
@@ -124,10 +133,7 @@ void configure(Run& r, const scene::Scene& setup, const mech::MechanicalModel& m
     m->geom_conaffinity[g] = plane ? 1 : 0;
     const double mu = body_mu[static_cast<std::size_t>(m->geom_bodyid[g])];
     m->geom_condim[g] = link && mu >= 0.0 ? 3 : 1;
-    m->geom_solref[2 * g] = tc;
-    m->geom_solref[2 * g + 1] = s.damping_ratio;
-    const double imp[5] = {s.dmin, s.dmax, s.width, 0.5, 2.0};
-    std::copy(imp, imp + 5, m->geom_solimp + 5 * g);
+    soften(m->geom_solref, m->geom_solimp, g, tc, s);
     m->geom_margin[g] = 0.0;
     m->geom_gap[g] = 0.0;
     for (int k = 0; k < 3; ++k) m->geom_friction[3 * g + k] = 0.0;
@@ -144,10 +150,7 @@ void configure(Run& r, const scene::Scene& setup, const mech::MechanicalModel& m
     // soft as the contacts; a one-URDF scene's none (MuJoCo's URDF ranges off).
     if (setup.bodies.empty()) m->jnt_limited[j] = 0;
     m->jnt_stiffness[j] = 0.0;
-    m->jnt_solref[2 * j] = tc;
-    m->jnt_solref[2 * j + 1] = s.damping_ratio;
-    const double imp[5] = {s.dmin, s.dmax, s.width, 0.5, 2.0};
-    std::copy(imp, imp + 5, m->jnt_solimp + 5 * j);
+    soften(m->jnt_solref, m->jnt_solimp, j, tc, s);
     m->jnt_margin[j] = 0.0;
   }
 }
@@ -476,7 +479,8 @@ sim::Trajectory simulate_mujoco(const mech::Model& model, const VectorXd& x0,
   for (int i = 0; i < mm.num_constraints(); ++i)
     if (mm.restitution(i) > 0.0) {
       tr.warn("mujoco-restitution-lost", 0.0,
-              "mujoco: restitution is lost: MuJoCo's contacts are damped springs (solref), "
+              "mujoco: restitution is lost: MuJoCo's contacts are damped "
+              "springs (solref), "
               "constraint '" +
                   mm.constraints[static_cast<std::size_t>(i)] +
                   "' has e = " + short_number(mm.restitution(i)));
