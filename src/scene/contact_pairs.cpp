@@ -10,6 +10,8 @@
 #include <lcsim/scene/contacts.hpp>
 #include <limits>
 
+#include "scene/detail.hpp"
+
 namespace lcsim::scene {
 
 using Eigen::Vector3d;
@@ -140,9 +142,13 @@ Separation separation(const Bodies& b, const ContactPoint& p, const BodyShape& s
 
 }  // namespace
 
+double plane_distance(const Plane& plane, const Vector3d& centre, double radius) {
+  return plane.normal.dot(centre - plane.point) - radius;
+}
+
 double signed_distance(const Bodies& bodies, const ContactPoint& p, const Plane& plane,
                        const Eigen::VectorXd& q) {
-  return plane.normal.dot(point_at(bodies, p, q) - plane.point) - p.radius;
+  return plane_distance(plane, point_at(bodies, p, q), p.radius);
 }
 
 double signed_distance(const Bodies& bodies, const ContactPoint& p, const BodyShape& s,

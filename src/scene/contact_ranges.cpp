@@ -5,9 +5,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <lcsim/io/input_error.hpp>
 #include <lcsim/mech/tolerances.hpp>
+#include <lcsim/scene/bodies.hpp>
 #include <lcsim/scene/linearisation.hpp>
 #include <limits>
+
+#include "scene/detail.hpp"
 
 namespace lcsim::scene {
 
@@ -35,13 +39,59 @@ Axis axis_of(const Bodies& b, std::size_t i, double q0) {
   return a;
 }
 
-// Where contact c's point is, seen from what it touches: in the world for a
-// plane, in the frame of the other body's link for a body's shape (so the
-// shape's own motion counts as the point's, relative to it).
-Eigen::Vector3d seen_point(const Bodies& dyn, const ContactFrame& c, const VectorXd& q) {
+// Contact c at q: its point seen from what it touches (in the world for a
+// plane, in the frame of the other body's link for a body's shape, so the
+// shape's own motion counts as the point's, relative to it) and its exact
+// gap (signed_distance). On a plane (`plane` set) both come from one pose
+// of the link.
+struct Probe {
+  Eigen::Vector3d seen;
+  double gap = 0.0;  // m
+};
+Probe probe(const Bodies& dyn, const ContactFrame& c, const Plane* plane, const VectorXd& q) {
   const Eigen::Vector3d w = dyn.link_pose(c.point.body, c.point.link, q) * c.point.local;
-  if (!c.against) return w;
-  return dyn.link_pose(c.against->body, c.against->link, q).inverse() * w;
+  if (plane) return {w, plane_distance(*plane, w, c.point.radius)};
+  return {dyn.link_pose(c.against->body, c.against->link, q).inverse() * w,
+          signed_distance(dyn, c.point, *c.against, q)};
+}
+
+// The plane contact c touches (nullptr for a body's shape); InputError as
+// signed_distance's when the scene has no plane of its name.
+const Plane* plane_of(const ContactFrame& c, const std::vector<Plane>& planes) {
+  if (c.against) return nullptr;
+  for (const Plane& p : planes)
+    if (p.name == c.plane) return &p;
+  throw InputError("contact '" + c.point.name + "': no plane '" + c.plane + "'");
+}
+
+// Marks the scene's coordinates that move link `link` of body b: the body's
+// floating base, and each simulated joint on the link's path from the root,
+// itself or as the leader of a mimic on it. No other coordinate enters the
+// link's pose (link_pose reads none other), so none other moves a point of it.
+void mark_moving(const Bodies& dyn, std::size_t b, const std::string& link,
+                 std::vector<bool>& moves) {
+  const SceneBody& body = dyn.bodies()[b];
+  const auto at = [&](std::size_t k) { return static_cast<std::size_t>(body.offset) + k; };
+  const std::size_t nb = base_coordinates(body.base).size();
+  for (std::size_t k = 0; k < nb; ++k) moves[at(k)] = true;
+  const auto mimics = mimic_joints(*body.urdf, body.urdf_source, body.joints);
+  for (auto l = body.urdf->getLink(link); l && l->parent_joint;
+       l = body.urdf->getLink(l->parent_joint->parent_link_name)) {
+    const auto m = mimics.find(l->parent_joint->name);
+    const std::string& j = m == mimics.end() ? l->parent_joint->name : m->second.leader;
+    const auto it = std::find(body.joints.begin(), body.joints.end(), j);
+    if (it != body.joints.end())
+      moves[at(nb + static_cast<std::size_t>(it - body.joints.begin()))] = true;
+  }
+}
+
+// Whether each of the scene's coordinates moves contact c's point as seen
+// from what it touches (its link's, and the other body's link's).
+std::vector<bool> moving_coordinates(const Bodies& dyn, const ContactFrame& c) {
+  std::vector<bool> moves(static_cast<std::size_t>(dyn.size()), false);
+  mark_moving(dyn, c.point.body, c.point.link, moves);
+  if (c.against) mark_moving(dyn, c.against->body, c.against->link, moves);
+  return moves;
 }
 
 // How far coordinate i can move either way (the smaller) before contact
@@ -51,16 +101,23 @@ struct Extent {
   double distance = std::numeric_limits<double>::infinity();
   std::string end = "search";
 };
+// A coordinate that does not move the point (`moves` false) is not
+// evaluated: its |p(q) - p(q0)| is exactly 0 at every step, so it never
+// exceeds, and its extent is the search's end, as the scan finds it.
 Extent reach_along(const Bodies& dyn, const ContactFrame& c, const std::vector<Plane>& planes,
-                   const VectorXd& q0, Eigen::Index i, const Axis& a, double threshold) {
+                   const VectorXd& q0, Eigen::Index i, const Axis& a, double threshold,
+                   bool moves) {
   Extent r;
-  const Eigen::Vector3d p0 = seen_point(dyn, c, q0);
+  const Plane* plane = plane_of(c, planes);
+  const Eigen::Vector3d p0 = probe(dyn, c, plane, q0).seen;
   for (const double dir : {-1.0, 1.0}) {
     const auto exceeds = [&](double step) {
+      if (!moves) return false;
       VectorXd q = q0;
       q(i) += dir * step;
-      const double moved = (seen_point(dyn, c, q) - p0).norm();
-      const double exact = signed_distance(dyn, c, planes, q) - c.gap;
+      const Probe at = probe(dyn, c, plane, q);
+      const double moved = (at.seen - p0).norm();
+      const double exact = at.gap - c.gap;
       const double linear = c.normal_row(i) * dir * step;
       return moved > 0.0 && std::abs(exact - linear) > threshold * moved;
     };
@@ -94,11 +151,12 @@ std::vector<ContactRange> contact_ranges(const Scene& s, double threshold) {
     r.gap = gaps(c.row);
     r.closed = mech::gap_is_zero(r.gap, scale(c.row));
     r.range = std::numeric_limits<double>::infinity();
+    const std::vector<bool> moves = moving_coordinates(dyn, c);
     for (std::size_t i = 0; i < s.lin.joints.size(); ++i) {
       const auto ii = static_cast<Eigen::Index>(i);
       const Axis a = axis_of(dyn, i, q0(ii));
       if (any_rad && a.unit != "rad") continue;  // rotations bend the gap; report theirs
-      const Extent got = reach_along(dyn, c, s.planes, q0, ii, a, threshold);
+      const Extent got = reach_along(dyn, c, s.planes, q0, ii, a, threshold, moves[i]);
       if (got.distance < r.range || r.coordinate.empty()) {
         r.coordinate = s.lin.joints[i];
         r.unit = a.unit;

@@ -255,6 +255,12 @@ std::vector<ContactFrame> against_frames(const std::vector<ContactBody>& bodies,
                                          const std::vector<ContactPoint>& points, const Bodies& dyn,
                                          const VectorXd& q0);
 
+// A sphere of `radius` about the world point `centre` against `plane`: its
+// signed distance normal . (centre - plane.point) - radius (m), the one
+// formula of signed_distance on a plane (contact_pairs.cpp), for a caller
+// that has the point's centre already (the contact ranges).
+double plane_distance(const Plane& plane, const Eigen::Vector3d& centre, double radius);
+
 // A scene of several URDFs (`bodies:`, scene_bodies.cpp): read_scene's
 // counterpart when the file has that key instead of `urdf:`.
 Scene read_bodies_scene(const YAML::Node& root, const std::string& source);

@@ -378,6 +378,81 @@ std::map<std::string, Isometry3d> link_poses(const Tree& t, const Config& c) {
   return X;
 }
 
+// Each link's step from its parent for link_pose, precomputed so that one
+// link's pose is the products along its path alone: link_poses' products
+// in the same order (so the same numbers) without the poses of every other
+// link, and without a name looked up (link_pose is called per contact and
+// per probe by the contact ranges, on trees of up to a hundred links).
+struct LinkStep {
+  int parent = -1;                             // its parent link's step (-1: the root)
+  const urdf::Joint* joint = nullptr;          // the joint from the parent (none at the root)
+  Isometry3d origin = Isometry3d::Identity();  // pose(parent_to_joint_origin_transform)
+  // Its position as positions() sets it: a simulated joint's coordinate or a
+  // frozen joint's q0 (0 if absent); a mimic's multiplier * that of its
+  // leader (simulated or frozen, never a mimic: mimic_joints resolves
+  // chains) + offset.
+  int coordinate = -1;  // the coordinate read (its own or its leader's), -1: frozen
+  double frozen = 0.0;  // the q0 read when frozen
+  bool mimic = false;
+  double multiplier = 1.0, offset = 0.0;
+  double position(const VectorXd& q) const {
+    const double own = coordinate >= 0 ? q(coordinate) : frozen;
+    return mimic ? multiplier * own + offset : own;
+  }
+};
+struct LinkSteps {
+  std::vector<LinkStep> steps;
+  std::map<std::string, int> index;  // link name -> its step
+};
+
+LinkSteps link_steps(const Tree& t, const std::map<std::string, double>& q0) {
+  const auto read = [&](LinkStep& s, const std::string& name) {
+    const auto i = t.index.find(name);
+    if (i != t.index.end() && i->second >= static_cast<int>(t.nb) &&
+        i->second < static_cast<int>(t.n)) {
+      s.coordinate = i->second;
+      return;
+    }
+    const auto it = q0.find(name);
+    s.frozen = it == q0.end() ? 0.0 : it->second;
+  };
+  LinkSteps out;
+  for (const auto& name : t.link_order) {  // root first: a parent before its children
+    LinkStep s;
+    const auto link = t.model.getLink(name);
+    if (const auto& j = link->parent_joint) {
+      s.parent = out.index.at(j->parent_link_name);
+      s.joint = j.get();
+      s.origin = pose(j->parent_to_joint_origin_transform);
+      const auto m = t.mimics.find(j->name);
+      s.mimic = m != t.mimics.end();
+      if (s.mimic) s.multiplier = m->second.multiplier, s.offset = m->second.offset;
+      read(s, s.mimic ? m->second.leader : j->name);
+    }
+    out.index[name] = static_cast<int>(out.steps.size());
+    out.steps.push_back(s);
+  }
+  return out;
+}
+
+// World pose of one link at q (root: as positions() places it).
+Isometry3d path_pose(const Tree& t, const LinkSteps& k, const VectorXd& q, int link) {
+  std::vector<int> path;  // from the link up to the root's child
+  for (int l = link; k.steps[static_cast<std::size_t>(l)].parent >= 0;
+       l = k.steps[static_cast<std::size_t>(l)].parent)
+    path.push_back(l);
+  Isometry3d X = t.base.pose;
+  if (t.nb > 0) {
+    X.linear() = exp_so3(q.segment<3>(3)) * t.base.pose.linear();
+    X.translation() = q.head<3>();
+  }
+  for (auto l = path.rbegin(); l != path.rend(); ++l) {
+    const LinkStep& s = k.steps[static_cast<std::size_t>(*l)];
+    X = X * s.origin * motion(*s.joint, s.position(q));
+  }
+  return X;
+}
+
 // Motion subspace of moving joint i in world coordinates. A floating
 // base's translations move the root along the world axes; its rotation
 // coordinate k turns the tree about the root's origin p with angular
@@ -600,6 +675,7 @@ struct UrdfDynamics::Impl {
   Tree tree;
   std::map<std::string, double> q0;
   Eigen::Vector3d gravity;
+  LinkSteps steps;
 };
 
 static std::shared_ptr<const UrdfDynamics::Impl> make_dynamics(
@@ -631,7 +707,9 @@ static std::shared_ptr<const UrdfDynamics::Impl> make_dynamics(
               "(got total mass " +
               format_number(mass) + ")");
   }
-  return std::make_shared<const UrdfDynamics::Impl>(UrdfDynamics::Impl{std::move(t), q0, gravity});
+  LinkSteps steps = link_steps(t, q0);
+  return std::make_shared<const UrdfDynamics::Impl>(
+      UrdfDynamics::Impl{std::move(t), q0, gravity, std::move(steps)});
 }
 
 UrdfDynamics::UrdfDynamics(const urdf::ModelInterface& model,
@@ -686,7 +764,7 @@ VectorXd UrdfDynamics::damping() const {
 Eigen::Isometry3d UrdfDynamics::link_pose(const std::string& link, const VectorXd& q) const {
   const Tree& t = impl_->tree;
   if (!t.owner.count(link)) throw InputError("no link '" + link + "' in the URDF");
-  return link_poses(t, positions(t, impl_->q0, q)).at(link);
+  return path_pose(t, impl_->steps, q, impl_->steps.index.at(link));
 }
 
 Eigen::Matrix3Xd UrdfDynamics::point_jacobian(const std::string& link, const Eigen::Vector3d& local,

@@ -322,6 +322,45 @@ contacts: [{link: a, plane: floor, name: toe_a}]
   EXPECT_NEAR(ranges[0].range, 2 * std::asin(0.01), 1e-12);
 }
 
+// The same toe on a leg whose hip is no coordinate: it mimics the other
+// leg's hip with multiplier 2 (so the toe's only rotation is a_hip's,
+// through the mimic; the contact ranges evaluate a coordinate only where
+// it moves the point, and must find this one). Along a_hip by th the leg
+// turns by 2 th: the error is |sin(th)|, 1 % at th = asin(0.01) on both
+// sides (same tolerance, same reasons as above).
+TEST_F(Contacts, ToeOfAMimicLegHoldsForTheArcsineOverTheMultiplier) {
+  const std::string link = R"(<inertial><mass value="1"/>
+      <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>)";
+  const auto leg = [&](const std::string& n, double x, const std::string& mimic) {
+    return "<link name=\"" + n + "\">" + link +
+           "<collision><origin xyz=\"0 0 -0.4\"/><geometry><sphere radius=\"0.05\"/></geometry>"
+           "</collision></link><joint name=\"" +
+           n + "_hip\" type=\"revolute\"><parent link=\"carriage\"/><child link=\"" + n +
+           "\"/><origin xyz=\"" + std::to_string(x) + " 0 0\"/><axis xyz=\"0 1 0\"/>" + mimic +
+           "<limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/></joint>";
+  };
+  const std::string urdf =
+      "<robot name=\"legs\"><link name=\"base\">" + link + "</link><link name=\"carriage\">" +
+      link +
+      "</link><joint name=\"lift\" type=\"prismatic\"><parent link=\"base\"/><child "
+      "link=\"carriage\"/><axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" "
+      "velocity=\"1\"/></joint>" +
+      leg("a", 0.0, "") + leg("b", 0.3, "<mimic joint=\"a_hip\" multiplier=\"2\"/>") + "</robot>";
+  const scene::Scene s = load(R"(urdf: r.urdf
+joints: [{name: lift, stops: []}, {name: a_hip, stops: [], mimic_stops: []}]
+planes: [{name: floor, point: [0, 0, -0.45], normal: [0, 0, 1]}]
+contacts: [{link: b, plane: floor, name: toe_b}]
+)",
+                              urdf);
+  const auto ranges = scene::contact_ranges(s, 0.01);
+  ASSERT_EQ(ranges.size(), 1u);
+  EXPECT_EQ(ranges[0].coordinate, "a_hip");
+  EXPECT_EQ(ranges[0].unit, "rad");
+  EXPECT_EQ(ranges[0].end, "threshold");
+  EXPECT_TRUE(ranges[0].closed);
+  EXPECT_NEAR(ranges[0].range, std::asin(0.01), 1e-12);
+}
+
 // Body against body (robots/gripper_box_scene.yaml): each fingertip's
 // sphere centre lies on the normal of the box's side face through the
 // box's centre, at d from it. Rolling the box by th about its centre (x)

@@ -85,12 +85,31 @@ t_end: 0.5
 // them (its feet are meshes), dropped 5.8 cm: 5 of 40 random poses of this
 // robot stopped in the exact method ("mode selection at t = ...: leading row
 // coefficient block of the active set is singular" or "mode feedback F_I
-// unavailable"); this is one of them. Checked: it completes; the robot is
+// unavailable"); this is one of them. The pose puts the soles on the floor
+// to the rounding of its forward kinematics: the eight gaps at q0 are 0,
+// 5.6e-17 and 1.1e-16 m (each the height of a point reached through three
+// rotations and lengths below 0.5 m: a dozen roundings of ~0.5 eps m, so
+// 1e-15 bounds them), far inside the default penetration tolerance (1e-6
+// m), which the scene keeps. Checked: it completes; the robot is
 // symmetric about its x-z plane, so each left joint equals its right one
 // and the base neither drifts sideways nor rolls nor yaws (1e-9: rounding of
 // the symmetric sums); no sample penetrates (1e-12 m); and the final
-// positions agree with Moreau-Jean at h = 1e-4 (first order: measured 5.4e-4
-// in the base pitch and below 4e-5 m elsewhere; 2e-3 bounds it).
+// positions agree with the time-stepping methods at h = 2e-4 and 1e-4, to
+// first order (e(h): the largest difference over the 12 coordinates, in
+// each case the base pitch):
+// - backward Euler: e = 7.271e-5 and 3.609e-5 rad, e / h = 0.3635 and
+//   0.3609 rad/s: e(h) <= C h with C = 0.4 rad/s (10 % over the measured
+//   constant); its Richardson extrapolant 2 x(h) - x(2h) meets the event
+//   run to 5.3e-7 (second order: a quarter of that, 1.4e-7, from h = 1e-4
+//   and 5e-5), and 2e-6 bounds it with a margin of about 4;
+// - Moreau-Jean: e = 1.010e-3 and 5.370e-4 rad (e(h) / e(2h) = 0.53), e / h
+//   = 5.05 and 5.37 rad/s: e(h) <= C h with C = 5.9 rad/s (10 % over the
+//   measured constant at h = 1e-4), and e(h) <= 0.6 e(2h). Its error is
+//   first order plus a part that does not vanish with h, 6.4e-5 rad (its
+//   Richardson extrapolant's distance, 6.2e-5 and 7.0e-5 from h = 1e-4 down
+//   to 2.5e-5), which appears at the heels' second landing (t = 0.2515 s)
+//   and which backward Euler does not show: the event run is the limit
+//   that backward Euler converges to.
 TEST_F(PublicRobots, TwoLegsOnFourPointSolesLandAndSettle) {
   write("legs.urdf", R"(<robot name='b'>
  <link name='torso'><inertial><origin xyz='0 0 0.1'/><mass value='5'/><inertia ixx='0.05' ixy='0' ixz='0' iyy='0.04' iyz='0' izz='0.03'/></inertial></link>
@@ -115,7 +134,6 @@ planes: [{name: floor, normal: [0, 0, 1]}]
 contacts:
   - {link: lfoot, plane: floor, points: [[0.07523479922561183, 0.03707322510422971, -0.04], [0.07523479922561183, -0.03707322510422971, -0.04], [-0.03, 0.03707322510422971, -0.04], [-0.03, -0.03707322510422971, -0.04]]}
   - {link: rfoot, plane: floor, points: [[0.07523479922561183, 0.03707322510422971, -0.04], [0.07523479922561183, -0.03707322510422971, -0.04], [-0.03, 0.03707322510422971, -0.04], [-0.03, -0.03707322510422971, -0.04]]}
-contact_options: {penetration_tolerance: 1}
 springs:
   - {name: k_lhip, joint: lhip, stiffness: 100, damping: 2, rest: 0.3013820626487555}
   - {name: k_lknee, joint: lknee, stiffness: 100, damping: 2, rest: -0.3978597731826419}
@@ -139,10 +157,32 @@ t_end: 0.5
     for (int j = 0; j < 3; ++j) EXPECT_NEAR(x.x(6 + j), x.x(9 + j), 1e-9) << x.t;
     for (const int c : {1, 3, 5}) EXPECT_NEAR(x.x(c), 0.0, 1e-9) << x.t;
   }
-  opt.h = 1e-4;
-  const sim::Trajectory mj = sim::simulate(model, model.initial, opt, "moreau-jean");
-  ASSERT_EQ(mj.status, sim::RunStatus::kCompleted) << mj.message;
-  EXPECT_LE((tr.final_state.head(n) - mj.final_state.head(n)).cwiseAbs().maxCoeff(), 2e-3);
+  VectorXd q0 = model.initial.head(n);  // the reference pose: the initial one but its height
+  q0(2) = 0.4800553567802965;
+  const VectorXd gap0 = m.E * q0 + m.g;
+  for (const std::string foot : {"lfoot", "rfoot"})
+    for (int k = 0; k < 4; ++k) {
+      const std::string c = foot + ".point" + std::to_string(k);
+      const auto r = std::find(m.constraints.begin(), m.constraints.end(), c);
+      ASSERT_NE(r, m.constraints.end()) << c;
+      EXPECT_NEAR(gap0(r - m.constraints.begin()), 0.0, 1e-15) << c;
+    }
+  const auto final_positions = [&](const char* method, double h) {
+    opt.h = h;
+    const sim::Trajectory run = sim::simulate(model, model.initial, opt, method);
+    EXPECT_EQ(run.status, sim::RunStatus::kCompleted) << method << " " << h << ": " << run.message;
+    return VectorXd(run.final_state.head(n));
+  };
+  const VectorXd x = tr.final_state.head(n);
+  const double h = 1e-4;
+  const VectorXd be2 = final_positions("euler", 2 * h), be1 = final_positions("euler", h);
+  EXPECT_LE((be1 - x).cwiseAbs().maxCoeff(), 0.4 * h);
+  EXPECT_LE((2 * be1 - be2 - x).cwiseAbs().maxCoeff(), 2e-6);
+  const VectorXd mj2 = final_positions("moreau-jean", 2 * h),
+                 mj1 = final_positions("moreau-jean", h);
+  const double e2 = (mj2 - x).cwiseAbs().maxCoeff(), e1 = (mj1 - x).cwiseAbs().maxCoeff();
+  EXPECT_LE(e1, 5.9 * h);
+  EXPECT_LE(e1, 0.6 * e2);
   EXPECT_LT(tr.energy_final, tr.energy_initial);
 }
 
