@@ -18,6 +18,7 @@
 #include <cmath>
 #include <lcsim/core/format.hpp>
 #include <lcsim/lcs/lcs.hpp>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -68,6 +69,14 @@ class FreeResponse {
     return m;
   }
   std::vector<VectorXd> CAx, CAx_scale;  // index m: C A^m x0 and its scale
+  // True when C A^j x0 and its scale are exactly zero for every j >= m:
+  // order m is, and A^{m+1} x0 and |A|^{m+1} |x0| are zero vectors (so is
+  // every later power's product).
+  bool zero_from(int m) {
+    reach(m);
+    return CAx[m].isZero(0.0) && CAx_scale[m].isZero(0.0) && Amx_.isZero(0.0) &&
+           Amx_abs_.isZero(0.0);
+  }
 
  private:
   const Lcs& sys_;
@@ -344,6 +353,40 @@ void classify_undecided(Ldcp& s, const Level& l, VectorXd& up) {
   }
 }
 
+// True when every level after l repeats l exactly, so that solving them
+// would change nothing: l (a force level, p >= 1) had no known part (xi and
+// its scale exactly zero), found u^p = 0 and decided no row (`before`: the
+// states on entry), and every later level's known part is exactly zero too
+// (the free response C A^m x0 from the orders later levels read, and the
+// Markov parameters H^h that the nonzero levels u^j meet there: zero, and
+// zero for every higher power). Each later level then has the same rows,
+// the same coefficients (zero) and the same script M as l: the same LCP and
+// the same result, level after level. A box resting on its four coplanar
+// corners with no spring keeps two corners undecided (dependent rows, u and
+// y identically zero) and otherwise solved the same zero level up to n.
+bool later_levels_repeat(Ldcp& s, const Level& l, const VectorXd& up,
+                         const std::vector<RowState>& before) {
+  if (l.p < 1 || !l.xi.isZero(0.0) || !l.scale.isZero(0.0) || !up.isZero(0.0) || s.state != before)
+    return false;
+  int rho_min = std::numeric_limits<int>::max();
+  for (int r = 0; r < s.sys.k(); ++r)
+    if (s.state[r] != RowState::kInactive) rho_min = std::min(rho_min, s.data.rho[r]);
+  if (rho_min == std::numeric_limits<int>::max()) return true;  // every row inactive
+  // Level p + 1 reads the orders rho_r + p + 1 >= rho_min + p + 1 of the
+  // free response, C A^{order - 1} x0.
+  if (!s.free.zero_from(std::max(0, rho_min + l.p))) return false;
+  const int h_max = 3 * s.sys.n();  // level_coefficients' cap on h
+  for (int j : s.nonzero_levels) {
+    for (int h = std::max(0, rho_min + l.p + 1 - j); h <= h_max; ++h) {
+      if (!s.data.markov(h).isZero(0.0)) return false;
+      // markov(h) leaves A^h B in AiB when H ends at h: zero, then every
+      // later H = C A^{h'} B is zero.
+      if (static_cast<int>(s.data.H.size()) == h + 1 && s.data.AiB.isZero(0.0)) break;
+    }
+  }
+  return true;
+}
+
 // Levels -n+1 .. n, as in the proof of Theorem 3.6.7, until the mode is
 // fixed. "" or why the LDCP has no (autonomous) solution.
 std::string solve_levels(Ldcp& s, int& lcp_solves) {
@@ -360,6 +403,7 @@ std::string solve_levels(Ldcp& s, int& lcp_solves) {
       continue;
     }
     if (l.K.empty() && l.I.empty()) break;  // every row decided inactive
+    const std::vector<RowState> before = s.state;
     const std::string failed = solve_level(s, l, up, lcp_solves);
     if (!failed.empty()) return failed;
     drop_dependent_multipliers(s, l, up);
@@ -367,6 +411,7 @@ std::string solve_levels(Ldcp& s, int& lcp_solves) {
     // Once no row is undecided the mode is fixed; the impulsive levels (p <= 0)
     // are still needed for the jump, later levels are not.
     if (p >= 0 && rows_in(s.state, RowState::kUndecided).empty()) break;
+    if (later_levels_repeat(s, l, up, before)) break;
   }
   return "";
 }

@@ -151,7 +151,7 @@ std::string EventDriven::select_cone_friction(double t, const lcs::IndexSet& und
       c /= cand[f].size();
     }
     std::string err;
-    const Phase ph = make_phase(out.mode, fm, undetermined, xa, err);
+    const Phase& ph = make_phase(out.mode, fm, undetermined, xa, err);
     if (!err.empty()) {
       if (painleve.empty() && err.find("Painlev") != std::string::npos) painleve = err;
       continue;

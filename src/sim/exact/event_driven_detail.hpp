@@ -319,9 +319,11 @@ class EventDriven {
   }
 
   // `friction`: the mode of each entry of mechanical.friction (empty for
-  // frictionless models).
-  Phase make_phase(const lcs::IndexSet& mode, const std::vector<FrictionMode>& friction,
-                   const lcs::IndexSet& undetermined, const VectorXd& xa, std::string& err) const;
+  // frictionless models). The phase returned is the memo's (phase_memo_),
+  // or on error the failed one: valid until the next call.
+  const Phase& make_phase(const lcs::IndexSet& mode, const std::vector<FrictionMode>& friction,
+                          const lcs::IndexSet& undetermined, const VectorXd& xa,
+                          std::string& err) const;
   Phase build_phase(const lcs::IndexSet& mode, const std::vector<FrictionMode>& friction,
                     const lcs::IndexSet& undetermined, const VectorXd& xa, std::string& err) const;
   // Friction (friction_phase.cpp, friction_modes.cpp).
@@ -444,12 +446,16 @@ class EventDriven {
     std::vector<char> small_opening;
     double h_first = 0.0;
   };
-  MonitorStart monitor_start(const Phase& phase, const VectorXd& xstart, double t,
-                             double h_max) const;
+  // `monitors`: these monitors (over phase's state) in place of phase's own;
+  // each monitor's start is its own, whatever the others are.
+  MonitorStart monitor_start(const Phase& phase, const VectorXd& xstart, double t, double h_max,
+                             const std::vector<Monitor>* monitors = nullptr) const;
   // Noise level of each monitor at the phase start (monitors.cpp).
-  std::vector<double> monitor_noise(const Phase& phase, const VectorXd& xstart, double t) const;
+  std::vector<double> monitor_noise(const std::vector<Monitor>& monitors, const VectorXd& xstart,
+                                    double t) const;
   // st.m0, st.d0 and st.h_first from st.noise.
-  void first_derivatives(const Phase& phase, const VectorXd& xstart, MonitorStart& st) const;
+  void first_derivatives(const Phase& phase, const std::vector<Monitor>& monitors,
+                         const VectorXd& xstart, MonitorStart& st) const;
 
   // One run's state between the stages of run() (event_driven.cpp).
   struct RunState {
@@ -595,8 +601,19 @@ class EventDriven {
     std::vector<FrictionMode> friction;
     VectorXd xa;
     Phase phase;
+    // The monitors' start of `phase` from xa at start_t (h_max = 1), once a
+    // selection check asked for it (selection_start).
+    std::optional<MonitorStart> start;
+    double start_t = 0.0;
   };
   mutable std::optional<PhaseMemo> phase_memo_;
+  mutable Phase failed_phase_;  // make_phase's result when it fails
+  // monitor_start(ph, xa ./ ph.D, t, 1.0) for a selection's checks (its m0
+  // and d0): kept with the memo when ph is the memo's phase at its state, so
+  // the checks of one chosen phase (consistent, lifting_normals) start its
+  // monitors once. Valid until the next make_phase.
+  const MonitorStart& selection_start(const Phase& ph, const VectorXd& xa, double t) const;
+  mutable MonitorStart scratch_start_;
   std::map<std::pair<lcs::IndexSet, std::vector<FrictionMode>>, StepExp> step_cache_;
   // The cache entry for `phase`'s samples on a grid of step dt, reset when
   // its Ab or dt differ (a frictional mode's feedback depends on the state).

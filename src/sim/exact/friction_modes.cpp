@@ -131,7 +131,7 @@ std::vector<FrictionMode> EventDriven::friction_lcp_modes(const lcs::IndexSet& m
 // True if every friction monitor of `ph` starts positive, or at zero and
 // leaves it upwards (or stays at zero identically).
 bool EventDriven::consistent(const Phase& ph, const VectorXd& xa, double t) const {
-  const MonitorStart st = monitor_start(ph, xa.cwiseQuotient(ph.D), t, 1.0);
+  const MonitorStart& st = selection_start(ph, xa, t);
   for (size_t j = 0; j < ph.monitors.size(); ++j) {
     if (ph.monitors[j].friction < 0) continue;
     if (st.m0[j] >= 0 && !(st.d0[j] > 0.0)) return false;
@@ -154,7 +154,7 @@ std::string EventDriven::select_friction(double t, const lcs::IndexSet& undeterm
   std::string err, painleve;
   auto accept = [&](const std::vector<FrictionMode>& fm) {
     err.clear();
-    const Phase ph = make_phase(out.mode, fm, undetermined, xa, err);
+    const Phase& ph = make_phase(out.mode, fm, undetermined, xa, err);
     if (!err.empty()) {
       if (painleve.empty() && err.find("Painlev") != std::string::npos) painleve = err;
       return false;
@@ -222,7 +222,7 @@ std::string EventDriven::select_friction_and_normals(double t, const lcs::ModeSe
     out.lcp_solves = all.lcp_solves;  // counted whether taken or not
     if (!selected) return false;
     std::string err;
-    const Phase ph = make_phase(all.mode, all.friction, {}, x2, err);
+    const Phase& ph = make_phase(all.mode, all.friction, {}, x2, err);
     if (!err.empty() || !all_consistent(ph, x2, t)) return false;
     out.mode = all.mode;
     out.friction = all.friction;
@@ -250,7 +250,7 @@ std::string EventDriven::select_friction_and_normals(double t, const lcs::ModeSe
   lcs::IndexSet lifting;  // constraints of I whose force leaves zero downwards
   if (why.empty()) {
     std::string err;
-    const Phase ph = make_phase(out.mode, out.friction, sel.undetermined, x1, err);
+    const Phase& ph = make_phase(out.mode, out.friction, sel.undetermined, x1, err);
     if (err.empty()) lifting = lifting_normals(ph, x1, t);
     if (err.empty() && !presses_shut(ph, sel.undetermined, x1, t)) {
       if (lifting.empty()) {
@@ -274,7 +274,7 @@ std::string EventDriven::select_friction_and_normals(double t, const lcs::ModeSe
 // selection would follow again (the quadruped landing on three independent
 // feet, one of them slipping).
 lcs::IndexSet EventDriven::lifting_normals(const Phase& ph, const VectorXd& xa, double t) const {
-  const MonitorStart st = monitor_start(ph, xa.cwiseQuotient(ph.D), t, 1.0);
+  const MonitorStart& st = selection_start(ph, xa, t);
   lcs::IndexSet out;
   for (size_t j = 0; j < ph.monitors.size(); ++j) {
     const Monitor& mon = ph.monitors[j];
@@ -302,7 +302,7 @@ bool EventDriven::release_normal(double t, const lcs::ModeSelection& sel,
     out.lcp_solves = cand.lcp_solves;  // counted whether taken or not
     if (!selected) continue;
     std::string err;
-    const Phase ph = make_phase(cand.mode, cand.friction, {}, x2, err);
+    const Phase& ph = make_phase(cand.mode, cand.friction, {}, x2, err);
     if (!err.empty() || redundant_normals(ph) || !all_consistent(ph, x2, t)) continue;
     out.mode = cand.mode;
     out.friction = cand.friction;
@@ -314,7 +314,9 @@ bool EventDriven::release_normal(double t, const lcs::ModeSelection& sel,
 
 bool EventDriven::presses_shut(const Phase& ph, const lcs::IndexSet& which, const VectorXd& xa,
                                double t) const {
-  Phase probe = ph;  // its monitors, with those of `which` added
+  // The gaps of `which` as monitors over ph's state (each monitor's start is
+  // its own: ph's need not be started again).
+  std::vector<Monitor> gaps;
   for (const int r : which) {
     Monitor mon;
     mon.constraint = r;
@@ -323,16 +325,16 @@ bool EventDriven::presses_shut(const Phase& ph, const lcs::IndexSet& which, cons
     for (size_t i = 0; i < ph.mode.size(); ++i) w += sys_.D(r, ph.mode[i]) * ph.F.row(i);
     mon.w = w.cwiseProduct(ph.D.transpose());
     mon.wA = ph.row_times(mon.w);
-    probe.monitors.push_back(std::move(mon));
+    gaps.push_back(std::move(mon));
   }
-  const MonitorStart st = monitor_start(probe, xa.cwiseQuotient(ph.D), t, 1.0);
-  for (size_t j = ph.monitors.size(); j < probe.monitors.size(); ++j)
+  const MonitorStart st = monitor_start(ph, xa.cwiseQuotient(ph.D), t, 1.0, &gaps);
+  for (size_t j = 0; j < gaps.size(); ++j)
     if (st.m0[j] >= 0 && !(st.d0[j] > 0.0)) return true;
   return false;
 }
 
 bool EventDriven::all_consistent(const Phase& ph, const VectorXd& xa, double t) const {
-  const MonitorStart st = monitor_start(ph, xa.cwiseQuotient(ph.D), t, 1.0);
+  const MonitorStart& st = selection_start(ph, xa, t);
   for (size_t j = 0; j < ph.monitors.size(); ++j)
     if (st.m0[j] >= 0 && !(st.d0[j] > 0.0)) return false;
   return true;

@@ -17,25 +17,27 @@ namespace lcsim::sim::detail {
 // level, its first nonzero derivative, and the first sampling step (h_max,
 // shorter where a monitor starts at zero).
 EventDriven::MonitorStart EventDriven::monitor_start(const Phase& phase, const VectorXd& xstart,
-                                                     double t, double h_max) const {
+                                                     double t, double h_max,
+                                                     const std::vector<Monitor>* monitors) const {
+  const std::vector<Monitor>& mons = monitors ? *monitors : phase.monitors;
   MonitorStart st;
   st.h_first = h_max;
-  st.noise = monitor_noise(phase, xstart, t);
-  first_derivatives(phase, xstart, st);
+  st.noise = monitor_noise(mons, xstart, t);
+  first_derivatives(phase, mons, xstart, st);
   return st;
 }
 
-std::vector<double> EventDriven::monitor_noise(const Phase& phase, const VectorXd& xstart,
-                                               double t) const {
+std::vector<double> EventDriven::monitor_noise(const std::vector<Monitor>& monitors,
+                                               const VectorXd& xstart, double t) const {
   // Noise level of each monitor at the phase start: rounding of its terms
   // |w| |x| plus the time quantisation of the event time (ulp(t) times its
   // rate). Its own terms, not |w|_1 max|x|: balancing can scale a coordinate
   // the monitor does not involve far above the others (a clamped joint of
   // Talos at 2.7e5), and that band (2.5e-9) hid a gap of 1.2e-9 closing,
   // wider than re-initialisation's zero test (1e-9 of the gap's terms).
-  std::vector<double> noise(phase.monitors.size());
-  for (size_t j = 0; j < phase.monitors.size(); ++j) {
-    const Monitor& mon = phase.monitors[j];
+  std::vector<double> noise(monitors.size());
+  for (size_t j = 0; j < monitors.size(); ++j) {
+    const Monitor& mon = monitors[j];
     noise[j] = 64.0 * kEps * mon.w.cwiseAbs().dot(xstart.cwiseAbs()) +
                time_resolution(t) * std::abs(mon.wA.dot(xstart));
   }
@@ -46,8 +48,8 @@ std::vector<double> EventDriven::monitor_noise(const Phase& phase, const VectorX
 // start (0 = the value itself; -1 = none up to n) and that derivative d0;
 // h_first shortened to a quarter of the time scale of its first two nonzero
 // Taylor terms.
-void EventDriven::first_derivatives(const Phase& phase, const VectorXd& xstart,
-                                    MonitorStart& st) const {
+void EventDriven::first_derivatives(const Phase& phase, const std::vector<Monitor>& monitors,
+                                    const VectorXd& xstart, MonitorStart& st) const {
   const std::vector<double>& noise = st.noise;
   double& h_first = st.h_first;
   std::vector<int>& m0 = st.m0;
@@ -58,7 +60,7 @@ void EventDriven::first_derivatives(const Phase& phase, const VectorXd& xstart,
   // Each monitor needs its first two nonzero derivatives only: the loop
   // stops once every monitor has them (usually m <= 3), instead of
   // always forming all n + 1 (O(n^3) per phase for large models).
-  const size_t nm = phase.monitors.size();
+  const size_t nm = monitors.size();
   m0.assign(nm, -1);
   d0.assign(nm, 0.0);
   st.small_opening.assign(nm, 0);
@@ -76,7 +78,7 @@ void EventDriven::first_derivatives(const Phase& phase, const VectorXd& xstart,
     }
     for (size_t j = 0; j < nm; ++j) {
       if (done[j]) continue;
-      const Monitor& mon = phase.monitors[j];
+      const Monitor& mon = monitors[j];
       const double dm = mon.w * Amx;
       const double zero =
           m == 0 ? noise[j] : ldcp_.tol_rel * mon.w.cwiseAbs().dot(Amx_abs) + ldcp_.tol_abs;

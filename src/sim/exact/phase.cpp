@@ -106,9 +106,10 @@ VectorXd Phase::expv(double tau, const VectorXd& z) const {
   return y;
 }
 
-Phase EventDriven::make_phase(const lcs::IndexSet& mode, const std::vector<FrictionMode>& friction,
-                              const lcs::IndexSet& undetermined, const VectorXd& xa,
-                              std::string& err) const {
+const Phase& EventDriven::make_phase(const lcs::IndexSet& mode,
+                                     const std::vector<FrictionMode>& friction,
+                                     const lcs::IndexSet& undetermined, const VectorXd& xa,
+                                     std::string& err) const {
   // The state compared exactly (NaN never matches): a phase's monitors are
   // scaled by it, so only the very same state gives the very same phase.
   const PhaseMemo* m = phase_memo_ ? &*phase_memo_ : nullptr;
@@ -116,11 +117,26 @@ Phase EventDriven::make_phase(const lcs::IndexSet& mode, const std::vector<Frict
       m->xa.size() == xa.size() && (m->xa.array() == xa.array()).all())
     return m->phase;
   Phase ph = build_phase(mode, friction, undetermined, xa, err);
-  if (err.empty())
-    phase_memo_ = PhaseMemo{mode, undetermined, friction, xa, ph};
-  else
+  if (!err.empty()) {
     phase_memo_.reset();
-  return ph;
+    failed_phase_ = std::move(ph);
+    return failed_phase_;
+  }
+  phase_memo_ = PhaseMemo{mode, undetermined, friction, xa, std::move(ph), std::nullopt, 0.0};
+  return phase_memo_->phase;
+}
+
+const EventDriven::MonitorStart& EventDriven::selection_start(const Phase& ph, const VectorXd& xa,
+                                                              double t) const {
+  PhaseMemo* m = phase_memo_ ? &*phase_memo_ : nullptr;
+  const bool memo =
+      m && &m->phase == &ph && m->xa.size() == xa.size() && (m->xa.array() == xa.array()).all();
+  if (memo && m->start && m->start_t == t) return *m->start;
+  MonitorStart st = monitor_start(ph, xa.cwiseQuotient(ph.D), t, 1.0);
+  if (!memo) return scratch_start_ = std::move(st);
+  m->start = std::move(st);
+  m->start_t = t;
+  return *m->start;
 }
 
 Phase EventDriven::build_phase(const lcs::IndexSet& mode, const std::vector<FrictionMode>& friction,
