@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <lcsim/circuit/circuit.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <numbers>
@@ -173,6 +174,36 @@ TEST(FloatingBridge, AllBlockingRingsUntilTheLoadMeetsTheTank) {
     ++checked;
   }
   EXPECT_GT(checked, 1000);
+}
+
+// Above 12 diodes the modes are not enumerated (4096 phases at most): the
+// same bridge with nine more diodes, each reverse biased by -1 V into a
+// capacitor of its own, runs through the all-blocking phase (its free pair
+// needs no enumeration) and is refused where the load meets the tank (t1 of
+// the test above, where the LDCP's levels fail: D1 active, D2 and D3
+// undecided), in one line naming the time and those diodes.
+TEST(FloatingBridge, AboveTwelveDiodesTheRefusalNamesTimeAndDiodes) {
+  std::string text = kBlocking;
+  std::string extra = "Vb b 0 -1\n";
+  for (int i = 1; i <= 9; ++i) {  // each into its own capacitor (leading index 1)
+    const std::string n = std::to_string(i);
+    extra += "DX" + n + " b c" + n + " ideal\nCX" + n + " c" + n + " 0 1u\n";
+  }
+  text.insert(text.find(".model"), extra);
+  const Circuit c = circuit::parse_circuit(text, "blk13.cir");
+  ASSERT_EQ(c.model.pair_names.size(), 13u);
+  sim::Options opt;
+  opt.t_end = 1e-3;
+  const sim::Trajectory tr = sim::simulate(c.model, opt);
+  ASSERT_EQ(tr.status, Status::kNumericalFailure);
+  EXPECT_EQ(tr.message.find('\n'), std::string::npos) << tr.message;
+  const Tank s0{5.0, 0.0, 10.0};
+  const double t1 =
+      bisect([&](double t) { return blocking(s0, t).w + blocking(s0, t).v; }, 0.8e-3, 0.9e-3);
+  char when[64];
+  std::snprintf(when, sizeof when, "mode selection at t = %.6g s: ", t1);  // short_number's digits
+  EXPECT_EQ(tr.message.rfind(when, 0), 0u) << tr.message << " / " << when;
+  EXPECT_NE(tr.message.find("(active: D1; undecided: D2, D3)"), std::string::npos) << tr.message;
 }
 
 // /tmp/br/fw.cir of the issue (circuits/full_wave_rectifier.cir).

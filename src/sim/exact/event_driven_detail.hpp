@@ -457,6 +457,10 @@ class EventDriven {
   // every mode whose phase starts consistently at xa; true with out.mode
   // set when one motion continues the state, else false with why.
   bool select_by_enumeration(double t, const VectorXd& xa, EventResult& out, std::string& why);
+  // " (active: D1; undecided: D2, D3)": a failed selection's sets by the
+  // pairs' names (a circuit's diodes), "" when both are empty.
+  std::string pair_sets(const lcs::IndexSet& active, const lcs::IndexSet& undecided) const;
+  std::string pair_list(const lcs::IndexSet& s) const;  // "D1, D2" ("none" when empty)
   // y_r vanishes identically on the phase from xa, for every held pair r.
   bool held_outputs_vanish(const Phase& ph, const VectorXd& xa) const;
   void record(Trajectory& tr, double t, const VectorXd& xa, const Phase& ph) const;

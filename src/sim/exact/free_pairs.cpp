@@ -32,8 +32,8 @@
 // from the state (every derivative of y_I vanishes at x0: held_outputs_vanish)
 // and start with every monitor lexicographically >= 0 (all_consistent). The
 // modes that pass must all give one motion (x0 and A_I^j x0, j <= n, equal):
-// then the first is taken; otherwise the state's continuation is not unique
-// and the run is refused naming two of them.
+// then the one holding the fewest pairs is taken; otherwise the state's
+// continuation is not unique and the run is refused naming two of them.
 #include <algorithm>
 #include <cmath>
 #include <lcsim/core/format.hpp>
@@ -251,6 +251,22 @@ bool same_motion(const MatrixXd& A1, const MatrixXd& A2, const VectorXd& x0) {
 
 }  // namespace
 
+std::string EventDriven::pair_list(const lcs::IndexSet& s) const {
+  std::string t;
+  for (size_t i = 0; i < s.size(); ++i) {
+    const auto r = static_cast<size_t>(s[i]);
+    t += (i ? ", " : "") +
+         (r < model_.pair_names.size() ? model_.pair_names[r] : "pair " + std::to_string(r));
+  }
+  return t.empty() ? std::string("none") : t;
+}
+
+std::string EventDriven::pair_sets(const lcs::IndexSet& active,
+                                   const lcs::IndexSet& undecided) const {
+  if (active.empty() && undecided.empty()) return "";
+  return " (active: " + pair_list(active) + "; undecided: " + pair_list(undecided) + ")";
+}
+
 bool EventDriven::select_by_enumeration(double t, const VectorXd& xa, EventResult& out,
                                         std::string& why) {
   if (model_.is_mechanical() || k_ > kMaxEnumerated) return false;
@@ -285,13 +301,18 @@ bool EventDriven::select_by_enumeration(double t, const VectorXd& xa, EventResul
   if (passed.empty()) return false;
   for (size_t i = 1; i < passed.size(); ++i) {
     if (same_motion(passed[0].second, passed[i].second, xa)) continue;
-    why = text("modes ", set_text(passed[0].first), " and ", set_text(passed[i].first),
-               " both continue the state at t = ", t,
-               " with different motions (the LDCP's levels failed and the continuation is not "
-               "unique)");
+    why = "modes {" + pair_list(passed[0].first) + "} and {" + pair_list(passed[i].first) +
+          "} (active pairs) both continue the state with different motions (the LDCP's levels "
+          "failed and the continuation is not unique)";
     return false;
   }
-  out.mode = passed[0].first;
+  // The fewest pairs held (the first such mask): a pair held at an
+  // identically zero multiplier would pin a free one and judge the exits on
+  // that one choice.
+  size_t best = 0;
+  for (size_t i = 1; i < passed.size(); ++i)
+    if (passed[i].first.size() < passed[best].first.size()) best = i;
+  out.mode = passed[best].first;
   out.x_plus = xa;
   out.status = Status::kOk;
   ldcp_undetermined_.clear();

@@ -10,6 +10,7 @@
 // approaches, select_regular_mode.
 #include <algorithm>
 #include <cmath>
+#include <lcsim/core/format.hpp>
 
 #include "sim/exact/event_driven_detail.hpp"
 
@@ -207,7 +208,8 @@ EventResult EventDriven::process_lcs(double t, const VectorXd& xa0) {
       // pairs, free_pairs.cpp): every mode is then tried at this state.
       std::string why;
       if (select_by_enumeration(t, xa, out, why)) return out;
-      out.message = "mode selection: " + (why.empty() ? sel.message : why);
+      out.message = "mode selection at t = " + short_number(t) + " s: " +
+                    (why.empty() ? sel.message + pair_sets(sel.mode, sel.undetermined) : why);
       return out;
     }
     bool impulsive = false;
