@@ -329,6 +329,45 @@ void circuit_section(Draft& d, const circuit::Circuit& c) {
   d.out << "well posed:  " << r.verdict << "\n";
 }
 
+// A switched circuit (ideal switches, docs/circuits.md): thesis Ch. 5's
+// passivity and verdict for every configuration its schedule visits, each
+// named by its switches' states, with the first time it holds (the lines
+// above judge the one at t = 0). A circuit without switches adds nothing.
+void configurations_section(Draft& d, const circuit::Circuit& c) {
+  const mech::Model& m = c.model;
+  if (m.configurations.size() < 2) return;
+  nlohmann::json list = nlohmann::json::array();
+  d.out << "configurations: " << m.configurations.size()
+        << " visited by the switches' schedule, each judged as above:\n";
+  for (std::size_t k = 0; k < m.configurations.size(); ++k) {
+    circuit::Circuit ck = c;
+    ck.model.lcs = m.configurations[k].lcs;  // the same states and energy in every one
+    const circuit::PassivityReport r = circuit::judge_passivity(ck);
+    std::string name;
+    nlohmann::json states = nlohmann::json::object();
+    for (std::size_t s = 0; s < c.switch_element.size(); ++s) {
+      const std::string& sw =
+          c.netlist.elements[static_cast<std::size_t>(c.switch_element[s])].name;
+      const bool on = k < c.switch_on.size() && s < c.switch_on[k].size() && c.switch_on[k][s];
+      name += (s ? ", " : "") + sw + (on ? " on" : " off");
+      states[sw] = on ? "on" : "off";
+    }
+    double first = -1.0;  // the first time configuration k holds
+    for (std::size_t i = 0; i < m.switch_config.size() && first < 0.0; ++i)
+      if (m.switch_config[i] == static_cast<int>(k)) first = i == 0 ? 0.0 : m.switch_times[i - 1];
+    list.push_back({{"switches", states},
+                    {"first_holds_at", first},
+                    {"passive", r.passive},
+                    {"passive_reason", r.passive_reason},
+                    {"globally_well_posed", r.globally_well_posed},
+                    {"locally_well_posed", r.locally_well_posed},
+                    {"verdict", r.verdict}});
+    d.out << "  " << name << " (from t = " << short_number(first) << " s): passive " << r.passive
+          << "; " << r.verdict << "\n";
+  }
+  d.j["circuit"]["configurations"] = list;
+}
+
 void notes_section(Draft& d, const std::vector<std::string>& notes) {
   d.j["notes"] = notes;
   d.out << "notes:";
@@ -480,7 +519,10 @@ AnalysisReport analysis_report(const scene::LoadedModel& loaded, const AnalysisO
     mechanical_section(d, model, sys);
   else
     lcs_section(d, sys);
-  if (loaded.circuit) circuit_section(d, *loaded.circuit);
+  if (loaded.circuit) {
+    circuit_section(d, *loaded.circuit);
+    configurations_section(d, *loaded.circuit);
+  }
   notes_section(d, notes);
   const LeftOut wp_left = options.full ? LeftOut{} : lcs::summary_left_out(wp);
   well_posedness_json(d, wp, wp_left);

@@ -478,7 +478,13 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
   Ldcp s{sys, data, opt, solver, -n + 1, FreeResponse(sys, x0), {}, {}, {}};
   s.state.assign(sys.k(), RowState::kUndecided);
   out.message = solve_levels(s, out.lcp_solves);
-  if (!out.message.empty()) return out;
+  if (!out.message.empty()) {
+    // A failure says where: the rows active and undecided when it failed
+    // (the caller names them; status stays a failure).
+    out.mode = rows_in(s.state, RowState::kActive);
+    out.undetermined = rows_in(s.state, RowState::kUndecided);
+    return out;
+  }
   out.mode = rows_in(s.state, RowState::kActive);
   out.undetermined = rows_in(s.state, RowState::kUndecided);
   out.x_plus = x0 + impulsive_jump(s, out.impulse);

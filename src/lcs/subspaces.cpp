@@ -244,6 +244,44 @@ Projection projection(const Lcs& sys, const IndexSet& I) {
   return out;
 }
 
+namespace {
+
+// A singular script M_II (rows scaled to unit max-norm) whose rows are
+// dependent: a combination w' (R x + M_II u) = w' R x of the mode's
+// relations y_i^(rho_i) = 0 holds no input, so w' R x vanishes identically on
+// the phase and so does its derivative w' R A x + w' R B_.I u (the u' it
+// would carry is w' M_II u' = 0). That derivative replaces the row of
+// largest |w_j| (the others and w' R x = 0 imply it back); repeated until
+// M_II is regular (Silverman's structure algorithm, as §3.3's V_I recursion
+// differentiates outputs). An ideal bridge's tank meeting a loaded capacitor
+// through two diodes (C1 || C2: y_D2 + y_D3 = v + w has no feedthrough)
+// needs one round. True when M_II became regular; false when a combination
+// vanishes in x too (a redundant output) or the rounds run out.
+bool differentiate_dependent_rows(const MatrixXd& A, const MatrixXd& BI, MatrixXd& R,
+                                  MatrixXd& Mc) {
+  const Eigen::Index m = Mc.rows();
+  for (Eigen::Index round = 0; round < m * (A.rows() + 1); ++round) {
+    const Eigen::JacobiSVD<MatrixXd> svd(Mc, Eigen::ComputeFullU);
+    if (svd.singularValues()(m - 1) > rank_tolerance(Mc)) return true;
+    const VectorXd w = svd.matrixU().col(m - 1);
+    Eigen::Index j = 0;
+    w.cwiseAbs().maxCoeff(&j);
+    const Eigen::RowVectorXd r = w.transpose() * R;
+    const double terms = (w.cwiseAbs().transpose() * R.cwiseAbs()).maxCoeff();
+    if (r.cwiseAbs().maxCoeff() <= 1e-12 * terms) return false;  // vanishes in x too
+    R.row(j) = r * A;
+    Mc.row(j) = r * BI;
+    const double s = Mc.row(j).cwiseAbs().maxCoeff() > 0.0 ? Mc.row(j).cwiseAbs().maxCoeff()
+                                                           : R.row(j).cwiseAbs().maxCoeff();
+    if (s == 0.0) return false;
+    R.row(j) /= s;
+    Mc.row(j) /= s;
+  }
+  return false;
+}
+
+}  // namespace
+
 ModeFeedback mode_feedback(const Lcs& sys, const IndexSet& I) {
   const Quadruple q = mode_quadruple(sys, I);
   const int n = sys.n(), m = static_cast<int>(I.size());
@@ -279,7 +317,8 @@ ModeFeedback mode_feedback(const Lcs& sys, const IndexSet& I) {
     R.row(a) /= s;
   }
   Eigen::JacobiSVD<MatrixXd> svd(Mc);
-  if (svd.singularValues()(m - 1) <= rank_tolerance(Mc)) {
+  if (svd.singularValues()(m - 1) <= rank_tolerance(Mc) &&
+      !differentiate_dependent_rows(q.K, q.L, R, Mc)) {
     std::ostringstream os;
     os << "mode " << set_to_string(I)
        << ": leading row coefficient matrix script M_II is singular (sigma_min/sigma_max = "

@@ -25,6 +25,7 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <lcsim/sim/sim.hpp>
@@ -82,10 +83,25 @@ struct Monitor {
   int friction = -1;        // entry of mechanical.friction for a cone or sliding monitor
 };
 
+// A free pair of a mode (free_pairs.cpp): a pair r of the mode whose
+// multiplier u_r moves neither the state (B_r = 0) nor any held output
+// (D_{S r} = 0 on the mode and its undetermined rows S) and whose own
+// output vanishes identically: u_r is not unique (an ideal bridge's load
+// floating while its four diodes block: D1's reverse voltage), only bounded
+// by the outputs it moves. Its admissible values at x are the z with
+// z >= 0, z >= l x (l in lower) and z <= h x (h in upper); the phase's
+// monitors are the differences h - l (Fourier–Motzkin), and a sample's u_r
+// is the least admissible value, max(0, l x) (unbalanced coordinates).
+struct FreePair {
+  int column = -1;
+  std::vector<RowVectorXd> lower, upper;
+};
+
 struct Phase {
   lcs::IndexSet mode;
-  MatrixXd Acl;  // closed-loop matrix
-  MatrixXd F;    // u_I = F x (|I| x n)
+  MatrixXd Acl;                // closed-loop matrix
+  MatrixXd F;                  // u_I = F x (|I| x n); a free pair's row is zero
+  std::vector<FreePair> free;  // general LCS only (free_pairs.cpp)
   // Models with friction: the mode of each entry of mechanical.friction and
   // its tangential multiplier u_T = Ft x (n_F x n); both empty otherwise.
   std::vector<FrictionMode> friction;
@@ -431,7 +447,31 @@ class EventDriven {
                                       const VectorXd& gap, const VectorXd& gap_scale,
                                       const VectorXd& rate, VectorXd& xa,
                                       lcs::IndexSet& joined) const;
-  EventResult process_lcs(const VectorXd& xa);
+  EventResult process_lcs(double t, const VectorXd& xa);
+  // Free pairs (free_pairs.cpp). The pairs of `mode` that are free (FreePair)
+  // with `undetermined` held too; empty for mechanical models.
+  lcs::IndexSet free_columns(const lcs::IndexSet& mode, const lcs::IndexSet& undetermined) const;
+  // Column c could be a free pair of a mode holding `held` (c among them):
+  // B_c = 0, D_{held c} = 0, and some output outside `held` moves with u_c.
+  bool free_shape(int c, const lcs::IndexSet& held) const;
+  // The phase's feedback and monitors when ph.mode has free pairs; false
+  // with err set when refused.
+  bool free_feedback(Phase& ph, const lcs::IndexSet& free, std::string& err) const;
+  bool add_free_monitors(Phase& ph, const lcs::IndexSet& free, const lcs::IndexSet& undetermined,
+                         std::string& err) const;
+  // Moves into `mode` the pairs that are free there (undetermined ones, and
+  // inactive ones whose output vanishes identically): one phase per motion.
+  void normalise_free(lcs::IndexSet& mode, lcs::IndexSet& undetermined) const;
+  // Mode selection when the LDCP's levels fail (a singular script M_II):
+  // every mode whose phase starts consistently at xa; true with out.mode
+  // set when one motion continues the state, else false with why.
+  bool select_by_enumeration(double t, const VectorXd& xa, EventResult& out, std::string& why);
+  // " (active: D1; undecided: D2, D3)": a failed selection's sets by the
+  // pairs' names (a circuit's diodes), "" when both are empty.
+  std::string pair_sets(const lcs::IndexSet& active, const lcs::IndexSet& undecided) const;
+  std::string pair_list(const lcs::IndexSet& s) const;  // "D1, D2" ("none" when empty)
+  // y_r vanishes identically on the phase from xa, for every held pair r.
+  bool held_outputs_vanish(const Phase& ph, const VectorXd& xa) const;
   void record(Trajectory& tr, double t, const VectorXd& xa, const Phase& ph) const;
   // A phase's start, per monitor: the noise level of its value, the order m0
   // of its first nonzero derivative (0 = the value; -1 = none up to n) and
@@ -561,6 +601,11 @@ class EventDriven {
     if (!ph.mode.empty()) {
       const VectorXd uI = ph.F * xa;
       for (size_t i = 0; i < ph.mode.size(); ++i) u(ph.mode[i]) = uI(i);
+    }
+    for (const FreePair& f : ph.free) {  // the least admissible value
+      double z = 0.0;
+      for (const RowVectorXd& l : f.lower) z = std::max(z, l.dot(xa));
+      u(f.column) = z;
     }
     return u;
   }

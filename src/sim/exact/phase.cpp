@@ -150,8 +150,11 @@ Phase EventDriven::build_phase(const lcs::IndexSet& mode, const std::vector<Fric
   ph.Ft = MatrixXd::Zero(static_cast<Eigen::Index>(friction.size()), n_);
   const bool frictional = std::any_of(friction.begin(), friction.end(),
                                       [](FrictionMode f) { return f != FrictionMode::kOpen; });
+  const lcs::IndexSet free = free_columns(mode, undetermined);  // empty but for circuits
   if (frictional) {
     if (!friction_feedback(ph, xa, err)) return ph;
+  } else if (!free.empty()) {
+    if (!free_feedback(ph, free, err) || !add_free_monitors(ph, free, undetermined, err)) return ph;
   } else if (!mode.empty()) {
     auto it = feedback_cache_.find(mode);
     if (it == feedback_cache_.end())
@@ -166,7 +169,7 @@ Phase EventDriven::build_phase(const lcs::IndexSet& mode, const std::vector<Fric
     for (size_t i = 0; i < mode.size(); ++i) BI.col(i) = sys_.B.col(mode[i]);
     ph.Acl += BI * ph.F;
   }
-  for (int r = 0; r < k_; ++r) {
+  for (int r = 0; free.empty() && r < k_; ++r) {
     const auto in_mode = std::find(mode.begin(), mode.end(), r);
     Monitor mon;
     mon.constraint = r;

@@ -10,6 +10,7 @@
 // approaches, select_regular_mode.
 #include <algorithm>
 #include <cmath>
+#include <lcsim/core/format.hpp>
 
 #include "sim/exact/event_driven_detail.hpp"
 
@@ -195,7 +196,7 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0,
   return out;
 }
 
-EventResult EventDriven::process_lcs(const VectorXd& xa0) {
+EventResult EventDriven::process_lcs(double t, const VectorXd& xa0) {
   EventResult out;
   out.impulse = VectorXd::Zero(k_);
   VectorXd xa = xa0;
@@ -205,7 +206,12 @@ EventResult EventDriven::process_lcs(const VectorXd& xa0) {
     const lcs::ModeSelection sel = lcs::select_mode(sys_, xa, ldcp_);
     out.lcp_solves += sel.lcp_solves;
     if (!sel.ok()) {
-      out.message = "mode selection: " + sel.message;
+      // The levels assume a P-matrix script M; a circuit's is not (free
+      // pairs, free_pairs.cpp): every mode is then tried at this state.
+      std::string why;
+      if (select_by_enumeration(t, xa, out, why)) return out;
+      out.message = "mode selection at t = " + short_number(t) + " s: " +
+                    (why.empty() ? sel.message + pair_sets(sel.mode, sel.undetermined) : why);
       return out;
     }
     bool impulsive = false;
@@ -216,6 +222,7 @@ EventResult EventDriven::process_lcs(const VectorXd& xa0) {
       out.x_plus = xa;
       out.status = Status::kOk;
       ldcp_undetermined_ = sel.undetermined;
+      normalise_free(out.mode, ldcp_undetermined_);  // a no-op unless a pair is free
       return out;
     }
     out.impulse += sel.impulse[0];
@@ -228,7 +235,7 @@ EventResult EventDriven::process_lcs(const VectorXd& xa0) {
 }
 
 EventResult EventDriven::process_event(double t, const VectorXd& xa, const lcs::IndexSet& held) {
-  return model_.is_mechanical() ? process_mechanical(t, xa, held) : process_lcs(xa);
+  return model_.is_mechanical() ? process_mechanical(t, xa, held) : process_lcs(t, xa);
 }
 
 }  // namespace lcsim::sim::detail
