@@ -467,6 +467,33 @@ TEST(SensitivityEvents, LcsJumpsAgainstFiniteDifferences) {
   EXPECT_EQ(expect_matches_fd(m, m.initial, T, ps, true), 12 * 9);
 }
 
+// A release after a jump: the LCS above with the sine's weight 3 (A[1][4]):
+// body 1 hits stop1 at 2.371 s (a jump; the event's root leaves q1 at
+// -2.2e-16, which the jump keeps), is held, and is pulled off at 3.165 s
+// (its force reaching zero), then hits again at 5.612 s. The free phase
+// after the release starts with y0 = q1 = -2.2e-16, within mode selection's
+// zero test, opening by its second derivative: the monitor follows it from
+// the start as an opening at zero (monitors.cpp), where it used to see a
+// spurious event 1.5e-6 s later (changing no mode: "grazing", every column
+// lost). Now x0 and four entries against central differences at x(T) and
+// the three event times: (7 + 4) columns x (7 + 3) entries, no loss.
+TEST(SensitivityEvents, LcsReleaseAfterJumpAgainstFiniteDifferences) {
+  mech::Model m = jumping_lcs();
+  m.lcs->A(1, 4) = 3.0;
+  const double T = 6.0;
+  const sim::Trajectory plain = run(m, m.initial, T);
+  ASSERT_TRUE(plain.ok()) << plain.message;
+  ASSERT_EQ(plain.events.size(), 3u);
+  EXPECT_EQ(plain.events[0].type, sim::EventType::kImpact);
+  EXPECT_EQ(plain.events[1].type, sim::EventType::kRelease);
+  EXPECT_EQ(plain.events[2].type, sim::EventType::kImpact);
+  EXPECT_NEAR(plain.events[1].t, 3.16465594546351, 1e-9);
+  const std::vector<Perturbation> ps = {
+      lcs_entry('A', 1, 0, "A[1][0]", -2.0), lcs_entry('A', 1, 4, "A[1][4]", 3.0),
+      lcs_entry('A', 1, 6, "A[1][6]", -1.0), lcs_entry('C', 1, 6, "C[stop2][6]", 0.1)};
+  EXPECT_EQ(expect_matches_fd(m, m.initial, T, ps, true), 11 * 10);
+}
+
 // An entry that changes a leading row index is a singular perturbation:
 // B[0][0] makes C B nonzero (stop1's relative degree 2 -> 1), D[stop1][0]
 // makes it 0. Each is reported absent, naming the pair, from the first phase
