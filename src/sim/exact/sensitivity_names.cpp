@@ -106,16 +106,20 @@ std::string one_sided_times(const mech::Input& in, const SensParam& p) {
   return "";
 }
 
-std::string check_input_param(const mech::Input& in, const InputName& w, const SensParam& p) {
-  const bool pulse = in.kind == "pulse";
+// "" when the input's kind has the parameter, else why not.
+std::string kind_fits(const mech::Input& in, const InputName& w) {
   const bool fits = w.family == 'b' || (w.family == 's' && in.sine) ||
-                    (w.family == 'p' && !in.sine) || (w.family == 'u' && pulse) ||
+                    (w.family == 'p' && !in.sine) || (w.family == 'u' && in.kind == "pulse") ||
                     (w.family == 'r' && (in.kind == "step" || in.kind == "ramp"));
-  if (!fits)
-    return std::string("input '") + in.name + "' is a " + in.kind + ": it has no " + w.word +
-           " (a sine: amplitude, offset, frequency, damping, phase, delay; piecewise linear: "
-           "pwl_v[in][k], pwl_t[in][k], delay; a step or ramp also time; a pulse also v1, v2, "
-           "rise, width, fall, period)";
+  if (fits) return "";
+  return std::string("input '") + in.name + "' is a " + in.kind + ": it has no " + w.word +
+         " (a sine: amplitude, offset, frequency, damping, phase, delay; piecewise linear: "
+         "pwl_v[in][k], pwl_t[in][k], delay; a step or ramp also time; a pulse also v1, v2, "
+         "rise, width, fall, period)";
+}
+
+// "" when the parameter has a two-sided derivative at the input's values.
+std::string two_sided(const mech::Input& in, const SensParam& p) {
   if (in.sine && p.kind == 'y' && in.origin == 0.0 && in.amplitude * std::sin(in.phase) != 0.0)
     return "the sine starts off its offset at t = 0 with a zero delay: only one-sided "
            "derivatives exist";
@@ -150,6 +154,10 @@ bool parse_input_param(const mech::MechanicalModel& m, const std::string& s, Sen
     return true;
   }
   const mech::Input& in = m.inputs[static_cast<size_t>(p.i)];
+  if (error = kind_fits(in, *w); !error.empty()) {
+    error = bad + error;
+    return true;
+  }
   if (w->point) {
     std::vector<std::string> points(in.times.size());
     p.j = resolve(k[1], points);
@@ -161,7 +169,7 @@ bool parse_input_param(const mech::MechanicalModel& m, const std::string& s, Sen
   } else {
     p.j = 0;  // time[in]: a step's or a ramp's one time, point 0
   }
-  error = check_input_param(in, *w, p);
+  error = two_sided(in, p);
   if (!error.empty()) error = bad + error;
   return true;
 }
