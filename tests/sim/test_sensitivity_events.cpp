@@ -361,15 +361,18 @@ TEST(SensitivityEvents, BlockSlidingToRestClosedForm) {
   EXPECT_NEAR(early.dx_final(0, 0), 1.0, 1e-13);
 }
 
-// What stays refused with friction: a parameter, another method, 3-D.
+// What stays refused with friction: a parameter of M, another method, 3-D.
 TEST(SensitivityEvents, FrictionRefusals) {
   const mech::Model m = load("robots/block_on_floor_friction.yaml");
   sim::Options opt;
   opt.t_end = 0.1;
-  opt.sensitivity = {"x0", "f[1]"};
+  // (f[1] was refused here; f, g, K, D are computed now:
+  // tests/sim/test_sensitivity_friction_params.cpp.)
+  opt.sensitivity = {"x0", "M[0][0]"};
   sim::Trajectory tr = sim::simulate(m, m.initial, opt, "event");
   EXPECT_EQ(tr.status, Status::kInvalidInput);
-  EXPECT_NE(tr.message.find("'f[1]': not computed with friction"), std::string::npos) << tr.message;
+  EXPECT_NE(tr.message.find("'M[0][0]': not computed with friction"), std::string::npos)
+      << tr.message;
   opt.sensitivity = {"x0"};
   tr = sim::simulate(m, m.initial, opt, "moreau-jean");
   EXPECT_EQ(tr.status, Status::kInvalidInput);

@@ -80,7 +80,8 @@ int expect_matches_fd(const mech::Model& m, const VectorXd& x0, double T,
   EXPECT_TRUE(tr.ok()) << tr.message;
   if (!tr.ok()) return 0;
   for (const auto& l : tr.sensitivity_losses)  // one that ends a column
-    if (!l.columns.empty()) ADD_FAILURE() << "t = " << l.t << " '" << l.contact << "': " << l.reason;
+    if (!l.columns.empty())
+      ADD_FAILURE() << "t = " << l.t << " '" << l.contact << "': " << l.reason;
   const VectorXd base = outcome(tr);
   const double xs = std::max(1.0, base.cwiseAbs().maxCoeff());
   const Eigen::Index n = tr.final_state.size();

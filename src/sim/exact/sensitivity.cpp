@@ -244,8 +244,9 @@ void Sensitivity::begin_phase(const Phase& ph, double t0, const VectorXd& xa, co
   mode_ = ph.mode;
   monitors_ = ph.monitors;
   for (Monitor& mon : monitors_) mon.w = mon.w.cwiseQuotient(ph.D.transpose());
+  const bool friction = mech_ && model_.mechanical->has_friction() && !cols_.params.empty();
   if (std::any_of(exists_.begin(), exists_.end(), [](char e) { return e != 0; }))
-    mode_derivatives(ph.mode, t0);
+    friction ? friction_mode_derivatives(ph, t0) : mode_derivatives(ph.mode, t0);
   else
     dAb_.clear(), dF_.assign(cols_.params.size(), MatrixXd()),
         dW_.assign(cols_.params.size(), MatrixXd());  // at() carries nothing
@@ -409,6 +410,10 @@ void Sensitivity::before_event(double tau, const VectorXd& x_minus, int monitor)
   for (size_t p = 0; p < cols_.params.size(); ++p) {
     const SensParam& sp = cols_.params[p];
     const Eigen::Index c = nx0_ + static_cast<Eigen::Index>(p);
+    if (mon.friction >= 0) {  // a stick force's or a sliding velocity's
+      if (dF_[p].size() > 0) dh(c) += friction_monitor_dh(p, static_cast<size_t>(monitor), x_minus);
+      continue;
+    }
     if (!mon.multiplier && sp.kind == 'g' && sp.i == mon.constraint) dh(c) += 1.0;
     if (!mon.multiplier && dW_[p].size() > 0) dh(c) += dW_[p].row(mon.constraint).dot(x_minus);
     if (mon.multiplier && dF_[p].size() > 0) {

@@ -107,6 +107,11 @@ class Sensitivity {
   // its outcome (x0 only: parameters are refused with friction); false, with
   // every column lost, where the outcome is not locally constant.
   bool friction_impact_map(double t, const EventResult::ImpactRound& round, MatrixXd& J);
+  // A phase with planar friction (sensitivity_friction.cpp): dAcl and the
+  // forces' dF (normals, then the sticking tangents) for f[i], g[c],
+  // K[i][j], D[i][j]; a stick monitor's parameter term dh.
+  void friction_mode_derivatives(const Phase& ph, double t);
+  double friction_monitor_dh(size_t p, size_t monitor, const VectorXd& x) const;
   bool friction_impact_regular(double t, const EventResult::ImpactRound& rd,
                                const std::vector<int>& A, const std::vector<int>& stuck,
                                const std::vector<int>& sliding, const VectorXd& lambda,
@@ -186,7 +191,9 @@ class Sensitivity {
   // Constraints whose monitors are the trigger's up to a positive factor
   // (same_event): they switch with it.
   std::vector<int> co_triggers_;
-  bool trigger_stick_ = false;  // the trigger was a stick force reaching the cone's edge
+  bool trigger_stick_ = false;
+  std::vector<Eigen::Index> stick_row_;  // per friction entry: its row of dF (-1 if not stuck)  //
+                                         // the trigger was a stick force reaching the cone's edge
 };
 
 }  // namespace lcsim::sim::detail

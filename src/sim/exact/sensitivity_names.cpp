@@ -276,9 +276,8 @@ std::string refuse_for_scheme(const detail::SensColumns& c, std::string_view met
   return "";
 }
 
-// Friction: the exact method through planar stick / slip, x0 only (its
-// phases' dAcl/dtheta for a parameter would need the friction's columns);
-// "" or why not.
+// Friction: the exact method through planar stick / slip, x0 and the
+// parameters that leave the friction's columns as they are; "" or why not.
 std::string refuse_friction(const mech::Model& model, const Options& opt, std::string_view method,
                             const OptionsUsed& used) {
   const std::string head =
@@ -291,10 +290,15 @@ std::string refuse_friction(const mech::Model& model, const Options& opt, std::s
     if (m.friction[f].is_3d())
       return head + "mechanical.friction[" + std::to_string(f) +
              "] is a 3-D contact (tangent2): sensitivities through 3-D friction are not computed";
+  // The free acceleration's parameters and the gap offsets: f, K, D, g
+  // (sensitivity_friction.cpp); the rest moves the friction's own columns or
+  // its impacts.
   for (const std::string& s : opt.sensitivity)
-    if (s != "x0")
+    if (s != "x0" &&
+        !(s.size() > 1 && std::string("fgKD").find(s[0]) != std::string::npos && s[1] == '['))
       return "Options::sensitivity '" + s + "': not computed with friction (model '" + model.name +
-             "' has mechanical.friction; through planar stick / slip only x0 is)";
+             "' has mechanical.friction; through planar stick / slip x0, f[i], g[c], K[i][j] and "
+             "D[i][j] are)";
   return "";
 }
 
