@@ -168,5 +168,70 @@ TEST(SensitivityFrictionParams, FrictionFilesAgainstFiniteDifferences) {
   EXPECT_EQ(total, 2 * 5 + 4 * 6 + 2 * 5 + 2 * 6);
 }
 
+// mu[c], the friction coefficient (kind 'u'): it moves a sliding contact's
+// force column -sigma mu t (the phase's dF and dAcl), a stick monitor by
+// d(mu) u_N, and a sliding impact's tangential impulse. The block sliding
+// to rest (v0 = 2, mu = 0.4, g = 9.81): x* = v0^2/(2 mu g), so dx*/dmu =
+// -x*/mu and dt*/dmu = -t*/mu; before the stop (T = 0.3 s) x = v0 T - mu g
+// T^2/2: dx/dmu = -g T^2/2, dv/dmu = -g T. The block dropped from y0 = 0.2
+// m at vx0 = 2 m/s (w = sqrt(2 g y0) at the impact t1 = w/g, after which it
+// slides: vx+ = vx0 - mu w, decelerating at mu g), at T = 0.4 s:
+// dx/dmu = -w (T - t1) - g (T - t1)^2/2, dvx/dmu = -w - g (T - t1). To
+// 1e-12 as above.
+TEST(SensitivityFrictionParams, MuClosedForms) {
+  mech::Model m = load("robots/block_on_floor_friction.yaml");
+  const double v0 = 2.0, mu = 0.4, g = 9.81;
+  const sim::Trajectory tr = run(m, 1.0, {"mu[floor]"});
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  ASSERT_EQ(tr.events.size(), 1u);
+  const double xs = v0 * v0 / (2 * mu * g), ts = v0 / (mu * g);
+  EXPECT_NEAR(tr.dx_final(0, 0), -xs / mu, 1e-12);
+  EXPECT_NEAR(tr.events[0].dt(0), -ts / mu, 1e-12);
+  EXPECT_NEAR(tr.dx_final(2, 0), 0.0, 1e-12);
+  const double T = 0.3;
+  const sim::Trajectory early = run(m, T, {"mu[0]"});
+  ASSERT_TRUE(early.ok()) << early.message;
+  EXPECT_NEAR(early.dx_final(0, 0), -g * T * T / 2, 1e-12);
+  EXPECT_NEAR(early.dx_final(2, 0), -g * T, 1e-12);
+  m.initial << 0, 0.2, 2, 0;
+  const double w = std::sqrt(2 * g * 0.2), t1 = w / g, Td = 0.4;
+  const sim::Trajectory drop = run(m, Td, {"mu[floor]"});
+  ASSERT_TRUE(drop.ok()) << drop.message;
+  ASSERT_EQ(drop.events.size(), 1u);  // the impact, sliding after it
+  ASSERT_TRUE(drop.dx_final_exists[0]);
+  EXPECT_NEAR(drop.dx_final(0, 0), -w * (Td - t1) - g * (Td - t1) * (Td - t1) / 2, 1e-12);
+  EXPECT_NEAR(drop.dx_final(2, 0), -w - g * (Td - t1), 1e-12);
+  // Refused: a constraint without friction, and on a frictionless model.
+  sim::Options o;
+  o.t_end = 0.1;
+  o.sensitivity = {"mu[nope]"};
+  EXPECT_EQ(sim::simulate(m, m.initial, o, "event").status, Status::kInvalidInput);
+  const mech::Model ball = load("robots/ball.yaml");
+  o.sensitivity = {"mu[0]"};
+  const sim::Trajectory nb = sim::simulate(ball, ball.initial, o, "event");
+  EXPECT_EQ(nb.status, Status::kInvalidInput);
+  EXPECT_NE(nb.message.find("has no friction"), std::string::npos) << nb.message;
+}
+
+// mu[0] on the four planar friction files against central differences (the
+// belt: stick then slip, the stick force's monitor mu u_N - u_T reaching
+// zero moves by d(mu) u_N; the spring: slip reversal and stick).
+TEST(SensitivityFrictionParams, MuAgainstFiniteDifferences) {
+  int total = 0;
+  for (const char* name :
+       {"robots/block_on_floor_friction.yaml", "robots/mass_spring_friction.yaml",
+        "robots/incline_friction.yaml", "robots/belt_friction.yaml"}) {
+    const mech::Model m = load(name);
+    const Param mu{"mu[0]", m.mechanical->friction[0].mu,
+                   [](mech::MechanicalModel& mm, double d) { mm.friction[0].mu += d; }};
+    const sim::Trajectory plain = run(m, m.t_end);
+    ASSERT_TRUE(plain.ok()) << plain.message;
+    const int per = static_cast<int>(m.initial.size() + plain.events.size());
+    EXPECT_EQ(expect_matches_fd(m, m.t_end, {mu}), per) << name;
+    total += per;
+  }
+  EXPECT_EQ(total, 5 + 6 + 5 + 6);
+}
+
 }  // namespace
 }  // namespace lcsim

@@ -574,7 +574,7 @@ void Sensitivity::after_event(const EventResult& ev, const Phase& next, double t
         lose_all(t, r, "coinciding events: this contact closes at the same time as another");
     for (const auto& rd : ev.rounds) {
       MatrixXd Jr, dRr = MatrixXd::Zero(n_, m_);
-      if (friction ? !friction_impact_map(t, rd, Jr) : !impact_map(t, rd, Jr, dRr)) break;
+      if (friction ? !friction_impact_map(t, rd, Jr, dRr) : !impact_map(t, rd, Jr, dRr)) break;
       J = Jr * J;
       dR = Jr * dR + dRr;
     }

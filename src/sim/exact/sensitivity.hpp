@@ -23,10 +23,10 @@
 
 namespace lcsim::sim::detail {
 
-// A named parameter: f[i], g[c], e[c], K[i][j], D[i][j], M[i][j] of a
-// mechanical model, A[i][j], B[i][j], C[i][j], D[i][j] of a general LCS
-// (0-based indices resolved from names), or an input's own (i the input,
-// j a point; kinds in input_param_kind).
+// A named parameter: f[i], g[c], e[c], K[i][j], D[i][j], M[i][j], mu[c]
+// (kind 'u', j the friction entry) of a mechanical model, A[i][j], B[i][j], C[i][j], D[i][j] of a
+// general LCS (0-based indices resolved from names), or an input's own (i the input, j a point;
+// kinds in input_param_kind).
 struct SensParam {
   char kind = 'f';
   int i = -1, j = -1;
@@ -104,9 +104,10 @@ class Sensitivity {
   const MatrixXd& at_dense(double t, double tau);
   bool impact_map(double t, const EventResult::ImpactRound& round, MatrixXd& J, MatrixXd& dR);
   // An impact round with planar friction (sensitivity_friction.cpp): J at
-  // its outcome (x0 only: parameters are refused with friction); false, with
+  // its outcome and dR for mu[c] (a sliding contact's impulse); false, with
   // every column lost, where the outcome is not locally constant.
-  bool friction_impact_map(double t, const EventResult::ImpactRound& round, MatrixXd& J);
+  bool friction_impact_map(double t, const EventResult::ImpactRound& round, MatrixXd& J,
+                           MatrixXd& dR);
   // A phase with planar friction (sensitivity_friction.cpp): dAcl and the
   // forces' dF (normals, then the sticking tangents) for f[i], g[c],
   // K[i][j], D[i][j]; a stick monitor's parameter term dh.
@@ -192,8 +193,9 @@ class Sensitivity {
   // (same_event): they switch with it.
   std::vector<int> co_triggers_;
   bool trigger_stick_ = false;
-  std::vector<Eigen::Index> stick_row_;  // per friction entry: its row of dF (-1 if not stuck)  //
-                                         // the trigger was a stick force reaching the cone's edge
+  std::vector<Eigen::Index> stick_row_;  // per friction entry: its row of dF (-1 if not stuck)
+  MatrixXd friction_F_;  // the friction phase's forces (normals, sticking tangents)  //
+                         // the trigger was a stick force reaching the cone's edge
 };
 
 }  // namespace lcsim::sim::detail

@@ -179,6 +179,18 @@ namespace {
 std::string parse_one(const mech::MechanicalModel& m, const std::string& s, SensParam& p) {
   const std::string bad = "sensitivity '" + s + "': ";
   if (std::string error; parse_input_param(m, s, p, error)) return error;
+  if (s.rfind("mu[", 0) == 0) {  // a contact's friction coefficient: kind 'u'
+    const std::vector<std::string> k = keys(s.substr(1));
+    if (k.size() != 1u) return bad + "expected one index, as mu[floor]";
+    p.kind = 'u';
+    p.name = s;
+    p.i = resolve(k[0], m.constraints);
+    if (p.i < 0) return bad + "no constraint '" + k[0] + "'";
+    for (size_t f = 0; f < m.friction.size(); ++f)
+      if (m.friction[f].contact == p.i) p.j = static_cast<int>(f);
+    if (p.j < 0) return bad + "constraint '" + k[0] + "' has no friction (mechanical.friction)";
+    return "";
+  }
   if (s.size() < 2 || std::string("fgeKDM").find(s[0]) == std::string::npos)
     return bad +
            "not a parameter name (x0, f[i], g[c], e[c], K[i][j], D[i][j], M[i][j], or an "
@@ -294,11 +306,11 @@ std::string refuse_friction(const mech::Model& model, const Options& opt, std::s
   // (sensitivity_friction.cpp); the rest moves the friction's own columns or
   // its impacts.
   for (const std::string& s : opt.sensitivity)
-    if (s != "x0" &&
+    if (s != "x0" && s.rfind("mu[", 0) != 0 &&
         !(s.size() > 1 && std::string("fgKD").find(s[0]) != std::string::npos && s[1] == '['))
       return "Options::sensitivity '" + s + "': not computed with friction (model '" + model.name +
-             "' has mechanical.friction; through planar stick / slip x0, f[i], g[c], K[i][j] and "
-             "D[i][j] are)";
+             "' has mechanical.friction; through planar stick / slip x0, f[i], g[c], K[i][j], "
+             "D[i][j] and mu[c] are)";
   return "";
 }
 
