@@ -275,7 +275,7 @@ TEST(SensitivityInputs, PwlLiftPointsAgainstFiniteDifferences) {
 // 0.1 1/s, phase 0.4, offset 0.1, delay 0.5 s): the delay's breakpoint,
 // impact, release under the sine (a multiplier monitor: dF_I in the
 // exosystem's columns), impact, release, to T = 8 s. Every sine parameter
-// against central differences.
+// against central differences: 6 x (2 + 5) entries.
 TEST(SensitivityInputs, DampedSineForceAgainstFiniteDifferences) {
   const mech::Model m =
       from_text("pushed",
@@ -289,29 +289,31 @@ TEST(SensitivityInputs, DampedSineForceAgainstFiniteDifferences) {
   const sim::Trajectory plain = run(m, m.initial, 8.0);
   ASSERT_TRUE(plain.ok()) << plain.message;
   const int events = static_cast<int>(plain.events.size());
-  ASSERT_GE(events, 4);
+  ASSERT_EQ(events, 5);  // 0.5 s, 3.202, 3.694, 6.698, 7.057
   EXPECT_EQ(expect_matches_fd(m, m.initial, 8.0, sine_params(m.mechanical->inputs[0], 0, true)),
             6 * (2 + events));
 }
 
-// A periodic pulse force (v1 = -1, v2 = 3, rise 0.1, width 0.3, fall 0.2,
+// A periodic pulse force (v1 = -2, v2 = 3, rise 0.1, width 0.3, fall 0.2,
 // period 1, delay 0.25) on a unit mass on a spring (K = 4) above a stop
-// (q >= -0.3, e = 0.5), from rest, to T = 2.2 s: its edges are scheduled
-// events, the mass hits the stop; each pulse parameter against central
-// differences (width, rise and fall move the points after them; the period
-// moves the second repetition's points).
+// (q >= -0.1, e = 0.5), from rest, to T = 2.2 s: its eight edges are
+// scheduled events, and the mass pulled by v1 hits the stop at 0.328 s
+// (9 events); each pulse parameter against central differences at x(T)
+// and every event time (width, rise and fall move the points after them;
+// the period moves the second repetition's points): 7 x (2 + 9) entries.
 TEST(SensitivityInputs, PulseForceAgainstFiniteDifferences) {
   const mech::Model m = from_text(
       "pulsed",
       "name: pulsed\ninputs:\n"
-      "  - {name: p, kind: pulse, v1: -1, v2: 3, rise: 0.1, width: 0.3, fall: 0.2,"
+      "  - {name: p, kind: pulse, v1: -2, v2: 3, rise: 0.1, width: 0.3, fall: 0.2,"
       " period: 1, delay: 0.25}\n"
-      "mechanical:\n  M: [[1]]\n  K: [[4]]\n  E: [[1]]\n  g: [0.3]\n  restitution: [0.5]\n"
+      "mechanical:\n  M: [[1]]\n  K: [[4]]\n  E: [[1]]\n  g: [0.1]\n  restitution: [0.5]\n"
       "  constraints: [stop]\n  force_inputs: [{input: p, gain: [1]}]\n"
       "initial: [0, 0]\nt_end: 2.2\n");
   const sim::Trajectory plain = run(m, m.initial, 2.2);
   ASSERT_TRUE(plain.ok()) << plain.message;
   const int events = static_cast<int>(plain.events.size());
+  EXPECT_EQ(events, 9);
   const std::vector<Param> ps = {
       {"v1[p]", 1.0, [](mech::Input& in, double d) { in.values[0] += d, in.values[3] += d; }},
       {"v2[p]", 3.0, [](mech::Input& in, double d) { in.values[1] += d, in.values[2] += d; }},
