@@ -123,14 +123,15 @@ TEST(SensitivityFiles, EveryShippedModelAgainstCentralDifferences) {
   }
 }
 
-// Files with friction: a parameter is refused by name (input error, one
-// line; x0 through planar stick / slip is test_sensitivity_events.cpp's).
+// Files with friction: a parameter of M is refused by name (input error,
+// one line; x0 through planar stick / slip is test_sensitivity_events.cpp's,
+// f, g, K, D test_sensitivity_friction_params.cpp's: f[0] was refused here).
 TEST(SensitivityFiles, FrictionFilesAreRefused) {
   for (const char* name :
        {"belt_friction.yaml", "block_on_floor_friction.yaml", "incline_friction.yaml",
         "mass_spring_friction.yaml", "spinning_disk_friction.yaml"}) {
     const mech::Model m = load_file(name);
-    const sim::Trajectory tr = exact(m, m.initial, 0.1, {"f[0]"});
+    const sim::Trajectory tr = exact(m, m.initial, 0.1, {"M[0][0]"});
     EXPECT_EQ(tr.status, Status::kInvalidInput) << name;
     EXPECT_NE(tr.message.find("friction"), std::string::npos) << tr.message;
   }

@@ -97,7 +97,10 @@ void EventDriven::first_derivatives(const Phase& phase, const std::vector<Monito
       for (int i = m0[j] + 1; i <= m; ++i) f *= i;
       const double tau = std::pow(ratio * f, 1.0 / (m - m0[j]));
       h_first = std::min(h_first, 0.25 * tau);
-      st.small_opening[j] = m0[j] == 0 && small[j] && d0[j] > 0.0 && dm > 0.0;
+      // Within the zero test and opening by the next derivative: of either
+      // sign (a general LCS's output held at -2.2e-16 through a jump and
+      // released: mode selection took it for zero).
+      st.small_opening[j] = m0[j] == 0 && small[j] && dm > 0.0;
       done[j] = 1;
       --remaining;
     }
@@ -121,10 +124,12 @@ void EventDriven::arm_monitors(PhaseMarch& pm) const {
     const double value = monitors[j].w.dot(pm.xstart);
     if (pm.start.m0[j] == 0 && pm.start.small_opening[j]) {
       // Rounding left a few 1e-14 of a held gap (a clamp's diode held over
-      // many periods) above the noise band, but mode selection took it for
-      // zero and opened it by its next derivative: followed from the start,
-      // as an opening at zero is, so the rounding of the states on the
-      // first, very short samples cannot read as its return.
+      // many periods) above the noise band, or a few 1e-16 below it (a
+      // general LCS's output after its jump, released), but mode selection
+      // took it for zero and opened it by its next derivative: followed
+      // from the start, as an opening at zero is, so the rounding of the
+      // states on the first, very short samples cannot read as its return
+      // (below the band, as a spurious event that changes no mode).
       pm.armed[j] = true;
       pm.opening[j] = 1;
       pm.offset[j] = value;

@@ -39,17 +39,6 @@ void add_input_forces(const mech::MechanicalModel& m, MatrixXd& H) {
   }
 }
 
-// d H / d amplitude of input `input` (N x n): its force uses' gains times
-// d l / d amplitude = (0, 1, 0) on its exosystem's columns.
-MatrixXd amplitude_columns(const mech::MechanicalModel& m, int input, int n) {
-  MatrixXd dH = MatrixXd::Zero(m.dofs(), n);
-  int at = 2 * m.dofs() + 1;
-  for (int i = 0; i < input; ++i) at += m.inputs[static_cast<size_t>(i)].exo_size();
-  for (const mech::InputUse& use : m.force_inputs)
-    if (use.input == input) dH.col(at + 1) += use.gain;
-  return dH;
-}
-
 }  // namespace
 
 Sensitivity::Sensitivity(const mech::Model& model, const lcs::Lcs& sys, const SensColumns& cols,
@@ -104,6 +93,7 @@ void Sensitivity::lose_all(double t, int contact, const std::string& reason) {
 void Sensitivity::start(const VectorXd& xa) {
   MatrixXd S = MatrixXd::Zero(n_, m_);
   for (int i = 0; i < nx0_; ++i) S(i, i) = 1.0;
+  if (mech_) input_start(S);  // an input's parameters move w(0)
   S0_ = S;
   Sc_ = S;
   t0_ = tc_ = 0.0;
@@ -111,6 +101,7 @@ void Sensitivity::start(const VectorXd& xa) {
   dtau_ = RowVectorXd::Zero(m_);
   S_minus_ = S;
   xdot_minus_ = VectorXd::Zero(n_);
+  x_minus_ = xa;
   if (!mech_) {
     start_on_boundary(xa);
     return;
@@ -136,9 +127,13 @@ void Sensitivity::start(const VectorXd& xa) {
     // above for every entry (their tests count the columns it leaves).
     for (int c = 0; c < nx0_; ++c)
       if (E.size() == 0 || E(r, c % N_) != 0.0) cols.push_back(c);
-    for (size_t p = 0; p < cols_.params.size(); ++p)
-      if (cols_.params[p].kind == 'g' && cols_.params[p].i == r)
-        cols.push_back(nx0_ + static_cast<int>(p));
+    for (size_t p = 0; p < cols_.params.size(); ++p) {
+      const SensParam& sp = cols_.params[p];
+      bool moves = sp.kind == 'g' && sp.i == r;
+      for (const mech::InputUse& u : m.gap_inputs)  // an input moving this stop
+        moves = moves || (input_param_kind(sp.kind) && u.input == sp.i && u.gain(r) != 0.0);
+      if (moves) cols.push_back(nx0_ + static_cast<int>(p));
+    }
     lose(0.0, r,
          "zero gap at the start: the initial state is on the boundary of the admissible set, "
          "where only one-sided derivatives exist",
@@ -210,6 +205,10 @@ void Sensitivity::mode_derivatives(const lcs::IndexSet& mode, double t) {
   const MatrixXd QH = Q * H;
   for (int p = 0; p < P; ++p) {
     const SensParam& sp = cols_.params[static_cast<size_t>(p)];
+    if (input_param_kind(sp.kind)) {  // an input's own (sensitivity_inputs.cpp)
+      input_mode_derivatives(static_cast<size_t>(p), mode);
+      continue;
+    }
     // dH has one entry -1 (K, D) or +1 (f) at (i, col); dM is the unit
     // entry (i, j) and its mirror.
     MatrixXd dAv = MatrixXd::Zero(N_, n_), dF = MatrixXd::Zero(kI, n_);
@@ -220,12 +219,6 @@ void Sensitivity::mode_derivatives(const lcs::IndexSet& mode, double t) {
         dAv -= Q.col(sp.j) * QH.row(sp.i);
         dF += WinvEG.col(sp.j) * QH.row(sp.i);
       }
-    } else if (sp.kind == 'a') {
-      // A sine's amplitude: dH = gain (0, 1, 0) on the input's exosystem
-      // columns, for each force it drives (sensitivity_names.cpp).
-      const MatrixXd dH = amplitude_columns(m, sp.i, n_);
-      dAv = Q * dH;
-      dF = -WinvEG * dH;
     } else {
       const int col = sp.kind == 'f' ? 2 * N_ : sp.kind == 'K' ? sp.j : N_ + sp.j;
       const double sign = sp.kind == 'f' ? 1.0 : -1.0;
@@ -251,8 +244,9 @@ void Sensitivity::begin_phase(const Phase& ph, double t0, const VectorXd& xa, co
   mode_ = ph.mode;
   monitors_ = ph.monitors;
   for (Monitor& mon : monitors_) mon.w = mon.w.cwiseQuotient(ph.D.transpose());
+  const bool friction = mech_ && model_.mechanical->has_friction() && !cols_.params.empty();
   if (std::any_of(exists_.begin(), exists_.end(), [](char e) { return e != 0; }))
-    mode_derivatives(ph.mode, t0);
+    friction ? friction_mode_derivatives(ph, t0) : mode_derivatives(ph.mode, t0);
   else
     dAb_.clear(), dF_.assign(cols_.params.size(), MatrixXd()),
         dW_.assign(cols_.params.size(), MatrixXd());  // at() carries nothing
@@ -375,6 +369,8 @@ void Sensitivity::fill(double t, MatrixXd& dx, std::vector<char>& exists) {
 void Sensitivity::before_event(double tau, const VectorXd& x_minus, int monitor) {
   S_minus_ = at(tau);
   xdot_minus_ = Acl_ * x_minus;
+  event_t_ = tau;
+  x_minus_ = x_minus;
   dtau_ = RowVectorXd::Zero(m_);
   if (monitor < 0) return;
   const Monitor& mon = monitors_[static_cast<size_t>(monitor)];
@@ -414,6 +410,10 @@ void Sensitivity::before_event(double tau, const VectorXd& x_minus, int monitor)
   for (size_t p = 0; p < cols_.params.size(); ++p) {
     const SensParam& sp = cols_.params[p];
     const Eigen::Index c = nx0_ + static_cast<Eigen::Index>(p);
+    if (mon.friction >= 0) {  // a stick force's or a sliding velocity's
+      if (dF_[p].size() > 0) dh(c) += friction_monitor_dh(p, static_cast<size_t>(monitor), x_minus);
+      continue;
+    }
     if (!mon.multiplier && sp.kind == 'g' && sp.i == mon.constraint) dh(c) += 1.0;
     if (!mon.multiplier && dW_[p].size() > 0) dh(c) += dW_[p].row(mon.constraint).dot(x_minus);
     if (mon.multiplier && dF_[p].size() > 0) {
@@ -537,6 +537,8 @@ bool Sensitivity::impact_map(double t, const EventResult::ImpactRound& rd, Matri
           law_ == 'r' ? VectorXd(Wf.solve(-dW * mu))
                       : VectorXd((eA.array() + 1.0).matrix().cwiseProduct(Wf.solve(-dW * lambda)));
       dv = dG * EA.transpose() * mu + G_ * EA.transpose() * dmu;
+    } else if (input_param_kind(sp.kind) && !m.gap_inputs.empty()) {
+      dv = input_impact_dv(p, A, EA, Wf, one_e);  // the stops' rate moves
     } else {
       continue;
     }
@@ -580,7 +582,7 @@ void Sensitivity::after_event(const EventResult& ev, const Phase& next, double t
       limit(i);
       const auto& rd = ev.rounds[i];
       MatrixXd Jr, dRr = MatrixXd::Zero(n_, m_);
-      if (friction ? !friction_impact_map(t, rd, Jr) : !impact_map(t, rd, Jr, dRr)) break;
+      if (friction ? !friction_impact_map(t, rd, Jr, dRr) : !impact_map(t, rd, Jr, dRr)) break;
       J = Jr * J;
       dR = Jr * dR + dRr;
     }

@@ -8,6 +8,8 @@
 //   sensitivity_friction.cpp  an impact with planar friction at its outcome
 //   sensitivity_lcs.cpp    a general LCS's parts: dAcl/dtheta of a mode for
 //                          the entries of A, B, C, D, and the jump P_I x
+//   sensitivity_inputs.cpp an input's own parameters (a sine's, a piecewise
+//                          linear input's): the exosystem's rows
 #pragma once
 
 #include <Eigen/Dense>
@@ -21,14 +23,26 @@
 
 namespace lcsim::sim::detail {
 
-// A named parameter: f[i], g[c], e[c], K[i][j], D[i][j], M[i][j] of a
-// mechanical model, A[i][j], B[i][j], C[i][j], D[i][j] of a general LCS
-// (0-based indices resolved from names).
+// A named parameter: f[i], g[c], e[c], K[i][j], D[i][j], M[i][j], mu[c]
+// (kind 'u', j the friction entry) of a mechanical model, A[i][j], B[i][j], C[i][j], D[i][j] of a
+// general LCS (0-based indices resolved from names), or an input's own (i the input, j a point;
+// kinds in input_param_kind).
 struct SensParam {
   char kind = 'f';
   int i = -1, j = -1;
   std::string name;  // as asked
 };
+
+// An input's parameter of a mechanical model (sensitivity_inputs.cpp):
+// 'a' amplitude, 'o' offset, 'w' frequency, 'z' damping, 'p' phase of a
+// sine; 'v' a point's value, 't' a point's time, 'y' the delay, '1' v1,
+// '2' v2, 'd' width, 'r' rise, 'l' fall, 'T' period of a piecewise linear
+// input (a pulse's names move its points).
+bool input_param_kind(char kind);
+// Parses amplitude[in], offset[in], ..., pwl_v[in][k], pwl_t[in][k]: "" or
+// the input error; false (untouched) when `s` is none of those names.
+bool parse_input_param(const mech::MechanicalModel& m, const std::string& s, SensParam& p,
+                       std::string& error);
 
 // The columns asked: x0 (every entry of the initial state) first, then the
 // parameters in the order asked. `error` is "" or the input error.
@@ -71,7 +85,10 @@ class Sensitivity {
   // Between before_event and after_event of a scheduled event: the last
   // `rows` states (the inputs' exosystems) are re-set to functions of t
   // alone, so their derivative is zero from there.
-  void reset_exosystem(int rows) { S_minus_.bottomRows(rows).setZero(); }
+  // An input's own parameters (sensitivity_inputs.cpp): those rows are set
+  // to the re-initialised state's derivative instead, and a parameter that
+  // moves this breakpoint (a point's time, a delay) gets dt_b/dtheta.
+  void reset_exosystem(int rows);
   // The last event's dtau/dtheta.
   void fill_event(Event& e) const;
   const std::vector<SensitivityLoss>& losses() const { return losses_; }
@@ -91,9 +108,15 @@ class Sensitivity {
   // ev.limit_x; false (every column lost) where it has no derivative.
   bool limit_map(double t, const EventResult& ev, MatrixXd& J, MatrixXd& dR);
   // An impact round with planar friction (sensitivity_friction.cpp): J at
-  // its outcome (x0 only: parameters are refused with friction); false, with
+  // its outcome and dR for mu[c] (a sliding contact's impulse); false, with
   // every column lost, where the outcome is not locally constant.
-  bool friction_impact_map(double t, const EventResult::ImpactRound& round, MatrixXd& J);
+  bool friction_impact_map(double t, const EventResult::ImpactRound& round, MatrixXd& J,
+                           MatrixXd& dR);
+  // A phase with planar friction (sensitivity_friction.cpp): dAcl and the
+  // forces' dF (normals, then the sticking tangents) for f[i], g[c],
+  // K[i][j], D[i][j]; a stick monitor's parameter term dh.
+  void friction_mode_derivatives(const Phase& ph, double t);
+  double friction_monitor_dh(size_t p, size_t monitor, const VectorXd& x) const;
   bool friction_impact_regular(double t, const EventResult::ImpactRound& rd,
                                const std::vector<int>& A, const std::vector<int>& stuck,
                                const std::vector<int>& sliding, const VectorXd& lambda,
@@ -109,6 +132,14 @@ class Sensitivity {
   // and dR = (dP_I/dtheta) x (false when not available: every column lost).
   void lcs_mode_derivatives(const lcs::IndexSet& mode, double t);
   bool lcs_jump(double t, const EventResult::LcsJump& jump, MatrixXd& J, MatrixXd& dR);
+  // An input's parameter p (sensitivity_inputs.cpp): its phases' dAcl, dF
+  // and dW from the augmented LCS's exosystem block and outputs, its start
+  // (dw(0)/dtheta), and its impacts on a moving stop (dv+/dtheta from the
+  // stop's rate).
+  void input_mode_derivatives(size_t p, const lcs::IndexSet& mode);
+  void input_start(MatrixXd& S);
+  VectorXd input_impact_dv(size_t p, const std::vector<int>& A, const MatrixXd& EA,
+                           const Eigen::LDLT<MatrixXd>& Wf, const VectorXd& one_e) const;
   std::string contact_name(int r) const;
   bool same_event(const Monitor& other, const Monitor& mon) const;
   void check_friction_start(const Monitor& mon, double t, int m0, int trigger, bool stuck);
@@ -158,12 +189,17 @@ class Sensitivity {
   MatrixXd S_minus_;
   VectorXd xdot_minus_;
   RowVectorXd dtau_;
-  int released_ = -1;  // the constraint the last event released (-1 if none)
-  int trigger_ = -1;   // the constraint whose monitor ended the last phase
+  double event_t_ = 0.0;  // the pending event's time
+  VectorXd x_minus_;      // the state before it (augmented)
+  int released_ = -1;     // the constraint the last event released (-1 if none)
+  int trigger_ = -1;      // the constraint whose monitor ended the last phase
   // Constraints whose monitors are the trigger's up to a positive factor
   // (same_event): they switch with it.
   std::vector<int> co_triggers_;
-  bool trigger_stick_ = false;  // the trigger was a stick force reaching the cone's edge
+  bool trigger_stick_ = false;
+  std::vector<Eigen::Index> stick_row_;  // per friction entry: its row of dF (-1 if not stuck)
+  MatrixXd friction_F_;  // the friction phase's forces (normals, sticking tangents)  //
+                         // the trigger was a stick force reaching the cone's edge
 };
 
 }  // namespace lcsim::sim::detail

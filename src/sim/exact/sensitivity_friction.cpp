@@ -55,9 +55,31 @@ void add_tangent_rows(const mech::MechanicalModel& m, const std::vector<int>& A,
   }
 }
 
+// mu[c] of a contact sliding after the impact: its column of B moves by
+// dB = -sigma t, so dlambda = -(X G B)^-1 X G dB lambda and dv+ = G (dB
+// lambda + B dlambda), into dR's velocity rows of the column.
+void mu_impact_columns(const mech::MechanicalModel& m, const std::vector<SensParam>& params,
+                       int nx0, const MatrixXd& G, const std::vector<int>& A,
+                       const FrictionImpactRows& s, const Eigen::FullPivLU<MatrixXd>& W,
+                       const VectorXd& lambda, MatrixXd& dR) {
+  const Eigen::Index N = G.rows(), na = s.B.cols();
+  for (size_t p = 0; p < params.size(); ++p) {
+    const SensParam& sp = params[p];
+    const auto k = std::find(s.sliding.begin(), s.sliding.end(), sp.j) - s.sliding.begin();
+    if (sp.kind != 'u' || k == static_cast<long>(s.sliding.size())) continue;
+    const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(sp.j)];
+    const auto i = std::find(A.begin(), A.end(), fc.contact) - A.begin();
+    MatrixXd dB = MatrixXd::Zero(N, na);
+    dB.col(i) = -s.sigma[static_cast<size_t>(k)] * VectorXd(fc.tangent);
+    const VectorXd dlambda = -W.solve(s.X * G * dB * lambda);
+    dR.block(N, nx0 + static_cast<Eigen::Index>(p), N, 1) = G * (dB * lambda) + G * s.B * dlambda;
+  }
+}
+
 }  // namespace
 
-bool Sensitivity::friction_impact_map(double t, const EventResult::ImpactRound& rd, MatrixXd& J) {
+bool Sensitivity::friction_impact_map(double t, const EventResult::ImpactRound& rd, MatrixXd& J,
+                                      MatrixXd& dR) {
   const mech::MechanicalModel& m = *model_.mechanical;
   if (!m.gap_inputs.empty() || rd.outcome.size() != static_cast<size_t>(m.num_constraints())) {
     lose_all(t, rd.closed.empty() ? -1 : rd.closed.front(),
@@ -126,6 +148,7 @@ bool Sensitivity::friction_impact_map(double t, const EventResult::ImpactRound& 
     J.block(N_, N_, N_, N_) -= GB * W.solve(s.R);
     J.block(N_, 2 * N_, N_, 1) = GB * W.solve(s.c);
   }
+  mu_impact_columns(m, cols_.params, nx0_, G_, A, s, W, lambda, dR);
   return true;
 }
 
@@ -182,6 +205,110 @@ bool Sensitivity::friction_impact_regular(double t, const EventResult::ImpactRou
     }
   }
   return true;
+}
+
+}  // namespace lcsim::sim::detail
+
+namespace lcsim::sim::detail {
+
+// A phase with planar friction in the mode (I, stick / slip): with the held
+// rows H = [E_I; T_S] and the force columns G = [E_I - sigma mu T; T_S]
+// (friction_phase.cpp), the forces are lambda = F x = -S^-1 H Av x with
+// S = H M^-1 G' and Av the free acceleration's rows (-M^-1 K, -M^-1 D,
+// M^-1 f), and Acl's velocity rows are Av + M^-1 G' F. A parameter of the
+// free acceleration (f[i], K[i][j], D[i][j]: dAv = M^-1 dH, one column)
+// leaves H, G and S as they are: dF = -S^-1 H dAv and dAcl = dAv + M^-1 G'
+// dF. A gap offset g[c] moves no phase (its term is the gap monitor's,
+// dh = 1). A singular S (a statically indeterminate stick, whose split the
+// phase chooses) loses the columns.
+void Sensitivity::friction_mode_derivatives(const Phase& ph, double t) {
+  const mech::MechanicalModel& m = *model_.mechanical;
+  const size_t P = cols_.params.size();
+  dAb_.assign(P, MatrixXd::Zero(n_, n_));
+  dF_.assign(P, MatrixXd());
+  dW_.assign(P, MatrixXd());
+  const Eigen::Index nI = static_cast<Eigen::Index>(ph.mode.size());
+  std::vector<Eigen::Index> stick(ph.friction.size(), -1);
+  Eigen::Index ns = 0;
+  for (size_t f = 0; f < ph.friction.size(); ++f)
+    if (ph.friction[f] == FrictionMode::kStick) stick[f] = nI + ns++;
+  stick_row_ = stick;
+  MatrixXd H(nI + ns, N_), Gc(nI + ns, N_);
+  const MatrixXd E = MatrixXd(m.E);
+  for (Eigen::Index i = 0; i < nI; ++i) H.row(i) = E.row(ph.mode[static_cast<size_t>(i)]);
+  Gc.topRows(nI) = H.topRows(nI);
+  for (size_t f = 0; f < ph.friction.size(); ++f) {
+    const mech::FrictionalContact& fc = m.friction[f];
+    if (stick[f] >= 0) H.row(stick[f]) = Gc.row(stick[f]) = VectorXd(fc.tangent).transpose();
+    const FrictionMode fm = ph.friction[f];
+    if (fm != FrictionMode::kSlipPositive && fm != FrictionMode::kSlipNegative) continue;
+    const auto it = std::find(ph.mode.begin(), ph.mode.end(), fc.contact);
+    Gc.row(it - ph.mode.begin()) -=
+        (fm == FrictionMode::kSlipPositive ? 1.0 : -1.0) * fc.mu * VectorXd(fc.tangent).transpose();
+  }
+  const MatrixXd GGt = G_ * Gc.transpose();
+  const Eigen::FullPivLU<MatrixXd> lu(H * GGt);
+  friction_F_ = MatrixXd::Zero(nI + ns, n_);
+  if (nI + ns > 0 && !lu.isInvertible()) {
+    std::vector<int> cols;
+    for (size_t p = 0; p < P; ++p) cols.push_back(nx0_ + static_cast<int>(p));
+    lose(t, ph.mode.empty() ? -1 : ph.mode.front(),
+         "a statically indeterminate stick (H M^-1 G' singular): the forces' split is the "
+         "phase's choice, its parameter derivative is not computed",
+         cols, true);
+    return;
+  }
+  const MatrixXd Av = sys_.A.middleRows(N_, N_);
+  if (nI + ns > 0) friction_F_ = -lu.solve(H * Av);
+  for (size_t p = 0; p < P; ++p) {
+    const SensParam& sp = cols_.params[p];
+    MatrixXd dAv = MatrixXd::Zero(N_, n_), dF = MatrixXd::Zero(nI + ns, n_);
+    if (sp.kind == 'f') dAv.col(2 * N_) = G_.col(sp.i);
+    if (sp.kind == 'K') dAv.col(sp.j) = -G_.col(sp.i);
+    if (sp.kind == 'D') dAv.col(N_ + sp.j) = -G_.col(sp.i);
+    MatrixXd dA = MatrixXd::Zero(n_, n_);
+    if (sp.kind == 'u') {
+      // mu of a sliding contact: its normal's force column -sigma mu t
+      // moves by dGc = -sigma t, so dF = -S^-1 H M^-1 dGc' F and dAcl's
+      // velocity rows M^-1 (dGc' F + G' dF). Sticking: no phase term.
+      const FrictionMode fm = ph.friction[static_cast<size_t>(sp.j)];
+      if (fm == FrictionMode::kSlipPositive || fm == FrictionMode::kSlipNegative) {
+        const mech::FrictionalContact& fc = m.friction[static_cast<size_t>(sp.j)];
+        MatrixXd dGc = MatrixXd::Zero(nI + ns, N_);
+        dGc.row(std::find(ph.mode.begin(), ph.mode.end(), fc.contact) - ph.mode.begin()) =
+            -(fm == FrictionMode::kSlipPositive ? 1.0 : -1.0) * VectorXd(fc.tangent).transpose();
+        dF = -lu.solve(H * G_ * dGc.transpose() * friction_F_);
+        dA.middleRows(N_, N_) = G_ * dGc.transpose() * friction_F_ + GGt * dF;
+      }
+    } else {
+      if (nI + ns > 0) dF = -lu.solve(H * dAv);
+      dA.middleRows(N_, N_) = dAv + GGt * dF;
+    }
+    dAb_[p] = D_.cwiseInverse().asDiagonal() * dA * D_.asDiagonal();
+    dF_[p] = dF;
+  }
+}
+
+// A friction monitor's parameter term: a sliding velocity sigma (t'v -
+// velocity) has none; a stick force mu u_N + side u_T (add_friction_monitors
+// pushes side -1, then +1) moves by (mu dF_N + side dF_T) x.
+double Sensitivity::friction_monitor_dh(size_t p, size_t monitor, const VectorXd& x) const {
+  const Monitor& mon = monitors_[monitor];
+  if (!mon.multiplier) return 0.0;
+  const mech::FrictionalContact& fc =
+      model_.mechanical->friction[static_cast<size_t>(mon.friction)];
+  const Eigen::Index row = stick_row_[static_cast<size_t>(mon.friction)];
+  const auto it = std::find(mode_.begin(), mode_.end(), fc.contact);
+  if (row < 0 || it == mode_.end()) return 0.0;
+  const Monitor* prev = monitor > 0 ? &monitors_[monitor - 1] : nullptr;
+  const double side =
+      prev != nullptr && prev->multiplier && prev->friction == mon.friction ? 1.0 : -1.0;
+  const MatrixXd& dF = dF_[p];
+  const Eigen::Index normal = it - mode_.begin();
+  const SensParam& sp = cols_.params[p];
+  // mu[c] of this contact: d(mu) u_N.
+  const double own = sp.kind == 'u' && sp.j == mon.friction ? friction_F_.row(normal).dot(x) : 0.0;
+  return own + (fc.mu * dF.row(normal) + side * dF.row(row)).dot(x);
 }
 
 }  // namespace lcsim::sim::detail

@@ -3,9 +3,10 @@
 // frictionless mechanical model named f[i], g[c], e[c], K[i][j], D[i][j],
 // M[i][j] with i, j a coordinate's 0-based index or name and c a
 // constraint's, or of a general LCS named A[i][j], B[i][j], C[i][j],
-// D[i][j] with its states' and pairs' names or indices
-// (docs/sensitivities.md).
+// D[i][j] with its states' and pairs' names or indices, or an input's own
+// (amplitude[in], frequency[in], pwl_v[in][k], ...; docs/sensitivities.md).
 #include <algorithm>
+#include <cmath>
 #include <lcsim/sim/sim.hpp>
 #include <set>
 
@@ -45,36 +46,155 @@ std::vector<std::string> keys(const std::string& s) {
   return out;
 }
 
-// amplitude[input]: a sine input's amplitude (kind 'a', i the input), where
-// it drives forces only: it is the exosystem's output row l = (1, amplitude,
-// 0), so it moves H's input columns and no state of the exosystem (which
-// the breakpoints re-set to functions of t alone). On a moving stop it would
-// move C and the impacts' relative velocity: not named.
-std::string parse_amplitude(const mech::MechanicalModel& m, const std::string& s, SensParam& p) {
-  const std::string bad = "sensitivity '" + s + "': ";
-  const std::vector<std::string> k = keys(s.substr(std::string("amplitude").size() - 1));
-  if (k.size() != 1u) return bad + "expected one index, as amplitude[push]";
-  std::vector<std::string> names;
-  for (const mech::Input& in : m.inputs) names.push_back(in.name);
-  p.kind = 'a';
-  p.name = s;
-  p.i = resolve(k[0], names);
-  if (p.i < 0) return bad + "no input '" + k[0] + "'";
-  if (!m.inputs[static_cast<size_t>(p.i)].sine)
-    return bad + "input '" + k[0] + "' is not a sine (only a sine's amplitude is named)";
-  for (const mech::InputUse& u : m.gap_inputs)
-    if (u.input == p.i)
-      return bad + "input '" + k[0] + "' moves a stop: its amplitude's derivative is not computed";
+// An input's own parameter (sensitivity_inputs.cpp): the name before the
+// brackets, its kind letter, whether it takes a point index, and the input
+// family it applies to ('s' sine, 'p' piecewise linear, 'u' a pulse, 'r' a
+// step or a ramp (its time), 'b' both).
+struct InputName {
+  const char* word;
+  char kind;
+  bool point;
+  char family;
+};
+constexpr InputName kInputNames[] = {
+    {"amplitude", 'a', false, 's'}, {"offset", 'o', false, 's'}, {"frequency", 'w', false, 's'},
+    {"damping", 'z', false, 's'},   {"phase", 'p', false, 's'},  {"delay", 'y', false, 'b'},
+    {"pwl_v", 'v', true, 'p'},      {"pwl_t", 't', true, 'p'},   {"time", 't', false, 'r'},
+    {"v1", '1', false, 'u'},        {"v2", '2', false, 'u'},     {"rise", 'r', false, 'u'},
+    {"width", 'd', false, 'u'},     {"fall", 'l', false, 'u'},   {"period", 'T', false, 'u'}};
+
+// Why a piecewise linear input's time parameter has one-sided derivatives
+// only ("" if it has both): points of one time that move apart (a jump
+// split, a zero rise or width), or a periodic input's point at 0 or at the
+// period, or its period down to its last point.
+std::string one_sided_times(const mech::Input& in, const SensParam& p) {
+  const size_t n = in.times.size();
+  std::vector<char> moves(n, 0);
+  const auto mark = [&](std::initializer_list<size_t> at) {
+    for (size_t k : at)
+      if (k < n) moves[k] = 1;
+  };
+  switch (p.kind) {
+    case 't':
+      for (size_t k = 0; k < n; ++k) moves[k] = in.times[k] == in.times[static_cast<size_t>(p.j)];
+      break;
+    case 'r':
+      mark({1, 2, 3});
+      break;
+    case 'd':
+      mark({2, 3});
+      break;
+    case 'l':
+      mark({3});
+      break;
+    case 'T':
+      return in.times.back() == in.period
+                 ? "the pulse fills its period (rise + width + fall = period): a shorter period "
+                   "is not a pulse"
+                 : "";
+    default:
+      return "";
+  }
+  for (size_t k = 0; k + 1 < n; ++k)
+    if (in.times[k] == in.times[k + 1] && moves[k] != moves[k + 1])
+      return "points " + std::to_string(k) + " and " + std::to_string(k + 1) +
+             " share a time and one of them moves (a zero rise, width or fall): the times "
+             "would cross";
+  for (size_t k = 0; k < n && in.period > 0.0; ++k)
+    if (moves[k] && (in.times[k] == 0.0 || in.times[k] == in.period))
+      return "a periodic input's point at the period's start or end moves out of its period";
   return "";
 }
 
+// "" when the input's kind has the parameter, else why not.
+std::string kind_fits(const mech::Input& in, const InputName& w) {
+  const bool fits = w.family == 'b' || (w.family == 's' && in.sine) ||
+                    (w.family == 'p' && !in.sine) || (w.family == 'u' && in.kind == "pulse") ||
+                    (w.family == 'r' && (in.kind == "step" || in.kind == "ramp"));
+  if (fits) return "";
+  return std::string("input '") + in.name + "' is a " + in.kind + ": it has no " + w.word +
+         " (a sine: amplitude, offset, frequency, damping, phase, delay; piecewise linear: "
+         "pwl_v[in][k], pwl_t[in][k], delay; a step or ramp also time; a pulse also v1, v2, "
+         "rise, width, fall, period)";
+}
+
+// "" when the parameter has a two-sided derivative at the input's values.
+std::string two_sided(const mech::Input& in, const SensParam& p) {
+  if (in.sine && p.kind == 'y' && in.origin == 0.0 && in.amplitude * std::sin(in.phase) != 0.0)
+    return "the sine starts off its offset at t = 0 with a zero delay: only one-sided "
+           "derivatives exist";
+  return in.sine ? "" : one_sided_times(in, p);
+}
+
+}  // namespace
+
+bool parse_input_param(const mech::MechanicalModel& m, const std::string& s, SensParam& p,
+                       std::string& error) {
+  const size_t open = s.find('[');
+  if (open == std::string::npos) return false;
+  const std::string word = s.substr(0, open);
+  const InputName* w = nullptr;
+  for (const InputName& c : kInputNames)
+    if (word == c.word) w = &c;
+  if (w == nullptr) return false;
+  const std::string bad = "sensitivity '" + s + "': ";
+  const std::vector<std::string> k = keys(s.substr(open - 1));
+  if (k.size() != (w->point ? 2u : 1u)) {
+    error = bad + "expected " + (w->point ? "two indices, as " : "one index, as ") + word +
+            (w->point ? "[push][1]" : "[push]");
+    return true;
+  }
+  std::vector<std::string> names;
+  for (const mech::Input& in : m.inputs) names.push_back(in.name);
+  p.kind = w->kind;
+  p.name = s;
+  p.i = resolve(k[0], names);
+  if (p.i < 0) {
+    error = bad + "no input '" + k[0] + "'";
+    return true;
+  }
+  const mech::Input& in = m.inputs[static_cast<size_t>(p.i)];
+  if (error = kind_fits(in, *w); !error.empty()) {
+    error = bad + error;
+    return true;
+  }
+  if (w->point) {
+    std::vector<std::string> points(in.times.size());
+    p.j = resolve(k[1], points);
+    if (p.j < 0) {
+      error = bad + "no point '" + k[1] + "' (input '" + in.name + "' has " +
+              std::to_string(in.times.size()) + ", from 0)";
+      return true;
+    }
+  } else {
+    p.j = 0;  // time[in]: a step's or a ramp's one time, point 0
+  }
+  error = two_sided(in, p);
+  if (!error.empty()) error = bad + error;
+  return true;
+}
+
+namespace {
+
 std::string parse_one(const mech::MechanicalModel& m, const std::string& s, SensParam& p) {
   const std::string bad = "sensitivity '" + s + "': ";
-  if (s.rfind("amplitude[", 0) == 0) return parse_amplitude(m, s, p);
+  if (std::string error; parse_input_param(m, s, p, error)) return error;
+  if (s.rfind("mu[", 0) == 0) {  // a contact's friction coefficient: kind 'u'
+    const std::vector<std::string> k = keys(s.substr(1));
+    if (k.size() != 1u) return bad + "expected one index, as mu[floor]";
+    p.kind = 'u';
+    p.name = s;
+    p.i = resolve(k[0], m.constraints);
+    if (p.i < 0) return bad + "no constraint '" + k[0] + "'";
+    for (size_t f = 0; f < m.friction.size(); ++f)
+      if (m.friction[f].contact == p.i) p.j = static_cast<int>(f);
+    if (p.j < 0) return bad + "constraint '" + k[0] + "' has no friction (mechanical.friction)";
+    return "";
+  }
   if (s.size() < 2 || std::string("fgeKDM").find(s[0]) == std::string::npos)
     return bad +
-           "not a parameter name (x0, f[i], g[c], e[c], K[i][j], D[i][j], M[i][j], "
-           "amplitude[input])";
+           "not a parameter name (x0, f[i], g[c], e[c], K[i][j], D[i][j], M[i][j], or an "
+           "input's: amplitude[in], frequency[in], pwl_v[in][k], ...)";
   p.kind = s[0];
   p.name = s;
   const std::vector<std::string> k = keys(s);
@@ -175,9 +295,8 @@ std::string refuse_for_scheme(const detail::SensColumns& c, std::string_view met
 
 // Friction: Moreau–Jean's step map at its stick / slip outcome, planar or
 // 3-D (step_sensitivity.cpp, the columns the scheme knows); the exact
-// method through planar stick / slip, x0 only (its phases'
-// dAcl/dtheta for a parameter would need the friction's columns); "" or why
-// not.
+// method through planar stick / slip, x0 and the parameters that leave the
+// friction's columns as they are; "" or why not.
 std::string refuse_friction(const mech::Model& model, const Options& opt, std::string_view method,
                             const OptionsUsed& used) {
   const std::string head =
@@ -194,10 +313,15 @@ std::string refuse_friction(const mech::Model& model, const Options& opt, std::s
     return head + "method '" + std::string(method) +
            "' does not compute sensitivities through stick / slip (methods 'event' and "
            "'moreau-jean' do)";
+  // The free acceleration's parameters and the gap offsets: f, K, D, g
+  // (sensitivity_friction.cpp); the rest moves the friction's own columns or
+  // its impacts.
   for (const std::string& s : opt.sensitivity)
-    if (s != "x0")
+    if (s != "x0" && s.rfind("mu[", 0) != 0 &&
+        !(s.size() > 1 && std::string("fgKD").find(s[0]) != std::string::npos && s[1] == '['))
       return "Options::sensitivity '" + s + "': not computed with friction (model '" + model.name +
-             "' has mechanical.friction; through planar stick / slip only x0 is)";
+             "' has mechanical.friction; through planar stick / slip x0, f[i], g[c], K[i][j], "
+             "D[i][j] and mu[c] are)";
   return "";
 }
 
