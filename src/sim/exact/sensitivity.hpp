@@ -102,6 +102,17 @@ class Sensitivity {
   void lose_all(double t, int contact, const std::string& reason);
   void start_on_boundary(const VectorXd& xa);
   const MatrixXd& at_dense(double t, double tau);
+  const MatrixXd& at_taylor(double t, double tau);
+  // The exponentials of the current phase over tau (kept per tau): Phi =
+  // e^{Ab tau}, and with `params` each parameter's term.
+  struct DenseBlock;
+  const DenseBlock& dense_block(double tau, bool params);
+  const DenseBlock* find_block(double tau, bool params) const;
+  // A large phase: whether the x0 block goes by Phi (formed, Pade) rather
+  // than by the Taylor action on its columns, by their estimated costs.
+  bool x0_by_exponential(double tau) const;
+  // The forcing structure of each parameter in the current phase (begin_phase).
+  void forcing_structure();
   bool impact_map(double t, const EventResult::ImpactRound& round, MatrixXd& J, MatrixXd& dR);
   // An accumulation's limit as the run takes it (sensitivity_accumulation.cpp):
   // the M-orthogonal projection onto E_J q + g_J = 0, E_J v = 0 from
@@ -173,14 +184,38 @@ class Sensitivity {
   std::vector<MatrixXd> dW_;
   lcs::IndexSet mode_;
   std::vector<Monitor> monitors_;  // unbalanced w
-  // A dense phase's exponentials per step length (at_dense).
+  // A phase's exponentials per step length (at_dense; a large phase's x0
+  // block, at_taylor), kept across phases: a later phase of the same mode
+  // (the same Ab, D and constant forcings) reuses them, as the plain run's
+  // grid steps do (StepExp).
   struct DenseBlock {
     double tau = 0.0;
+    bool params = false;  // Gamma and Psi computed
+    lcs::IndexSet mode;
+    MatrixXd Ab, forcing;
+    VectorXd D;
     MatrixXd Phi;
-    std::vector<MatrixXd> Psi;  // per parameter
+    // Constant forcings (const_): int_0^tau e^{Ab s} ds times forcing_, by
+    // columns (one augmented exponential of size n + their count).
+    MatrixXd Gamma;
+    std::vector<MatrixXd> Psi;  // per parameter (Van Loan, size 2n), others
   };
   bool dense_ = false;
   std::vector<DenseBlock> dense_cache_;
+  size_t dense_next_ = 0;  // the cache's slot to reuse once full
+  MatrixXd next_;          // at_dense's product (kept: no allocation per sample)
+  VectorXd znext_;
+  double Ab_norm1_ = 0.0;  // ||Ab||_1 (norm1_ adds the parameters')
+  // Per parameter in the current phase: the nonzero columns of dAb when few
+  // (the product dAb z over them; all columns: empty and dcols_all_), and
+  // whether they are all constant states (Ab's row zero: the augmented 1),
+  // so dAb z = sum over them of dAb.col(c) z(c), the same all along the
+  // phase (f[i]): const_ lists the pairs (parameter, column c), forcing_
+  // their columns dAb.col(c) (balanced; per mode, not per state).
+  std::vector<std::vector<Eigen::Index>> dcols_;
+  std::vector<char> dcols_all_, dconst_;
+  std::vector<std::pair<int, Eigen::Index>> const_;
+  MatrixXd forcing_;  // n x const_.size()
   // The cursor: S and the balanced state at tc_.
   double tc_ = 0.0;
   MatrixXd Sc_;
