@@ -425,6 +425,7 @@ const Sensitivity::DenseBlock& Sensitivity::dense_block(double tau, bool params)
   b.Ab = Ab_;
   b.D = D_;
   b.forcing = forcing_;
+  if (params) b.dAb = dAb_;
   if (params) {
     const Eigen::Index nc = static_cast<Eigen::Index>(const_.size());
     if (nc > 0) {
@@ -464,10 +465,23 @@ const Sensitivity::DenseBlock& Sensitivity::dense_block(double tau, bool params)
 // of k dt) take their own exponential, as before, so S is not moved even by
 // rounding (the system identification example's Gauss-Newton stops on a
 // cost that must fall at 1e-10 relative steps).
+namespace {
+// Two phases' parameter forcings dAb, bit for bit (a block's Psi is formed
+// from them: the mode and Ab alone do not fix an input's or a friction
+// coefficient's column).
+bool same_forcings(const std::vector<MatrixXd>& a, const std::vector<MatrixXd>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t p = 0; p < a.size(); ++p)
+    if (a[p].rows() != b[p].rows() || a[p].cols() != b[p].cols() || a[p] != b[p]) return false;
+  return true;
+}
+}  // namespace
+
 const Sensitivity::DenseBlock* Sensitivity::find_block(double tau, bool params) const {
   for (const DenseBlock& c : dense_cache_)
     if (c.tau == tau && (c.params || !params) && c.mode == mode_ && c.Ab.rows() == Ab_.rows() &&
-        c.Ab == Ab_ && c.D == D_ && c.forcing.cols() == forcing_.cols() && c.forcing == forcing_)
+        c.Ab == Ab_ && c.D == D_ && c.forcing.cols() == forcing_.cols() && c.forcing == forcing_ &&
+        (!params || same_forcings(c.dAb, dAb_)))
       return &c;
   return nullptr;
 }

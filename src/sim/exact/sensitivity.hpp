@@ -194,6 +194,7 @@ class Sensitivity {
     lcs::IndexSet mode;
     MatrixXd Ab, forcing;
     VectorXd D;
+    std::vector<MatrixXd> dAb;  // the parameters' forcings Psi was formed from
     MatrixXd Phi;
     // Constant forcings (const_): int_0^tau e^{Ab s} ds times forcing_, by
     // columns (one augmented exponential of size n + their count).
