@@ -27,7 +27,9 @@ namespace lcsim::lcs {
 
 namespace {
 
-enum class RowState { kUndecided, kActive, kInactive };
+// kDependent: an undecided row whose [C_r D_r] lies in the span of the
+// active rows' (mark_dependent): undetermined, left out of later levels.
+enum class RowState { kUndecided, kActive, kInactive, kDependent };
 
 std::vector<int> rows_in(const std::vector<RowState>& st, RowState s) {
   std::vector<int> r;
@@ -129,7 +131,7 @@ Level level_coefficients(Ldcp& s, int p) {
   for (int r = 0; r < k; ++r) {
     // A row decided inactive keeps its state: its coefficients are not
     // used again (a robot's 64 stops, most open, at up to n levels each).
-    if (s.state[r] == RowState::kInactive) continue;
+    if (s.state[r] == RowState::kInactive || s.state[r] == RowState::kDependent) continue;
     const int order = s.data.rho[r] + p;
     if (order >= 1) {
       const int m = s.free.reach(order - 1);
@@ -353,6 +355,41 @@ void classify_undecided(Ldcp& s, const Level& l, VectorXd& up) {
   }
 }
 
+// An undecided row r whose [C_r D_r] is a combination of the active rows'
+// (a fourth coplanar corner of a box whose three others are active: E_r =
+// E_1 + E_2 - E_3, and so its gap offset in the augmented C) has y_r = sum
+// alpha_i y_i identically, zero in the mode; any u_r >= 0 that the active
+// rows absorb gives the same motion, and u_r = 0 is one. Carried on as
+// undecided it met rounding at every later level: a q of 1e-10 from the
+// active block's solve (not in its scale) classified the KUKA's box corner
+// inactive, monitored on a gap that is rounding of zero (events that
+// changed nothing until the livelock guard refused), and the 80-link chain's
+// 54 dependent contacts overflowed the levels' scale before level n. Such a
+// row is undetermined from this level on (u_r = 0, as the rows left
+// undecided at the end). The test is relative, 1e-9 of the row, far above
+// the rounding of a geometric dependence (4.4e-16 on the KUKA's corners)
+// and far below any independent row.
+void mark_dependent(Ldcp& s) {
+  const std::vector<int> I = rows_in(s.state, RowState::kActive);
+  const std::vector<int> K = rows_in(s.state, RowState::kUndecided);
+  if (I.empty() || K.empty()) return;
+  const int n = s.sys.n(), k = s.sys.k();
+  MatrixXd rows(n + k, static_cast<Eigen::Index>(I.size()));
+  for (size_t i = 0; i < I.size(); ++i)
+    rows.col(static_cast<Eigen::Index>(i)) << s.sys.C.row(I[i]).transpose(),
+        s.sys.D.row(I[i]).transpose();
+  const Eigen::CompleteOrthogonalDecomposition<MatrixXd> cod(rows);
+  constexpr double kDependence = 1e-9;
+  for (int r : K) {
+    VectorXd row(n + k);
+    row << s.sys.C.row(r).transpose(), s.sys.D.row(r).transpose();
+    const double size = row.norm();
+    if (!(size > 0.0)) continue;
+    if ((rows * cod.solve(row) - row).norm() <= kDependence * size)
+      s.state[static_cast<size_t>(r)] = RowState::kDependent;
+  }
+}
+
 // True when every level after l repeats l exactly, so that solving them
 // would change nothing: l (a force level, p >= 1) had no known part (xi and
 // its scale exactly zero), found u^p = 0 and decided no row (`before`: the
@@ -408,6 +445,7 @@ std::string solve_levels(Ldcp& s, int& lcp_solves) {
     if (!failed.empty()) return failed;
     drop_dependent_multipliers(s, l, up);
     classify_undecided(s, l, up);
+    mark_dependent(s);
     // Once no row is undecided the mode is fixed; the impulsive levels (p <= 0)
     // are still needed for the jump, later levels are not.
     if (p >= 0 && rows_in(s.state, RowState::kUndecided).empty()) break;
@@ -454,6 +492,16 @@ const MatrixXd& LdcpData::markov(int i) const {
   return H[i];
 }
 
+// The rows left undecided and those found dependent, in order.
+std::vector<int> undetermined_rows(const Ldcp& s) {
+  std::vector<int> out;
+  for (int r = 0; r < static_cast<int>(s.state.size()); ++r)
+    if (s.state[static_cast<size_t>(r)] == RowState::kUndecided ||
+        s.state[static_cast<size_t>(r)] == RowState::kDependent)
+      out.push_back(r);
+  return out;
+}
+
 // The driver: refusals, then the levels, then the mode and the jump.
 ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions& opt) {
   ModeSelection out;
@@ -482,11 +530,11 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
     // A failure says where: the rows active and undecided when it failed
     // (the caller names them; status stays a failure).
     out.mode = rows_in(s.state, RowState::kActive);
-    out.undetermined = rows_in(s.state, RowState::kUndecided);
+    out.undetermined = undetermined_rows(s);
     return out;
   }
   out.mode = rows_in(s.state, RowState::kActive);
-  out.undetermined = rows_in(s.state, RowState::kUndecided);
+  out.undetermined = undetermined_rows(s);
   out.x_plus = x0 + impulsive_jump(s, out.impulse);
   out.status = Status::kOk;
   return out;

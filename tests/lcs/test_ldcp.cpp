@@ -159,15 +159,15 @@ TEST(Ldcp, DiodeBridgeZeroDiagonalSkewCoupling) {
 namespace lcsim::lcs {
 namespace {
 
-// A unit point mass in the plane, x0 = (x, z, vx, vz, 1), under gravity
-// (g = 9.81), resting on two copies of the floor row z >= 0 (dependent
+// A unit point mass in the plane, x0 = (x, z, vx, vz, 1), under gravity g
+// (9.81 or 0), resting on two copies of the floor row z >= 0 (dependent
 // constraints, as a box's coplanar corners give); `spring` pulls x towards
 // 0 with stiffness 1, which the floor rows do not see.
-Lcs twin_floor(bool spring) {
+Lcs twin_floor(bool spring, double g = 9.81) {
   Lcs s;
   s.A = MatrixXd::Zero(5, 5);
   s.A(0, 2) = s.A(1, 3) = 1.0;
-  s.A(3, 4) = -9.81;
+  s.A(3, 4) = -g;
   if (spring) s.A(2, 0) = -1.0;
   s.B = MatrixXd::Zero(5, 2);
   s.B(3, 0) = s.B(3, 1) = 1.0;
@@ -177,15 +177,12 @@ Lcs twin_floor(bool spring) {
   return s;
 }
 
-// The force levels a selection solves: one row of the pair carries the
-// weight (9.81), the other stays undetermined (u and y identically zero,
-// Remark 3.4.8) and no level decides it. Without the spring every level
-// after the second repeats it exactly (its known part is zero: A^3 x0 = 0
-// and C A^2 B = 0) and the LDCP stops there, after level 2, not at n = 5.
-// With the spring the free response never vanishes and every level is
-// solved; the z rows are the same, so mode, undetermined set
-// and (absent) jump are too, and they are the ones without the stop.
-TEST(Ldcp, StopsAtRepeatingLevelsWithTheSameMode) {
+// Under gravity one row of the pair carries the weight (9.81) from level 1
+// on, and the other, whose row [C D] is the active one's, is undetermined
+// from there (mark_dependent: u and y identically zero, Remark 3.4.8), so
+// the LDCP stops after level 1 with the spring or without it: the same mode
+// and undetermined row, no jump.
+TEST(Ldcp, DependentRowIsUndeterminedFromTheLevelItIsFound) {
   LdcpOptions o;
   o.regular_only = true;
   VectorXd x0(5);
@@ -195,16 +192,43 @@ TEST(Ldcp, StopsAtRepeatingLevelsWithTheSameMode) {
   ASSERT_TRUE(stop.ok()) << stop.message;
   ASSERT_TRUE(all.ok()) << all.message;
   // Level 1's singular 2 x 2 LCP takes two attempts (principal pivoting,
-  // then Lemke), each later level one: 3 with the stop (levels 1, 2), 6
-  // without (levels 1..5): the three levels 3..5 are the ones not solved.
-  EXPECT_EQ(stop.lcp_solves, 3);
-  EXPECT_EQ(all.lcp_solves, 6);
+  // then Lemke), and no level follows.
+  EXPECT_EQ(stop.lcp_solves, 2);
+  EXPECT_EQ(all.lcp_solves, 2);
   EXPECT_EQ(stop.mode, all.mode);
   EXPECT_EQ(stop.undetermined, all.undetermined);
   ASSERT_EQ(stop.mode.size(), 1u);
   ASSERT_EQ(stop.undetermined.size(), 1u);
   EXPECT_NE(stop.mode[0], stop.undetermined[0]);
   EXPECT_EQ(stop.x_plus, x0);  // regular: no jump
+}
+
+// Without gravity no row is active (nothing presses the floor), so no row
+// is dependent on an active one and both stay undecided (u and y
+// identically zero). Without the spring every level after the first
+// repeats it exactly (its known part is zero: A^2 x0 = 0 and C A B u = 0)
+// and the LDCP stops there (later_levels_repeat), not at n = 5; with the
+// spring the free response never vanishes and every level 1..5 is solved.
+// The z rows are the same, so the mode (empty), the undetermined rows (both)
+// and the (absent) jump are too.
+TEST(Ldcp, StopsAtRepeatingLevelsWithTheSameMode) {
+  LdcpOptions o;
+  o.regular_only = true;
+  VectorXd x0(5);
+  x0 << 1.0, 0.0, 0.0, 0.0, 1.0;
+  const ModeSelection stop = select_mode(twin_floor(false, 0.0), x0, o);
+  const ModeSelection all = select_mode(twin_floor(true, 0.0), x0, o);
+  ASSERT_TRUE(stop.ok()) << stop.message;
+  ASSERT_TRUE(all.ok()) << all.message;
+  // One attempt per level (q = 0: the pivoting solver's first basis
+  // solves it): level 1 with the stop, levels 1..5 without.
+  EXPECT_EQ(stop.lcp_solves, 1);
+  EXPECT_EQ(all.lcp_solves, 5);
+  EXPECT_TRUE(stop.mode.empty());
+  EXPECT_EQ(stop.mode, all.mode);
+  EXPECT_EQ(stop.undetermined, (IndexSet{0, 1}));
+  EXPECT_EQ(stop.undetermined, all.undetermined);
+  EXPECT_EQ(stop.x_plus, x0);
 }
 
 }  // namespace
