@@ -12,6 +12,8 @@
 #include <numbers>
 #include <string>
 
+#include "support/bisect.hpp"
+
 namespace lcsim {
 namespace {
 
@@ -251,22 +253,8 @@ C1 out 0 100n
   }
 }
 
-// Brent-free bisection on [a, b] (f(a), f(b) of opposite signs) to ~1 ulp.
-template <class F>
-double bisect(F f, double a, double b) {
-  double fa = f(a);
-  for (int it = 0; it < 200 && b - a > 0; ++it) {
-    const double m = 0.5 * (a + b);
-    if (m <= a || m >= b) break;
-    const double fm = f(m);
-    if ((fm > 0) == (fa > 0)) {
-      a = m, fa = fm;
-    } else {
-      b = m;
-    }
-  }
-  return 0.5 * (a + b);
-}
+// Bisection (tests/support/bisect.hpp), not the simulator's own root finder.
+using test_support::bisect;
 
 TEST(HalfWaveRectifier, TurnsOffAndOnWhereTheClosedFormSays) {
   const Circuit c =

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "support/bisect.hpp"
+
 namespace lcsim {
 namespace {
 
@@ -29,22 +31,7 @@ using std::numbers::pi;
 constexpr double kEventTol = 1e-12;  // s
 constexpr double kVoltTol = 1e-9;    // V
 
-// Bisection on [a, b] (f(a), f(b) of opposite signs) to ~1 ulp.
-template <class F>
-double bisect(F f, double a, double b) {
-  double fa = f(a);
-  for (int it = 0; it < 200; ++it) {
-    const double m = 0.5 * (a + b);
-    if (m <= a || m >= b) break;
-    const double fm = f(m);
-    if ((fm > 0) == (fa > 0)) {
-      a = m, fa = fm;
-    } else {
-      b = m;
-    }
-  }
-  return 0.5 * (a + b);
-}
+using test_support::bisect;
 // The first sign change of f after a (f(a) > 0), scanned in steps of h
 // (far below the half periods here), then bisected.
 template <class F>

@@ -10,6 +10,8 @@
 #include <numbers>
 #include <string>
 
+#include "support/bisect.hpp"
+
 namespace lcsim {
 namespace {
 
@@ -24,16 +26,7 @@ sim::Trajectory run(const mech::Model& m, double t_end, double dt_out = 0.0) {
   return sim::make_integrator("event")->run(m, m.initial, o);
 }
 
-// Root of f on [a, b] (f(a) > 0 >= f(b)) by bisection to the last bit.
-template <class F>
-double bisect(F&& f, double a, double b) {
-  for (int i = 0; i < 200 && b - a > 0.0; ++i) {
-    const double c = 0.5 * (a + b);
-    if (c <= a || c >= b) break;
-    (f(c) > 0.0 ? a : b) = c;
-  }
-  return 0.5 * (a + b);
-}
+using test_support::bisect;
 
 // A free mass m = 2 kg pushed by a PWL force (N): 0 at 0 s, 2 at 1 s, 2 at
 // 2 s, a jump to -1 at 2 s, -1 at 3 s and after. Hand integration piece by

@@ -26,6 +26,8 @@
 #include <string>
 #include <vector>
 
+#include "support/sensitivity_fd.hpp"
+
 namespace lcsim {
 namespace {
 
@@ -43,11 +45,7 @@ sim::Trajectory run(const mech::Model& m, const VectorXd& x0, double T,
   return sim::simulate(m, x0, opt, "event");
 }
 
-struct Perturbation {
-  std::string column;
-  double theta;  // the entry's value (the step is 1e-4 max(1, |theta|))
-  std::function<void(mech::Model&, VectorXd&, double)> apply;
-};
+using Perturbation = test_support::FdColumn;
 
 Perturbation force(int i, double f) {
   return {"f[" + std::to_string(i) + "]", f,
@@ -58,17 +56,9 @@ Perturbation gap(int c, const std::string& name, double g) {
           [c](mech::Model& m, VectorXd&, double d) { m.mechanical->g(c) += d; }};
 }
 
-// The run's end state and event times: x(T) then t_1, t_2, ...
-VectorXd outcome(const sim::Trajectory& tr) {
-  VectorXd out(tr.final_state.size() + static_cast<Eigen::Index>(tr.events.size()));
-  out.head(tr.final_state.size()) = tr.final_state;
-  for (size_t k = 0; k < tr.events.size(); ++k)
-    out(tr.final_state.size() + static_cast<Eigen::Index>(k)) = tr.events[k].t;
-  return out;
-}
-
 // Compares every column (x0 entries when `x0`, then `ps`) against central
-// differences at T; returns the number of entries compared.
+// differences at T (tests/support/sensitivity_fd.hpp); returns the number of
+// entries compared.
 int expect_matches_fd(const mech::Model& m, const VectorXd& x0, double T,
                       const std::vector<Perturbation>& ps, bool x0_columns,
                       const std::string& absent = "") {
@@ -88,48 +78,7 @@ int expect_matches_fd(const mech::Model& m, const VectorXd& x0, double T,
   for (const auto& l : tr.sensitivity_losses)
     if (absent.empty() || l.reason.find(absent) == std::string::npos)
       ADD_FAILURE() << "t = " << l.t << " '" << l.contact << "': " << l.reason;
-  const VectorXd base = outcome(tr);
-  const double xs = std::max(1.0, base.cwiseAbs().maxCoeff());
-  const Eigen::Index n = tr.final_state.size();
-  int compared = 0;
-  for (size_t c = 0; c < all.size(); ++c) {
-    auto fd = [&](double h) {
-      VectorXd out[2];
-      for (int s = 0; s < 2; ++s) {
-        mech::Model mm = m;
-        VectorXd xx = x0;
-        all[c].apply(mm, xx, s == 0 ? h : -h);
-        const sim::Trajectory t2 = run(mm, xx, T);
-        EXPECT_TRUE(t2.ok()) << t2.message;
-        EXPECT_EQ(t2.events.size(), tr.events.size()) << all[c].column << ": events differ";
-        if (t2.events.size() != tr.events.size()) return VectorXd(VectorXd::Zero(base.size()));
-        out[s] = outcome(t2);
-      }
-      return VectorXd((out[0] - out[1]) / (2 * h));
-    };
-    if (!tr.dx_final_exists[c]) {  // absent (a loss above): no number
-      EXPECT_EQ(tr.dx_final.col(static_cast<Eigen::Index>(c)).cwiseAbs().maxCoeff(), 0.0);
-      continue;
-    }
-    const double h = 1e-4 * std::max(1.0, std::abs(all[c].theta));
-    const VectorXd d1 = fd(h), d2 = fd(h / 2);
-    EXPECT_EQ(tr.sensitivity_columns[c], all[c].column);
-    const auto col = static_cast<Eigen::Index>(c);
-    for (Eigen::Index i = 0; i < d2.size(); ++i) {
-      const double tol = 4 * std::abs(d1(i) - d2(i)) + 64e-13 * xs / h;
-      if (i < n) {
-        EXPECT_NEAR(tr.dx_final(i, col), d2(i), tol) << "dx[" << i << "]/d" << all[c].column;
-      } else {
-        const sim::Event& e = tr.events[static_cast<size_t>(i - n)];
-        EXPECT_TRUE(e.dt_exists[c]);
-        EXPECT_NEAR(e.dt(col), d2(i), tol)
-            << "dt of event " << i - n << " (" << sim::to_string(e.type) << " at " << e.t << ")/d"
-            << all[c].column;
-      }
-      ++compared;
-    }
-  }
-  return compared;
+  return test_support::expect_columns_match_fd(m, x0, T, tr, all);
 }
 
 int count_type(const sim::Trajectory& tr, sim::EventType type) {

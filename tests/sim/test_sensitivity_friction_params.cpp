@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "support/sensitivity_fd.hpp"
+
 namespace lcsim {
 namespace {
 
@@ -39,56 +41,21 @@ struct Param {
   std::function<void(mech::MechanicalModel&, double)> apply;
 };
 
-VectorXd outcome(const sim::Trajectory& tr) {
-  VectorXd out(tr.final_state.size() + static_cast<Eigen::Index>(tr.events.size()));
-  out.head(tr.final_state.size()) = tr.final_state;
-  for (size_t k = 0; k < tr.events.size(); ++k)
-    out(tr.final_state.size() + static_cast<Eigen::Index>(k)) = tr.events[k].t;
-  return out;
-}
-
 // Every present column of `ps` against central differences at x(T) and each
-// event time; the number of entries compared.
+// event time (tests/support/sensitivity_fd.hpp); the number of entries
+// compared.
 int expect_matches_fd(const mech::Model& m, double T, const std::vector<Param>& ps) {
   std::vector<std::string> names;
-  for (const Param& p : ps) names.push_back(p.column);
+  std::vector<test_support::FdColumn> cols;
+  for (const Param& p : ps) {
+    names.push_back(p.column);
+    cols.push_back({p.column, p.theta,
+                    [p](mech::Model& mm, VectorXd&, double d) { p.apply(*mm.mechanical, d); }});
+  }
   const sim::Trajectory tr = run(m, T, names);
   EXPECT_TRUE(tr.ok()) << tr.message;
   if (!tr.ok()) return 0;
-  const VectorXd base = outcome(tr);
-  const double xs = std::max(1.0, base.cwiseAbs().maxCoeff());
-  const Eigen::Index n = tr.final_state.size();
-  int compared = 0;
-  for (size_t c = 0; c < ps.size(); ++c) {
-    const auto col = static_cast<Eigen::Index>(c);
-    if (!tr.dx_final_exists[c]) {  // absent: no number
-      EXPECT_EQ(tr.dx_final.col(col).cwiseAbs().maxCoeff(), 0.0);
-      continue;
-    }
-    auto fd = [&](double h) {
-      VectorXd out[2];
-      for (int s = 0; s < 2; ++s) {
-        mech::Model mm = m;
-        ps[c].apply(*mm.mechanical, s == 0 ? h : -h);
-        const sim::Trajectory t2 = run(mm, T);
-        EXPECT_TRUE(t2.ok()) << t2.message;
-        EXPECT_EQ(t2.events.size(), tr.events.size()) << ps[c].column << ": events differ";
-        if (t2.events.size() != tr.events.size()) return VectorXd(VectorXd::Zero(base.size()));
-        out[s] = outcome(t2);
-      }
-      return VectorXd((out[0] - out[1]) / (2 * h));
-    };
-    const double h = 1e-4 * std::max(1.0, std::abs(ps[c].theta));
-    const VectorXd d1 = fd(h), d2 = fd(h / 2);
-    for (Eigen::Index i = 0; i < d2.size(); ++i) {
-      const double tol = 4 * std::abs(d1(i) - d2(i)) + 64e-13 * xs / h;
-      const double got =
-          i < n ? tr.dx_final(i, col) : tr.events[static_cast<size_t>(i - n)].dt(col);
-      EXPECT_NEAR(got, d2(i), tol) << ps[c].column << " entry " << i;
-      ++compared;
-    }
-  }
-  return compared;
+  return test_support::expect_columns_match_fd(m, m.initial, T, tr, cols);
 }
 
 Param force(int i, double f) {

@@ -25,6 +25,8 @@
 #include <string>
 #include <vector>
 
+#include "support/sensitivity_fd.hpp"
+
 namespace lcsim {
 namespace {
 
@@ -62,64 +64,27 @@ struct Param {
   int input = 0;
 };
 
-VectorXd outcome(const sim::Trajectory& tr) {
-  VectorXd out(tr.final_state.size() + static_cast<Eigen::Index>(tr.events.size()));
-  out.head(tr.final_state.size()) = tr.final_state;
-  for (size_t k = 0; k < tr.events.size(); ++k)
-    out(tr.final_state.size() + static_cast<Eigen::Index>(k)) = tr.events[k].t;
-  return out;
-}
-
 // Every column of `ps` against central differences at x(T) and at every
-// event time; returns the number of entries compared (no loss expected).
+// event time (tests/support/sensitivity_fd.hpp); returns the number of
+// entries compared (no loss that ends a column expected).
 int expect_matches_fd(const mech::Model& m, const VectorXd& x0, double T,
                       const std::vector<Param>& ps) {
   std::vector<std::string> names;
-  for (const Param& p : ps) names.push_back(p.column);
+  std::vector<test_support::FdColumn> cols;
+  for (const Param& p : ps) {
+    names.push_back(p.column);
+    cols.push_back({p.column, p.theta, [p](mech::Model& mm, VectorXd&, double d) {
+                      p.apply(mm.mechanical->inputs[static_cast<size_t>(p.input)], d);
+                    }});
+  }
   const sim::Trajectory tr = run(m, x0, T, names);
   EXPECT_TRUE(tr.ok()) << tr.message;
   if (!tr.ok()) return 0;
   for (const auto& l : tr.sensitivity_losses)  // one that ends a column
     if (!l.columns.empty())
       ADD_FAILURE() << "t = " << l.t << " '" << l.contact << "': " << l.reason;
-  const VectorXd base = outcome(tr);
-  const double xs = std::max(1.0, base.cwiseAbs().maxCoeff());
-  const Eigen::Index n = tr.final_state.size();
-  int compared = 0;
-  for (size_t c = 0; c < ps.size(); ++c) {
-    auto fd = [&](double h) {
-      VectorXd out[2];
-      for (int s = 0; s < 2; ++s) {
-        mech::Model mm = m;
-        ps[c].apply(mm.mechanical->inputs[static_cast<size_t>(ps[c].input)], s == 0 ? h : -h);
-        const sim::Trajectory t2 = run(mm, x0, T);
-        EXPECT_TRUE(t2.ok()) << t2.message;
-        EXPECT_EQ(t2.events.size(), tr.events.size()) << ps[c].column << ": events differ";
-        if (t2.events.size() != tr.events.size()) return VectorXd(VectorXd::Zero(base.size()));
-        out[s] = outcome(t2);
-      }
-      return VectorXd((out[0] - out[1]) / (2 * h));
-    };
-    EXPECT_EQ(tr.sensitivity_columns[c], ps[c].column);
-    EXPECT_TRUE(tr.dx_final_exists[c]) << ps[c].column;
-    const double h = 1e-4 * std::max(1.0, std::abs(ps[c].theta));
-    const VectorXd d1 = fd(h), d2 = fd(h / 2);
-    const auto col = static_cast<Eigen::Index>(c);
-    for (Eigen::Index i = 0; i < d2.size(); ++i) {
-      const double tol = 4 * std::abs(d1(i) - d2(i)) + 64e-13 * xs / h;
-      if (i < n) {
-        EXPECT_NEAR(tr.dx_final(i, col), d2(i), tol) << "dx[" << i << "]/d" << ps[c].column;
-      } else {
-        const sim::Event& e = tr.events[static_cast<size_t>(i - n)];
-        EXPECT_TRUE(e.dt_exists[c]);
-        EXPECT_NEAR(e.dt(col), d2(i), tol)
-            << "dt of event " << i - n << " (" << sim::to_string(e.type) << " at " << e.t << ")/d"
-            << ps[c].column;
-      }
-      ++compared;
-    }
-  }
-  return compared;
+  for (size_t c = 0; c < ps.size(); ++c) EXPECT_TRUE(tr.dx_final_exists[c]) << ps[c].column;
+  return test_support::expect_columns_match_fd(m, x0, T, tr, cols);
 }
 
 // A sine's parameters, by name.
