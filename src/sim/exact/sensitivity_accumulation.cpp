@@ -28,6 +28,9 @@ bool Sensitivity::limit_map(double t, const EventResult& ev, MatrixXd& J, Matrix
     return false;
   }
   const int nj = static_cast<int>(ev.limit_rows.size());
+  J = MatrixXd::Identity(n_, n_);
+  dR = MatrixXd::Zero(n_, m_);
+  if (nj == 0) return true;  // no contact projected: the identity
   MatrixXd EJ(nj, N_);
   VectorXd gJ(nj);
   for (int i = 0; i < nj; ++i) {
@@ -38,11 +41,9 @@ bool Sensitivity::limit_map(double t, const EventResult& ev, MatrixXd& J, Matrix
   const Eigen::CompleteOrthogonalDecomposition<MatrixXd> W(EJ * GEt);
   const MatrixXd K = GEt * W.pseudoInverse();  // G E_J' W^+
   const MatrixXd P = MatrixXd::Identity(N_, N_) - K * EJ;
-  J = MatrixXd::Identity(n_, n_);
   J.topLeftCorner(N_, N_) = P;
   J.block(N_, N_, N_, N_) = P;
   J.block(0, 2 * N_, N_, 1) = -K * gJ;  // the augmented state's constant entry
-  dR = MatrixXd::Zero(n_, m_);
   const VectorXd rq = EJ * ev.limit_x.head(N_) + gJ, rv = EJ * ev.limit_x.segment(N_, N_);
   for (size_t p = 0; p < cols_.params.size(); ++p) {
     const SensParam& sp = cols_.params[p];

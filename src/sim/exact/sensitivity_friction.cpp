@@ -247,7 +247,8 @@ void Sensitivity::friction_mode_derivatives(const Phase& ph, double t) {
         (fm == FrictionMode::kSlipPositive ? 1.0 : -1.0) * fc.mu * VectorXd(fc.tangent).transpose();
   }
   const MatrixXd GGt = G_ * Gc.transpose();
-  const Eigen::FullPivLU<MatrixXd> lu(H * GGt);
+  Eigen::FullPivLU<MatrixXd> lu;  // no held row (every contact open): nothing to factor
+  if (nI + ns > 0) lu.compute(H * GGt);
   friction_F_ = MatrixXd::Zero(nI + ns, n_);
   if (nI + ns > 0 && !lu.isInvertible()) {
     std::vector<int> cols;
