@@ -58,12 +58,15 @@ Trajectory.v = property(lambda self: _mechanical_views(self)[1],
                         doc="Velocities, shape (n, N): a view of x (mechanical models).")
 
 
-def sweep(model, methods, hs, x0=None, t_end=None, impact=None, theta=None, repeat=3):
+def sweep(model, methods, hs, x0=None, t_end=None, impact=None, theta=None, repeat=3,
+          sensitivity=()):
     """The work-precision sweep of `lcsim sweep`: each method of `methods` at each
     step of `hs`, against an exact event-driven run. Returns the dict that
-    `lcsim sweep --json` prints (rows, references); lcsim.plot.work_precision draws it."""
+    `lcsim sweep --json` prints (rows, references); lcsim.plot.work_precision draws it.
+    `sensitivity` (columns as `simulate`'s, e.g. ["x0", "f[1]"]) adds each row's
+    error_gradient: its dx(T)/dtheta against the exact derivative."""
     return _json.loads(_lcsim._sweep_json(model, list(methods), [float(h) for h in hs], x0,
-                                          t_end, impact, theta, repeat))
+                                          t_end, impact, theta, repeat, list(sensitivity)))
 
 
 def impact_map(model, v1=(-1.0, 1.0), v2=(-1.0, 1.0), n=41, x0=None, law="newton"):

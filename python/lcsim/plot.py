@@ -344,36 +344,56 @@ def work_precision(sweep, output, title="", error="max"):
     """Draws the work-precision diagram of a sweep: `sweep` is the dict lcsim.sweep
     returns (or `lcsim sweep --json` prints), or the path of such a JSON file; `error`
     is "max" (over the whole run: the default, since a damped run at rest by t_end
-    hides its errors from the final state), "events" or "final"."""
+    hides its errors from the final state), "events" or "final". A sweep asked for
+    sensitivities (rows with "error_gradient") gets a second panel beside it: the
+    error of dx(T)/dtheta against the exact derivative, on the same time axis (the
+    speed-accuracy trade of a gradient, docs/sensitivities.md). Returns the row keys
+    drawn, one per panel."""
     if isinstance(sweep, dict):
         data = sweep
     else:
         with open(sweep) as f:
             data = json.load(f)
-    key = "error_" + error
+    keys = ["error_" + error]
+    if any("error_gradient" in r for r in data["rows"]):
+        keys.append("error_gradient")
     methods = {}
     for r in data["rows"]:
         methods.setdefault(r.get("label", r["method"]), []).append(r)
+    fig, axes = plt.subplots(1, len(keys), figsize=(7.6 * len(keys), 5.0), squeeze=False)
+    title = title or data.get("model", "")
+    for ax, key in zip(axes[0], keys):
+        _work_precision_panel(ax, data, methods, key)
+        what = "gradient" if key == "error_gradient" else "work-precision"
+        ax.set_title(f"{title}: {what}" if title else what, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(output, dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    return keys
 
-    def time_of(r):
-        t = r.get("time_s", r.get("wall_time_s"))
-        return t if t is not None else float("nan")
 
-    fig, ax = plt.subplots(figsize=(7.6, 5.0))
+def _time_of(r):
+    t = r.get("time_s", r.get("wall_time_s"))
+    return t if t is not None else float("nan")
+
+
+def _work_precision_lines(ax, methods, key):
+    """One line per time-stepping method (key against time); the exact run a vertical
+    line. Returns the finite points drawn and the rows that failed or were refused."""
     markers = iter("os^vD<>phHd8*")
     finite_pts, bad_rows = [], []
     for method, rows in methods.items():
         if rows[0]["method"] == "event":
-            t = time_of(rows[0])
+            t = _time_of(rows[0])
             if t > 0:
                 ax.axvline(t, color="k", ls=":", lw=1,
                            label=f"{method} (exact, {rows[0].get('reference_law', '')})")
             continue
         bad_rows += [r for r in rows if r.get("status", "completed") != "completed"]
-        pts = [(time_of(r), r.get(key), r["h"], r.get("warnings", 0)) for r in rows
+        pts = [(_time_of(r), r.get(key), r["h"], r.get("warnings", 0)) for r in rows
                if r.get("status", "completed") == "completed"
                and r.get(key) is not None and math.isfinite(r[key]) and r[key] > 0
-               and time_of(r) > 0]
+               and _time_of(r) > 0]
         if not pts:
             continue
         pts.sort()
@@ -395,8 +415,36 @@ def work_precision(sweep, output, title="", error="max"):
         for t, e, h, _ in pts:
             ax.annotate(f"h={h:g}", (t, e), textcoords="offset points", xytext=(4, 4),
                         fontsize=7)
-    times = [p[0] for p in finite_pts] + [time_of(r) for rows in methods.values()
-                                           for r in rows if time_of(r) > 0]
+    return finite_pts, bad_rows
+
+
+def _work_precision_failures(ax, bad_rows):
+    """Rows that failed or were refused have no error: crosses on a band at the top
+    (x in data coordinates, or the left edge; one height per row so labels do not
+    overlap)."""
+    lo, _ = ax.get_xlim()
+    height = iter(0.96 - 0.05 * i for i in range(len(bad_rows)))
+    for kind, mk, col in (("failed", "x", "tab:red"), ("refused", "X", "tab:purple")):
+        sel = [r for r in bad_rows if r["status"].startswith(kind)]
+        if not sel:
+            continue
+        xs = [_time_of(r) if _time_of(r) > 0 else lo * 1.3 for r in sel]
+        ys = [next(height) for _ in sel]
+        ax.plot(xs, ys, ls="none", marker=mk, ms=9, color=col,
+                transform=ax.get_xaxis_transform(), clip_on=False,
+                label=f"{kind} (no error): " + ", ".join(
+                    f"{r['method']} h={r['h']:g}" for r in sel))
+        for x, y, r in zip(xs, ys, sel):
+            ax.annotate(f"{r['method']} h={r['h']:g} {kind}", (x, y),
+                        xycoords=("data", "axes fraction"), textcoords="offset points",
+                        xytext=(7, -3), fontsize=7, color=col)
+
+
+def _work_precision_panel(ax, data, methods, key):
+    """One panel of the diagram: `key` of each row against its time."""
+    finite_pts, bad_rows = _work_precision_lines(ax, methods, key)
+    times = [p[0] for p in finite_pts] + [_time_of(r) for rows in methods.values()
+                                           for r in rows if _time_of(r) > 0]
     if times:  # at least a decade wide, so the log axis has labelled ticks
         lo, hi = min(times) / 3, max(times) * 3
         mid = math.sqrt(lo * hi)
@@ -415,35 +463,16 @@ def work_precision(sweep, output, title="", error="max"):
         ax.plot([], [], ls="none", marker="o", ms=10, mfc="none", mec="0.3",
                 label="ringed: the run warned")
     if bad_rows:
-        # A band at the top: x in data coordinates (or the left edge), y in
-        # axes fraction, one height per row so labels do not overlap.
-        lo, _ = ax.get_xlim()
-        height = iter(0.96 - 0.05 * i for i in range(len(bad_rows)))
-        for kind, mk, col in (("failed", "x", "tab:red"), ("refused", "X", "tab:purple")):
-            sel = [r for r in bad_rows if r["status"].startswith(kind)]
-            if not sel:
-                continue
-            xs = [time_of(r) if time_of(r) > 0 else lo * 1.3 for r in sel]
-            ys = [next(height) for _ in sel]
-            ax.plot(xs, ys, ls="none", marker=mk, ms=9, color=col,
-                    transform=ax.get_xaxis_transform(), clip_on=False,
-                    label=f"{kind} (no error): " + ", ".join(
-                        f"{r['method']} h={r['h']:g}" for r in sel))
-            for x, y, r in zip(xs, ys, sel):
-                ax.annotate(f"{r['method']} h={r['h']:g} {kind}", (x, y),
-                            xycoords=("data", "axes fraction"), textcoords="offset points",
-                            xytext=(7, -3), fontsize=7, color=col)
+        _work_precision_failures(ax, bad_rows)
     merged = any("tool" in r for r in data["rows"])
     ax.set_xlabel("time per run (s, median; lcsim wall, Siconos loop CPU)" if merged
                   else "wall time per run (s, median)")
-    ax.set_ylabel(f"{error} state error (max abs) vs exact run")
-    title = title or data.get("model", "")
-    ax.set_title(f"{title}: work-precision" if title else "work-precision", fontsize=10)
+    if key == "error_gradient":
+        ax.set_ylabel("dx(T)/dtheta error (max abs) vs the exact derivative")
+    else:
+        ax.set_ylabel(f"{key[len('error_'):]} state error (max abs) vs exact run")
     ax.grid(True, which="both", ls=":", lw=0.5)
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
-    fig.tight_layout()
-    fig.savefig(output, dpi=120, bbox_inches="tight")
-    plt.close(fig)
 
 
 # ---- The cart chain's timing (bench/run_chain_bench.sh) ------------------------------

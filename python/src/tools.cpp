@@ -71,8 +71,10 @@ py::object analyze(const ModelHandle& model, bool full, double linearisation_thr
 
 std::string sweep(const ModelHandle& model, std::vector<std::string> methods,
                   std::vector<double> hs, std::optional<VectorXd> x0, std::optional<double> t_end,
-                  std::optional<std::string> impact, std::optional<double> theta, int repeat) {
+                  std::optional<std::string> impact, std::optional<double> theta, int repeat,
+                  std::vector<std::string> sensitivity) {
   app::SweepOptions o;
+  o.base.sensitivity = std::move(sensitivity);
   o.methods = std::move(methods);
   o.hs = std::move(hs);
   o.repeat = repeat;
@@ -192,7 +194,9 @@ void bind_tools(py::module_& m) {
   m.def("_sweep_json", &sweep, py::arg("model"), py::arg("methods"), py::arg("hs"),
         py::arg("x0") = py::none(), py::arg("t_end") = py::none(), py::arg("impact") = py::none(),
         py::arg("theta") = py::none(), py::arg("repeat") = 3,
-        "The work-precision sweep (app::run_sweep) as the JSON text `lcsim sweep --json` prints.");
+        py::arg("sensitivity") = std::vector<std::string>{},
+        "The work-precision sweep (app::run_sweep) as the JSON text `lcsim sweep --json` prints; "
+        "`sensitivity` (as `--sensitivity`) adds each row's error_gradient.");
   m.def("_impact_map_csv", &impact_map_csv, py::arg("model"), py::arg("v1"), py::arg("v2"),
         py::arg("n") = 41, py::arg("x0") = py::none(), py::arg("law") = "newton",
         "The impact map of thesis Figure 3.5 (app::impact_map) as the CSV `lcsim impacts --map` "

@@ -96,6 +96,26 @@ def test_work_precision_python_and_cli(robots, lcsim_binary, tmp_path):
     assert_png(tmp_path / "cli.png")
 
 
+def test_work_precision_draws_the_gradient_beside_the_state(robots, lcsim_binary, tmp_path):
+    # A sweep asked for sensitivities: each scheme row's error_gradient (its
+    # dx(T)/dx0 against the exact one; the two carts before their impact, where
+    # both converge) is drawn in a second panel, from Python and from the CLI.
+    model = lcsim.load(robots / "two_carts.yaml")
+    sweep = lcsim.sweep(model, ["event", "euler"], [1e-2, 1e-3], t_end=0.9, repeat=1,
+                        sensitivity=["x0"])
+    grads = [r["error_gradient"] for r in sweep["rows"] if r["method"] == "euler"]
+    assert len(grads) == 2 and 0 < grads[1] < grads[0]  # first order: it falls with h
+    assert lcsim.plot.work_precision(sweep, tmp_path / "py.png") == ["error_max",
+                                                                      "error_gradient"]
+    assert_png(tmp_path / "py.png")
+    cli = subprocess.run([str(lcsim_binary), "sweep", str(robots / "two_carts.yaml"),
+                          "--methods", "event,euler", "--h", "1e-2", "--repeat", "1",
+                          "--t-end", "0.9", "--sensitivity", "x0",
+                          "--plot", str(tmp_path / "cli.png")], capture_output=True, text=True)
+    assert cli.returncode == 0, cli.stderr
+    assert_png(tmp_path / "cli.png")
+
+
 def test_bad_file_is_one_line_and_exit_1(tmp_path):
     (tmp_path / "bad.csv").write_text("a,b\n1,2\n")
     assert lcsim.plot.main(["trajectory", str(tmp_path / "bad.csv"), "-o",

@@ -67,6 +67,13 @@ Perturbation entry(const std::string& name, char which, int i, int j, double ste
           }};
 }
 
+// The friction coefficient of mechanical.friction[f].
+Perturbation friction_mu(const std::string& name, int f, double step) {
+  return {name, step, [f](mech::Model& m, VectorXd&, double d) {
+            m.mechanical->friction[static_cast<size_t>(f)].mu += d;
+          }};
+}
+
 Perturbation state(int i, double step) {
   return {"x0[" + std::to_string(i) + "]", step,
           [i](mech::Model&, VectorXd& x, double d) { x(i) += d; }};
@@ -404,13 +411,13 @@ namespace {
 // acceleration exactly (v+ = v + h a, q+ = q + h (v + v+) / 2, the normal
 // impulse -h f1 per step), so the step map's derivative is the closed
 // form's: dx/dv0 = T, dx/df0 = T^2 / (2 M00), dx/df1 = mu T^2 / (2 M00),
-// dv/df1 = mu T / M00, dx/dM00 = -a T^2 / (2 M00), to rounding (40 steps:
-// 1e-13 absolute, a hundred times the measured 1e-15).
+// dv/df1 = mu T / M00, dx/dM00 = -a T^2 / (2 M00), dx/dmu = -g T^2 / 2, to
+// rounding (40 steps: 1e-13 absolute, a hundred times the measured 1e-15).
 TEST(StepSensitivity, MoreauJeanSlidingBlockIsTheClosedForm) {
   const mech::Model m = load("block_on_floor_friction.yaml");
   const double T = 0.4, mu = 0.4, g = 9.81, a = -mu * g;
-  const sim::Trajectory tr =
-      run("moreau-jean", m, m.initial, T, 1e-2, {"x0", "f[0]", "f[1]", "M[0][0]"}, 0.5);
+  const sim::Trajectory tr = run("moreau-jean", m, m.initial, T, 1e-2,
+                                 {"x0", "f[0]", "f[1]", "M[0][0]", "mu[floor]"}, 0.5);
   ASSERT_TRUE(tr.ok()) << tr.message;
   ASSERT_TRUE(tr.sensitivity_losses.empty()) << tr.sensitivity_losses.front().reason;
   EXPECT_NEAR(tr.final_state(0), 2.0 * T + a * T * T / 2, 1e-13);
@@ -424,6 +431,9 @@ TEST(StepSensitivity, MoreauJeanSlidingBlockIsTheClosedForm) {
   EXPECT_NEAR(dx(0, 6), -a * T * T / 2, 1e-13);
   EXPECT_NEAR(dx(2, 6), -a * T, 1e-13);
   EXPECT_NEAR(dx(1, 5), 0.0, 1e-13);  // the block stays on the floor
+  // mu[floor]: a = -mu g, so dx/dmu = -g T^2 / 2 and dv/dmu = -g T.
+  EXPECT_NEAR(dx(0, 7), -9.81 * T * T / 2, 1e-13);
+  EXPECT_NEAR(dx(2, 7), -9.81 * T, 1e-13);
 }
 
 // The incline (robots/incline_friction.yaml): sliding down, then stuck
@@ -448,7 +458,7 @@ TEST(StepSensitivity, MoreauJeanThroughStickAndSlipMatchesItsOwnDifferences) {
     expect_matches_own_fd("moreau-jean", m, x0, 2.0, 1e-2,
                           {state(0, 1e-6), state(1, 1e-7), state(2, 1e-6), state(3, 1e-6),
                            entry("f[0]", 'f', 0, 0, 1e-4), entry("f[1]", 'f', 1, 0, 1e-4),
-                           entry("M[0][0]", 'M', 0, 0, 1e-4)},
+                           entry("M[0][0]", 'M', 0, 0, 1e-4), friction_mu("mu[plane]", 0, 1e-6)},
                           theta);
   }
 }
@@ -538,7 +548,8 @@ TEST(StepSensitivity, MoreauJean3dThroughVerticesFacesAndStickMatchesItsOwnDiffe
     EXPECT_EQ(fm.back(), "stick ");
     expect_matches_own_fd("moreau-jean", m, x0, 0.8, 1e-2,
                           {state(0, 1e-6), state(1, 1e-6), state(3, 1e-6), state(4, 1e-6),
-                           entry("f[0]", 'f', 0, 0, 1e-4), entry("f[2]", 'f', 2, 0, 1e-4)});
+                           entry("f[0]", 'f', 0, 0, 1e-4), entry("f[2]", 'f', 2, 0, 1e-4),
+                           friction_mu("mu[floor]", 0, 1e-4)});
   }
 }
 

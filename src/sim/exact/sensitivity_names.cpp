@@ -277,7 +277,8 @@ namespace {
 // any other kind is refused by name, never taken as a zero column.
 std::string refuse_for_scheme(const detail::SensColumns& c, std::string_view method) {
   for (const detail::SensParam& p : c.params) {
-    if (std::string_view("fKDMgea").find(p.kind) == std::string_view::npos)
+    if (std::string_view(method == "moreau-jean" ? "fKDMgeau" : "fKDMgea").find(p.kind) ==
+        std::string_view::npos)
       return "Options::sensitivity '" + p.name + "': method '" + std::string(method) +
              "' does not compute it (the method 'event' does)";
     if (method == "moreau-jean" && p.kind == 'g')

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <lcsim/impact/impact.hpp>
 #include <limits>
 #include <string>
@@ -79,18 +80,27 @@ VectorXd StepSensitivity::amplitude_force(int input, double t) const {
   return out;
 }
 
+void StepSensitivity::lose_column(double t, int row, const std::string& reason, int column) {
+  lose_columns(t, row, reason, [column](int c) { return c == column; });
+}
+
 void StepSensitivity::lose_all(double t, int row, const std::string& reason) {
-  if (!any_exists()) return;
+  lose_columns(t, row, reason, [](int) { return true; });
+}
+
+void StepSensitivity::lose_columns(double t, int row, const std::string& reason,
+                                   const std::function<bool(int)>& which) {
   SensitivityLoss l;
+  for (int c = 0; c < m_; ++c)
+    if (exists_[static_cast<size_t>(c)] && which(c)) {
+      exists_[static_cast<size_t>(c)] = 0;
+      l.columns.push_back(c);
+    }
+  if (l.columns.empty()) return;
   l.t = t;
   l.contact = model_.is_mechanical() ? model_.mechanical->constraints[static_cast<size_t>(row)]
                                      : "y" + std::to_string(row);
   l.reason = reason;
-  for (int c = 0; c < m_; ++c)
-    if (exists_[static_cast<size_t>(c)]) {
-      exists_[static_cast<size_t>(c)] = 0;
-      l.columns.push_back(c);
-    }
   losses_.push_back(std::move(l));
 }
 
@@ -208,6 +218,7 @@ bool MjStepSensitivity::impulse_terms(double t0, const Eigen::LLT<MatrixXd>& W, 
   }
   Pieces pc;
   if (friction && !friction_pieces(t0, rows, lambda_N, *friction, v_next, pc)) return false;
+  mu_terms(W, pc, dVn);
   const int nu = ns + static_cast<int>(pc.cols.size());
   if (nu == 0) return true;
   // Unknowns: the normal impulses of S, then the pieces' (stuck tangents,
@@ -242,16 +253,37 @@ bool MjStepSensitivity::impulse_terms(double t0, const Eigen::LLT<MatrixXd>& W, 
   return true;
 }
 
+void MjStepSensitivity::mu_terms(const Eigen::LLT<MatrixXd>& W, const Pieces& pc,
+                                 MatrixXd& dVn) const {
+  for (size_t p = 0; p < cols_.params.size(); ++p) {
+    const SensParam& sp = cols_.params[p];
+    if (sp.kind != 'u') continue;
+    for (const auto& [f, Fmu] : pc.per_mu)
+      if (f == sp.j) dVn.col(nx0_ + static_cast<int>(p)) += W.solve(Fmu);
+  }
+}
+
 bool MjStepSensitivity::friction_pieces(double t0, const std::vector<int>& rows,
                                         const VectorXd& lambda_N, const Friction& fr,
                                         const VectorXd& v_next, Pieces& out) {
   const mech::MechanicalModel& m = *model_.mechanical;
-  for (const mech::FrictionalContact& fc : m.friction) {
+  for (size_t entry = 0; entry < m.friction.size(); ++entry) {
+    const mech::FrictionalContact& fc = m.friction[entry];
     const auto it = std::find(rows.begin(), rows.end(), fc.contact);
-    if (it == rows.end() || fc.mu == 0.0) continue;  // open, or frictionless at this contact
+    if (it == rows.end()) continue;  // open
+    if (fc.mu == 0.0) {  // frictionless here; its mu[c] is one-sided where it would stick
+      for (size_t p = 0; p < cols_.params.size(); ++p)
+        if (cols_.params[p].kind == 'u' && cols_.params[p].i == fc.contact)
+          lose_column(t0, fc.contact,
+                      "mu = 0 at this contact: the derivative in mu is one-sided (it would "
+                      "stick)",
+                      nx0_ + static_cast<int>(p));
+      continue;
+    }
     const int a = static_cast<int>(it - rows.begin());
     const double p2 = fr.t2 ? (*fr.t2)(fc.contact) : 0.0;
-    if (!contact_piece(t0, fc, a, lambda_N(a), (*fr.t)(fc.contact), p2, v_next, fr.V, out))
+    if (!contact_piece(t0, fc, static_cast<int>(entry), a, lambda_N(a), (*fr.t)(fc.contact), p2,
+                       v_next, fr.V, out))
       return false;
   }
   return true;
@@ -263,9 +295,9 @@ bool MjStepSensitivity::friction_pieces(double t0, const std::vector<int>& rows,
 // cone (impulse mu P_N D_i) or a face (impulse between D_i and D_i+1, the
 // velocity along the face's normal: (D_i+1 - D_i).u = 0 held). A planar
 // contact, or a 3-D one with d = 1 (a flat cone), has friction along t only.
-bool MjStepSensitivity::contact_piece(double t0, const mech::FrictionalContact& fc, int a,
-                                      double ln, double p1, double p2, const VectorXd& v_next,
-                                      double V, Pieces& out) {
+bool MjStepSensitivity::contact_piece(double t0, const mech::FrictionalContact& fc, int entry,
+                                      int a, double ln, double p1, double p2,
+                                      const VectorXd& v_next, double V, Pieces& out) {
   const int d = model_.mechanical->edges_of(fc);
   const bool flat = !fc.is_3d() || d == 1;
   const double s = fc.sliding(v_next), s2 = flat ? 0.0 : fc.tangent2.dot(v_next);
@@ -288,6 +320,7 @@ bool MjStepSensitivity::contact_piece(double t0, const mech::FrictionalContact& 
   if (flat) {
     if (p1 * s >= 0.0) return lose("whose friction impulse does not oppose its sliding");
     out.normal.emplace_back(a, -(s > 0.0 ? 1.0 : -1.0) * fc.mu * t);
+    out.per_mu.emplace_back(entry, p1 / fc.mu * t);
     return true;
   }
   const impact::ConeFacet f = impact::cone_facet(s, s2, d);
@@ -302,6 +335,7 @@ bool MjStepSensitivity::contact_piece(double t0, const mech::FrictionalContact& 
     if (std::hypot(p1 - mu_pn * c0, p2 - mu_pn * s0) > kDegenerate * mu_pn)
       return lose("whose friction impulse is not its cone's vertex opposing the sliding");
     out.normal.emplace_back(a, fc.mu * Di);
+    out.per_mu.emplace_back(entry, ln * Di);
     return true;
   }
   // On the face: (p1, p2) = mu (ln D_i + b (D_i+1 - D_i)), 0 < b < ln.
@@ -314,6 +348,7 @@ bool MjStepSensitivity::contact_piece(double t0, const mech::FrictionalContact& 
   const VectorXd Dd = dc * t + ds * t2;
   out.normal.emplace_back(a, fc.mu * Di);
   out.cols.push_back(fc.mu * Dd), out.rows.push_back(Dd);
+  out.per_mu.emplace_back(entry, ln * Di + b * Dd);
   return true;
 }
 

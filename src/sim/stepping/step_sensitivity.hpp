@@ -9,6 +9,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <functional>
 #include <lcsim/sim/sim.hpp>
 #include <string>
 #include <vector>
@@ -37,6 +38,11 @@ class StepSensitivity {
                       std::vector<int>& active);
   // Every column absent from t on (once), naming constraint `row`.
   void lose_all(double t, int row, const std::string& reason);
+  // Column `column` absent from t on (once), naming constraint `row`.
+  void lose_column(double t, int row, const std::string& reason, int column);
+  // The columns `which` selects that still exist: absent from t on, one loss.
+  void lose_columns(double t, int row, const std::string& reason,
+                    const std::function<bool(int)>& which);
   bool any_exists() const;
   // d f(t)/d amplitude of input `input` (the parameter kind 'a'): its force
   // gains times the sine's unit waveform at t (docs/inputs.md).
@@ -79,7 +85,13 @@ class MjStepSensitivity : public StepSensitivity {
   struct Pieces {
     std::vector<std::pair<int, VectorXd>> normal;  // (position in S, column)
     std::vector<VectorXd> cols, rows;
+    // A sliding contact's friction impulse over mu, F / mu (generalised,
+    // N s), by its mechanical.friction entry: its mu[c] column's forcing.
+    std::vector<std::pair<int, VectorXd>> per_mu;
   };
+  // The mu[c] columns' forcing W^-1 F / mu of each sliding contact (zero for
+  // a stuck one, at its outcome), added to dVn.
+  void mu_terms(const Eigen::LLT<MatrixXd>& W, const Pieces& pc, MatrixXd& dVn) const;
   // The impulses' part of dv+ (added to dVn): the strictly active normal
   // rows S as equalities with the friction's pieces; false when the step
   // map has no derivative (a loss recorded).
@@ -93,8 +105,8 @@ class MjStepSensitivity : public StepSensitivity {
                        const Friction& fr, const VectorXd& v_next, Pieces& out);
   // One contact's piece: fc on S at position a with normal impulse ln and
   // friction impulse (p1, p2).
-  bool contact_piece(double t0, const mech::FrictionalContact& fc, int a, double ln, double p1,
-                     double p2, const VectorXd& v_next, double V, Pieces& out);
+  bool contact_piece(double t0, const mech::FrictionalContact& fc, int entry, int a, double ln,
+                     double p1, double p2, const VectorXd& v_next, double V, Pieces& out);
   const Eigen::LLT<MatrixXd>& factor(double h);
   // The parameters' part of W dv+ (before the impulses): h (df - dD v -
   // dK (q + h theta v)) - dW (v+ - v) for each parameter column.
