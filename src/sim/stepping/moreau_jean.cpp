@@ -236,6 +236,13 @@ class MjRun {
     return advance(j, last, h);
   }
 
+  // The last friction step's velocity scale (m/s), max(|v_free|, |v_end|)
+  // with v_end its end velocity: the stick band's scale for the labels
+  // (label_modes) and for the derivative's stick / slip pieces alike.
+  double velocity_scale(const VectorXd& v_end) const {
+    return std::max(v_free_size_, v_end.size() > 0 ? v_end.lpNorm<Eigen::Infinity>() : 0.0);
+  }
+
   // The step map's derivative (step_sensitivity.hpp), with the step's
   // friction impulses and velocity scale (label_modes') where there are any.
   void sensitivity_step(double t0, double h) {
@@ -243,7 +250,7 @@ class MjRun {
     if (friction_) {
       fr.t = &lambda_T_;
       fr.t2 = u_t2_.size() > 0 ? &friction_->lambda_T2() : nullptr;
-      fr.V = std::max(v_free_size_, v_next_.size() > 0 ? v_next_.lpNorm<Eigen::Infinity>() : 0.0);
+      fr.V = velocity_scale(v_next_);
     }
     sens_->step(t0, h, q_, v_, v_next_, A_, z_, friction_ ? &fr : nullptr);
   }
@@ -489,7 +496,7 @@ class MjRun {
   // between the step and the next one: z_, pos_, lambda_T_ and the second
   // tangents' impulses are the step's, v_ its end velocity.
   void label_modes() {
-    const double V = std::max(v_free_size_, v_.size() > 0 ? v_.lpNorm<Eigen::Infinity>() : 0.0);
+    const double V = velocity_scale(v_);
     for (size_t fi = 0; fi < fmode_.size(); ++fi) {
       if (fmode_[fi] != FrictionMode::kStick) continue;  // open (closed ones are kStick here)
       const mech::FrictionalContact& fc = m_.friction[fi];
