@@ -325,11 +325,7 @@ bool MjStepSensitivity::contact_piece(double t0, const mech::FrictionalContact& 
   }
   const impact::ConeFacet f = impact::cone_facet(s, s2, d);
   const VectorXd t2 = fc.tangent2;
-  auto D = [&](int i) {
-    const auto [c, sn] = impact::cone_edge(i % (2 * d), d);
-    return std::pair<double, double>{c, sn};
-  };
-  const auto [c0, s0] = D(f.edge);
+  const auto [c0, s0] = impact::cone_edge(f.edge, d);
   const VectorXd Di = c0 * t + s0 * t2;
   if (!f.face) {
     if (std::hypot(p1 - mu_pn * c0, p2 - mu_pn * s0) > kDegenerate * mu_pn)
@@ -339,7 +335,7 @@ bool MjStepSensitivity::contact_piece(double t0, const mech::FrictionalContact& 
     return true;
   }
   // On the face: (p1, p2) = mu (ln D_i + b (D_i+1 - D_i)), 0 < b < ln.
-  const auto [c1, s1] = D(f.edge + 1);
+  const auto [c1, s1] = impact::cone_edge((f.edge + 1) % (2 * d), d);
   const double dc = c1 - c0, ds = s1 - s0;
   const double b =
       ((p1 / fc.mu - ln * c0) * dc + (p2 / fc.mu - ln * s0) * ds) / (dc * dc + ds * ds);
