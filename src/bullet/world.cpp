@@ -316,6 +316,14 @@ Plan plan_of(const mech::Model& model, const WorldSettings& s) {
       return p;
     }
   }
+  // Friction is Bullet's own at a contact scene's contacts (above); the
+  // rigid bodies of a matrix model and a scene without contacts have no
+  // place for it, and would drop it silently.
+  if (model.is_mechanical() && model.mechanical->has_friction())
+    throw std::invalid_argument(
+        "bullet: " + (model.source.empty() ? "model '" + model.name + "'" : model.source) +
+        ": mechanical.friction on a model that is not a URDF contact scene: Bullet runs "
+        "friction at a scene's contacts only (methods 'event' and 'moreau-jean' simulate it)");
   if (!setup) {
     p.rb6_limits = limits_of(model, s.limit_range);
     return p;
@@ -489,9 +497,11 @@ WorldSettings::Friction parse_friction(const std::string& name) {
 }
 
 namespace {
+// Bullet's own contact solver, restitution and friction (a contact scene's
+// friction only: plan_of refuses it elsewhere, naming why).
 sim::OptionsUsed bullet_options_used() {
-  sim::OptionsUsed u;  // Bullet's own contact solver and restitution
-  u.h = u.needs_mechanical = true;
+  sim::OptionsUsed u;
+  u.h = u.needs_mechanical = u.friction = u.friction_3d = true;
   return u;
 }
 }  // namespace
@@ -501,14 +511,8 @@ sim::Trajectory simulate_bullet(const mech::Model& model, const VectorXd& x0,
   // The library's one check of a run's input, as sim::Integrator::run makes.
   sim::Options opt = options;
   // Friction at a contact scene's contacts is Bullet's own (WorldSettings::
-  // friction). The "bullet" integrator's options_used states none, so
-  // `--method bullet` still refuses it (and the methods that take friction
-  // are listed without Bullet, which takes it on contact scenes only).
-  sim::OptionsUsed used = bullet_options_used();
-  if (model.is_mechanical() && model.mechanical->has_friction() &&
-      (contact_scene_of(model) || bodies_scene_of(model)))
-    used.friction = used.friction_3d = true;
-  if (auto refused = sim::refuse_invalid_run(model, x0, opt, "bullet", used))
+  // friction); plan_of refuses it on any other model.
+  if (auto refused = sim::refuse_invalid_run(model, x0, opt, "bullet", bullet_options_used()))
     return std::move(*refused);
   if (std::string why = settings_error(s); !why.empty()) {
     sim::Trajectory tr;

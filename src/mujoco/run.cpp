@@ -440,18 +440,22 @@ double mj_step_time(const mech::Model& model, const VectorXd& x0, double h, long
   return wall / static_cast<double>(std::max(1L, steps));
 }
 
+// The step, and MuJoCo's own contacts and friction (Settings::cone) at a
+// scene's contacts: check_expressible refuses friction anywhere else.
+namespace {
+sim::OptionsUsed mujoco_options_used() {
+  sim::OptionsUsed u;
+  u.h = u.needs_mechanical = u.friction = u.friction_3d = true;
+  return u;
+}
+}  // namespace
+
 // It is one piece: the step loop's stages (forces, mj_step, read back, record,
 // divergence) share the run's state and read in order.
 sim::Trajectory simulate_mujoco(const mech::Model& model, const VectorXd& x0,
                                 const sim::Options& options, const Settings& s) {
   sim::Options opt = options;
-  sim::OptionsUsed used;
-  used.h = used.needs_mechanical = true;
-  // Friction at the scene's contacts is MuJoCo's own (Settings::cone;
-  // check_expressible refuses any other). The "mujoco" integrator's
-  // options_used states none: `--method mujoco` still refuses friction.
-  used.friction = used.friction_3d = true;
-  if (auto refused = sim::refuse_invalid_run(model, x0, opt, "mujoco", used))
+  if (auto refused = sim::refuse_invalid_run(model, x0, opt, "mujoco", mujoco_options_used()))
     return std::move(*refused);
   sim::Trajectory tr;
   tr.method = "mujoco " + settings_description(s, opt.h, model.mechanical->has_friction());
@@ -537,11 +541,7 @@ namespace {
 class MujocoIntegrator : public sim::Integrator {
  public:
   std::string name() const override { return "mujoco"; }
-  sim::OptionsUsed options_used() const override {
-    sim::OptionsUsed u;
-    u.h = u.needs_mechanical = true;
-    return u;
-  }
+  sim::OptionsUsed options_used() const override { return mujoco_options_used(); }
 
  protected:
   std::string refusal(const mech::Model& model) const override {

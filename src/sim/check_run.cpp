@@ -116,40 +116,47 @@ std::string check_output_size(const mech::Model& model, const Options& opt, cons
          ": raise " + knob + ", or max_output_bytes";
 }
 
-// A model with friction and a method that would ignore it: refused, naming
-// the methods that handle friction (those whose OptionsUsed::friction is set).
-std::string refuse_friction(const mech::Model& model, std::string_view method,
-                            const OptionsUsed& used) {
-  if (used.friction || !model.is_mechanical() || !model.mechanical->has_friction()) return "";
+// The methods that would take this model and state in a run of default
+// options (their own checks and refusal included: Bullet and MuJoCo take
+// friction at a URDF scene's contacts only), quoted and joined, those with
+// `takes` in their OptionsUsed.
+std::string methods_taking(const mech::Model& model, const VectorXd& x0, bool OptionsUsed::*takes) {
+  Options probe;
+  probe.t_end = std::isfinite(model.t_end) ? model.t_end : 1.0;
   std::string with;
   for (const std::string& name : integrators().names())
-    if (auto integ = integrators().make(name); integ && integ->options_used().friction)
+    if (auto integ = integrators().make(name);
+        integ && integ->options_used().*takes && !integ->refuse(model, x0, probe))
       with += (with.empty() ? "'" : ", '") + name + "'";
+  return with;
+}
+
+// A model with friction and a method that would ignore it: refused, naming
+// the methods that would take it (methods_taking).
+std::string refuse_friction(const mech::Model& model, const VectorXd& x0, std::string_view method,
+                            const OptionsUsed& used) {
+  if (used.friction || !model.is_mechanical() || !model.mechanical->has_friction()) return "";
+  const std::string with = methods_taking(model, x0, &OptionsUsed::friction);
   return "method '" + std::string(method) + "' does not support friction (model '" + model.name +
          "' has " + std::to_string(model.mechanical->friction.size()) + " frictional contact" +
          (model.mechanical->friction.size() == 1 ? "" : "s") + " in mechanical.friction); " +
-         (with.empty() ? std::string("no simulation method supports it yet (the impact laws do)")
+         (with.empty() ? std::string("no other method takes this model and state")
                        : "use method " + with);
 }
 
 // A model with 3-D friction (two tangents) and a method that handles planar
-// friction only: refused, naming the methods that handle it (those whose
-// OptionsUsed::friction_3d is set) or, with none, the impact laws.
-std::string refuse_friction_3d(const mech::Model& model, std::string_view method,
-                               const OptionsUsed& used) {
+// friction only: refused, naming the methods that would take it.
+std::string refuse_friction_3d(const mech::Model& model, const VectorXd& x0,
+                               std::string_view method, const OptionsUsed& used) {
   if (used.friction_3d || !model.is_mechanical() || !model.mechanical->has_friction_3d()) return "";
   const auto& fr = model.mechanical->friction;
   const auto it = std::find_if(fr.begin(), fr.end(),
                                [](const mech::FrictionalContact& c) { return c.is_3d(); });
-  std::string with;
-  for (const std::string& name : integrators().names())
-    if (auto integ = integrators().make(name); integ && integ->options_used().friction_3d)
-      with += (with.empty() ? "'" : ", '") + name + "'";
+  const std::string with = methods_taking(model, x0, &OptionsUsed::friction_3d);
   return "method '" + std::string(method) + "' does not yet handle 3-D friction (model '" +
          model.name + "' has two tangents at mechanical.friction[" +
          std::to_string(it - fr.begin()) + "]); " +
-         (with.empty() ? std::string("no simulation method handles it yet (the impact laws "
-                                     "'newton', 'inelastic' and 'moreau-restitution' do)")
+         (with.empty() ? std::string("no other method takes this model and state")
                        : "method " + with + " does");
 }
 
@@ -287,8 +294,8 @@ std::string check_run(const mech::Model& model, const VectorXd& x0, const Option
     return "method '" + std::string(method) + "' needs a mechanical model ('" + model.name +
            "' is a general LCS; the methods 'event' and 'euler' take one)";
   // 3-D first: a planar refusal would name methods that refuse 3-D friction too.
-  if (std::string m = refuse_friction_3d(model, method, used); !m.empty()) return m;
-  if (std::string m = refuse_friction(model, method, used); !m.empty()) return m;
+  if (std::string m = refuse_friction_3d(model, x0, method, used); !m.empty()) return m;
+  if (std::string m = refuse_friction(model, x0, method, used); !m.empty()) return m;
   if (std::string m = refuse_asymmetric(model, method, used); !m.empty()) return m;
   if (used.dense_lcs && model.lcs_state_size() > mech::kMaxDenseLcsState)
     return "method '" + std::string(method) +

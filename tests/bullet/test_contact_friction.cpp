@@ -158,5 +158,43 @@ TEST(PeerFrictionOutputs, TheSamplesCarryTheFrictionAlongTheTangents) {
   EXPECT_NEAR(impulse, mass * (v_end - kV0), 1e-12);
 }
 
+// `--method bullet` (the registered integrator) runs a contact scene's
+// friction as simulate_bullet with its default settings does: the same run,
+// bit for bit (one code path), and the closed form's stop as above. A model
+// of matrices with friction has no contact for Bullet's friction: refused in
+// one line naming the model and the methods that simulate it.
+TEST(BulletFriction, MethodBulletRunsASceneWithFrictionAndRefusesMatrices) {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("lcsim_bullet_method_" + std::to_string(::getpid()));
+  const mech::Model m = scene::load_model(test_support::write_slide_scene(dir, 0.0, kMu, kV0, 0.6));
+  sim::Options o;
+  o.t_end = 0.6;
+  o.h = kH;
+  o.dt_out = kH;
+  const sim::Trajectory tr = sim::make_integrator("bullet")->run(m, m.initial, o);
+  ASSERT_EQ(tr.status, sim::RunStatus::kCompleted) << tr.message;
+  const sim::Trajectory direct = simulate_bullet(m, m.initial, o, WorldSettings{});
+  std::filesystem::remove_all(dir);  // Bullet reads the scene's file (model.source)
+  ASSERT_EQ(tr.final_state.size(), direct.final_state.size());
+  EXPECT_EQ(tr.final_state, direct.final_state);  // the same code path: no rounding apart
+  const auto s = test_support::measure_slide(tr, 1e-3, 0.05);
+  EXPECT_NEAR(s.t_stop, kV0 / (kMu * kG), 2 * kH);  // the tolerances of the first test
+  EXPECT_NEAR(s.distance, kV0 * kV0 / (2 * kMu * kG), kV0 * kH);
+
+  mech::MechanicalModel b;  // a unit mass on the floor y >= 0, friction along x
+  b.M = Eigen::MatrixXd::Identity(2, 2).sparseView();
+  b.E = Eigen::RowVector2d(0, 1).sparseView();
+  b.f = Eigen::Vector2d(0, -kG);
+  b.friction.push_back(mech::FrictionalContact(0, Eigen::Vector2d(1, 0), kMu));
+  const mech::Model block = mech::model_of(b, "block");
+  const sim::Trajectory refused =
+      sim::make_integrator("bullet")->run(block, (Eigen::VectorXd(4) << 0, 0, 1, 0).finished(), o);
+  EXPECT_EQ(refused.status, sim::RunStatus::kInvalidInput);
+  EXPECT_EQ(refused.message,
+            "bullet: model 'block': mechanical.friction on a model that is not a URDF contact "
+            "scene: Bullet runs friction at a scene's contacts only (methods 'event' and "
+            "'moreau-jean' simulate it)");
+}
+
 }  // namespace
 }  // namespace lcsim::bullet
