@@ -80,6 +80,10 @@ Setup setup_of(const Study& s, const RunPoint& p) {
       case K::kRestitution:
         u.model.mechanical->restitution(q.row) = v;
         break;
+      case K::kMu:  // a value < 0 is the run's invalid input (mech::check_model)
+        for (mech::FrictionalContact& c : u.model.mechanical->friction)
+          if (c.contact == q.row) c.mu = v;
+        break;
       case K::kScale:
         scale(*u.model.mechanical, q, v);
         break;

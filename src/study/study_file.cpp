@@ -51,6 +51,20 @@ int named_index(const Study& s, const std::string& key, const std::string& name,
   return found;
 }
 
+// A mu.<constraint> quantity: every model has a mechanical.friction entry on
+// that constraint.
+void check_frictional(const Study& s, const std::string& key, const std::string& name, int row) {
+  for (const auto& m : s.models) {
+    const auto& fr = m.mechanical->friction;
+    if (std::none_of(fr.begin(), fr.end(),
+                     [row](const mech::FrictionalContact& c) { return c.contact == row; }))
+      y::fail(s.source, key,
+              "constraint '" + io::one_line(name, 80) + "' of model '" + m.name +
+                  "' has no friction (no mechanical.friction entry, no scene contact's "
+                  "friction:)");
+  }
+}
+
 std::vector<std::string> split_dots(const std::string& key) { return io::split(key, '.'); }
 
 // where: the key as placed in the file ("axes[1].scale.K"), for messages.
@@ -100,10 +114,15 @@ Quantity parse_quantity(const Study& s, const std::string& key, const std::strin
     q.kind = p[0] == "x0" ? K::kX0 : p[0] == "v0" ? K::kV0 : K::kRestitution;
     q.row = named_index(s, where, p[1], q.kind == K::kRestitution);
     return q;
+  } else if (p.size() == 2 && p[0] == "mu") {
+    q.kind = K::kMu;
+    q.row = named_index(s, where, p[1], true);
+    check_frictional(s, where, p[1], q.row);
+    return q;
   }
   y::fail(s.source, where,
           "unknown quantity (expected method, impact, h, theta, t_end, x0.<coord>, v0.<coord>, "
-          "restitution.<constraint> or scale.<M|D|K|f|g>...)");
+          "restitution.<constraint>, mu.<constraint> or scale.<M|D|K|f|g>...)");
 }
 
 void check_name(const Study& s, const std::string& key, const Quantity& q, const std::string& v) {

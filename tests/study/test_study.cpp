@@ -195,6 +195,34 @@ TEST(StudyRuns, EventsAndEnergyOfTheThesisRun) {
   EXPECT_NEAR(std::stod(cell(s, elastic, "energy_change")), 0.0, 1e-12);
 }
 
+// mu.<constraint> sets the friction coefficient of the constraint's
+// mechanical.friction entry: the block of robots/block_on_floor_friction.yaml
+// (v0 = 2 m/s) sticks at x* = v0^2 / (2 mu g) (at t* = v0 / (mu g)), which the exact method hits to
+// rounding (1e-12: tests/sim/test_event_friction.cpp's margin). A constraint
+// without friction is a one-line error; mu < 0 a row of invalid input.
+TEST(StudyRuns, FrictionCoefficientAxisAgainstTheSlidingBlocksClosedForm) {
+  const std::string head = "model: ../../robots/block_on_floor_friction.yaml\n";
+  const Study s = parse_study(head + "axes:\n  - mu.floor: [0.3, 0.4, -0.1]\n", kSource);
+  for (const int i : {0, 1}) {
+    const double mu = i == 0 ? 0.3 : 0.4;  // both stick before t_end = 1
+    const Row r = run_one(s, static_cast<std::size_t>(i));
+    ASSERT_EQ(cell(s, r, "status"), "completed") << cell(s, r, "message");
+    EXPECT_NEAR(std::stod(cell(s, r, "final_x")), 4.0 / (2.0 * mu * 9.81), 1e-12) << mu;
+  }
+  const Row bad = run_one(s, 2);
+  EXPECT_EQ(cell(s, bad, "status"), "invalid input");
+  EXPECT_NE(cell(s, bad, "message").find("mu"), std::string::npos) << cell(s, bad, "message");
+  try {
+    (void)parse("axes:\n  - mu.stop: [0.2]\n");
+    ADD_FAILURE() << "a constraint without friction was accepted";
+  } catch (const io::InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              kSource +
+                  ": axes[0].mu.stop: constraint 'stop' of model 'two_carts' has no friction (no "
+                  "mechanical.friction entry, no scene contact's friction:)");
+  }
+}
+
 TEST(StudyJournal, ResumeReadsWholeLinesAndRefusesAnotherStudy) {
   const std::string path = testing::TempDir() + "/study_journal_test.journal";
   std::filesystem::remove(path);

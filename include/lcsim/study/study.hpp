@@ -24,15 +24,28 @@ namespace lcsim::study {
 //   x0.<coord>       initial position of a coordinate (m or rad)
 //   v0.<coord>       initial velocity of a coordinate
 //   restitution.<constraint>
+//   mu.<constraint>  the friction coefficient of its mechanical.friction entry
 //   scale.<M|D|K>    the whole matrix times the value
 //   scale.<M|D|K>.<coord>.<coord>   one entry, and its mirror (symmetry kept)
 //   scale.<f>.<coord>, scale.g.<constraint>   one entry of f or g
 struct Quantity {
-  enum class Kind { kModel, kMethod, kImpact, kH, kTheta, kTEnd, kX0, kV0, kRestitution, kScale };
+  enum class Kind {
+    kModel,
+    kMethod,
+    kImpact,
+    kH,
+    kTheta,
+    kTEnd,
+    kX0,
+    kV0,
+    kRestitution,
+    kMu,
+    kScale
+  };
   Kind kind = Kind::kH;
   std::string key;     // as written ("x0.x1", "scale.K")
   std::string matrix;  // kScale: "M", "D", "K", "f" or "g"
-  int row = -1;        // kX0, kV0, kRestitution, kScale entries: 0-based index; -1 = whole
+  int row = -1;        // kX0, kV0, kRestitution, kMu, kScale entries: 0-based index; -1 = whole
   int col = -1;        // kScale of M, D, K entries
   bool text() const { return kind == Kind::kMethod || kind == Kind::kImpact; }
 };
