@@ -356,6 +356,9 @@ class EventDriven {
   // undetermined constraints held too where friction presses them shut.
   // "" or the failure message; undetermined gets the K the phase keeps.
   // held: the ending phase's mode (I ∪ K is tried first when it held them).
+  std::string select_friction_releasing(double t, const lcs::ModeSelection& sel, VectorXd& xa,
+                                        EventResult& out, lcs::IndexSet& undetermined);
+  bool spans_row(const lcs::IndexSet& mode, int j) const;
   std::string select_friction_and_normals(double t, const lcs::ModeSelection& sel,
                                           const lcs::IndexSet& held, VectorXd& xa, EventResult& out,
                                           lcs::IndexSet& undetermined);
@@ -366,10 +369,11 @@ class EventDriven {
   // The constraints of ph.mode whose normal force leaves zero downwards at
   // the phase start (friction_modes.cpp).
   lcs::IndexSet lifting_normals(const Phase& ph, const VectorXd& xa, double t) const;
-  // I ∪ K less one constraint of `lifting`, when that phase starts
-  // consistently (friction_modes.cpp): true and out set, else false.
+  // I ∪ K (then I) less one constraint of `lifting`, when that phase starts
+  // consistently (friction_modes.cpp): true and out, undetermined set, else
+  // false.
   bool release_normal(double t, const lcs::ModeSelection& sel, const lcs::IndexSet& lifting,
-                      VectorXd& xa, EventResult& out);
+                      VectorXd& xa, EventResult& out, lcs::IndexSet& undetermined);
   // True when every monitor of `ph` (normals and friction) starts positive or
   // leaves zero upwards.
   bool all_consistent(const Phase& ph, const VectorXd& xa, double t) const;

@@ -208,7 +208,7 @@ std::string EventDriven::select_friction_and_normals(double t, const lcs::ModeSe
                                                      const lcs::IndexSet& held, VectorXd& xa,
                                                      EventResult& out,
                                                      lcs::IndexSet& undetermined) {
-  if (sel.undetermined.empty()) return select_friction(t, sel.undetermined, xa, out);
+  if (sel.undetermined.empty()) return select_friction_releasing(t, sel, xa, out, undetermined);
   const auto in_held = [&](int r) { return std::find(held.begin(), held.end(), r) != held.end(); };
   // I ∪ K: taken when its friction modes are selected and every monitor of
   // its phase starts consistently.
@@ -260,12 +260,30 @@ std::string EventDriven::select_friction_and_normals(double t, const lcs::ModeSe
     }
   }
   if (try_union()) return "";
-  if (release_normal(t, sel, lifting, xa, out)) {
-    undetermined.clear();
-    return "";
-  }
+  if (release_normal(t, sel, lifting, xa, out, undetermined)) return "";
   xa = x1;
   return why;
+}
+
+// No undetermined constraint: the friction modes on the LDCP's mode; when a
+// slip's friction unloads a normal force that starts at zero, the phase
+// would end at once and the same selection follow again, so that constraint
+// is released (release_normal) when the phase without it starts
+// consistently.
+std::string EventDriven::select_friction_releasing(double t, const lcs::ModeSelection& sel,
+                                                   VectorXd& xa, EventResult& out,
+                                                   lcs::IndexSet& undetermined) {
+  if (std::string why = select_friction(t, sel.undetermined, xa, out); !why.empty()) return why;
+  if (std::none_of(out.friction.begin(), out.friction.end(), [](FrictionMode f) {
+        return f != FrictionMode::kOpen && f != FrictionMode::kStick;
+      }))
+    return "";
+  std::string err;
+  const Phase& ph = make_phase(out.mode, out.friction, sel.undetermined, xa, err);
+  if (!err.empty()) return "";
+  const lcs::IndexSet lifting = lifting_normals(ph, xa, t);
+  if (!lifting.empty()) (void)release_normal(t, sel, lifting, xa, out, undetermined);
+  return "";
 }
 
 // The constraints of ph.mode whose normal force starts at zero and leaves it
@@ -284,32 +302,56 @@ lcs::IndexSet EventDriven::lifting_normals(const Phase& ph, const VectorXd& xa, 
   return out;
 }
 
-// I ∪ K without one constraint of `lifting` (it opens; its gap is then
-// monitored): taken when its normal rows are independent, its friction modes
-// are selected and every monitor of its phase starts consistently. The
-// first such candidate in the order of `lifting`; false when none is.
+// I ∪ K without one constraint j of `lifting` (it leaves: its gap is
+// monitored); failing that, the same with j shut without force,
+// undetermined, when its row of E lies in the span of the others' (its gap
+// is then identically zero: the quadruped's hind foot unloaded while the
+// fourth, dependent foot takes the load). Taken when its normal rows are
+// independent, its friction modes are selected and every monitor of its
+// phase starts consistently: the first such candidate in the order of
+// `lifting`; false when none is. `undetermined` is the taken candidate's.
+// (I without j, K opened too, was tried and left out: it let the quadruped
+// of tests/scene/test_exact_box_friction.cpp rock onto a diagonal and meet
+// a Painlevé-type landing later.)
 bool EventDriven::release_normal(double t, const lcs::ModeSelection& sel,
-                                 const lcs::IndexSet& lifting, VectorXd& xa, EventResult& out) {
-  for (const int j : lifting) {
+                                 const lcs::IndexSet& lifting, VectorXd& xa, EventResult& out,
+                                 lcs::IndexSet& undetermined) {
+  const int n = static_cast<int>(lifting.size());
+  for (int c = 0; c < 2 * n; ++c) {
+    const int j = lifting[static_cast<size_t>(c % n)];
+    const bool keep_j = c >= n;  // j shut without force, undetermined
     EventResult cand = out;
     cand.mode.clear();
     for (const lcs::IndexSet* part : {&sel.mode, &sel.undetermined})
       for (const int r : *part)
         if (r != j) cand.mode.push_back(r);
     std::sort(cand.mode.begin(), cand.mode.end());
+    if (keep_j && !spans_row(cand.mode, j)) continue;
+    const lcs::IndexSet und = keep_j ? lcs::IndexSet{j} : lcs::IndexSet{};
     VectorXd x2 = xa;
-    const bool selected = select_friction(t, {}, x2, cand).empty();
+    const bool selected = select_friction(t, und, x2, cand).empty();
     out.lcp_solves = cand.lcp_solves;  // counted whether taken or not
     if (!selected) continue;
     std::string err;
-    const Phase& ph = make_phase(cand.mode, cand.friction, {}, x2, err);
+    const Phase& ph = make_phase(cand.mode, cand.friction, und, x2, err);
     if (!err.empty() || redundant_normals(ph) || !all_consistent(ph, x2, t)) continue;
     out.mode = cand.mode;
     out.friction = cand.friction;
+    undetermined = und;
     xa = x2;
     return true;
   }
   return false;
+}
+
+// Whether row j of E lies in the span of the rows `mode` (rank unchanged).
+bool EventDriven::spans_row(const lcs::IndexSet& mode, int j) const {
+  const Eigen::Index nI = static_cast<Eigen::Index>(mode.size());
+  MatrixXd EI(nI + 1, N_);
+  for (Eigen::Index i = 0; i < nI; ++i)
+    EI.row(i) = model_.mechanical->E.row(mode[static_cast<size_t>(i)]);
+  EI.row(nI) = model_.mechanical->E.row(j);
+  return Eigen::FullPivLU<MatrixXd>(EI).rank() == Eigen::FullPivLU<MatrixXd>(EI.topRows(nI)).rank();
 }
 
 bool EventDriven::presses_shut(const Phase& ph, const lcs::IndexSet& which, const VectorXd& xa,
