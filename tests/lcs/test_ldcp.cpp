@@ -233,3 +233,50 @@ TEST(Ldcp, StopsAtRepeatingLevelsWithTheSameMode) {
 
 }  // namespace
 }  // namespace lcsim::lcs
+
+namespace lcsim::lcs {
+namespace {
+
+// The two carts of eq. (3.1) in a time 2^k times faster, t' = t / 2^k:
+// (A, B) 2^k (A, B). The same motion, so the same mode selection: the mode,
+// the undetermined rows and x_plus of the original, and each impulse of
+// delta^(j) 2^(-k (j + 1)) times the original's (delta^(j)(t) =
+// 2^(k (j + 1)) delta^(j)(t')).
+Lcs fast_carts(int k) {
+  Lcs s;
+  s.A.resize(4, 4);
+  s.A << 0, 0, 1, 0, 0, 0, 0, 1, -2, 1, 0, 0, 1, -1, 0, 0;
+  s.B = MatrixXd::Zero(4, 1);
+  s.B(2, 0) = 1;
+  s.A *= std::ldexp(1.0, k);  // exact: a power of two
+  s.B *= std::ldexp(1.0, k);
+  s.C = MatrixXd::Zero(1, 4);
+  s.C(0, 0) = 1;
+  s.D = MatrixXd::Zero(1, 1);
+  return s;
+}
+
+// Issue 27 (the 80-link chain's overflow): at (0, 0, 0, 1) the LDCP decides
+// at level 2 on C A^3 x0 (y''' = 1 > 0: the unconstrained mode, as
+// TwoCartsReleaseSelectsUnconstrained). With k = 400, A^3 x0 = 2^1200 (1,
+// -1, 0, 0) is past the double range (~2^1024), computed with level 1's
+// free response, before the level that decides: level 2's coefficient is
+// inf with terms of size inf. The levels are solved again with time scaled
+// back by the growth of |A|^m, and select the original's mode exactly
+// (script M = C A B 2^(2k) = 2^800 stays finite, so the leading index is
+// found as for k = 0). k = 0 and k = 300 (2^900: no overflow) take the
+// direct path.
+TEST(Ldcp, LevelsPastTheDoubleRangeAreSolvedInScaledTime) {
+  for (const int k : {0, 300, 400}) {
+    SCOPED_TRACE("k = " + std::to_string(k));
+    const ModeSelection sel = select_mode(fast_carts(k), Vector4d(0, 0, 0, 1));
+    ASSERT_TRUE(sel.ok()) << sel.message;
+    EXPECT_TRUE(sel.mode.empty());
+    EXPECT_TRUE(sel.undetermined.empty());
+    EXPECT_EQ(sel.x_plus, Vector4d(0, 0, 0, 1));
+    for (const VectorXd& u : sel.impulse) EXPECT_EQ(u(0), 0.0);
+  }
+}
+
+}  // namespace
+}  // namespace lcsim::lcs
