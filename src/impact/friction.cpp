@@ -138,7 +138,8 @@ ClosedFriction closed_friction(const mech::MechanicalModel& m, const IndexSet& c
 // the impact, or sticking, its row held), judged by
 // detail::no_painleve_after_solve; the sign patterns this impact does not
 // take are not judged (before, every pattern was, up to 8 frictional
-// contacts, and none above). The message, or "" when there is none.
+// contacts, and none above). The message, or "" when there is none. Both
+// are sufficient conditions: painleve_decided then enumerates the modes.
 constexpr const char* kPainleveTail =
     "; the friction impact LCP may have no solution or several (not resolved)";
 

@@ -278,5 +278,41 @@ TEST(Ldcp, LevelsPastTheDoubleRangeAreSolvedInScaledTime) {
   }
 }
 
+// The impulses mapped back: from y = q1 = -1 (a state that is not
+// consistent) the two carts, and the hook of Example 3.8.3 (the same A, its
+// B and C scaled alike), jump with impulses (delta and delta'), and the
+// levels after the jump overflow at k = 400 (without the scaled retry these
+// selections fail). The same mode, undetermined rows and x_plus as at
+// k = 0, and impulse[j] = the original's impulse[j] 2^(-400 (j + 1)). 1e-12:
+// the scaled run's A is 2^-e' A (e' >= 1, the growth of |A|, not 1), so its
+// products round differently from the original's; both are a few ulps of
+// O(1) numbers (the file's tolerance).
+TEST(Ldcp, ImpulsesOfTheScaledLevelsAreMappedBack) {
+  for (const bool with_hook : {false, true}) {
+    SCOPED_TRACE(with_hook ? "hook" : "two carts");
+    const Lcs s0 = with_hook ? hook() : two_carts();
+    Lcs s = s0;
+    s.A *= std::ldexp(1.0, 400);
+    s.B *= std::ldexp(1.0, 400);
+    const Vector4d x0(-1, 0, 0, 0);
+    const ModeSelection a = select_mode(s0, x0), b = select_mode(s, x0);
+    ASSERT_TRUE(a.ok()) << a.message;
+    ASSERT_TRUE(b.ok()) << b.message;
+    EXPECT_EQ(a.mode, b.mode);
+    EXPECT_EQ(a.undetermined, b.undetermined);
+    EXPECT_LE((a.x_plus - b.x_plus).norm(), 1e-12);
+    ASSERT_EQ(a.impulse.size(), b.impulse.size());
+    bool impulsive = false;
+    for (size_t j = 0; j < a.impulse.size(); ++j) {
+      impulsive = impulsive || !a.impulse[j].isZero(0.0);
+      // The original's impulse in the fast time (zero where it is zero;
+      // 2^-1200 and below underflow to zero, as the library's mapping does).
+      const VectorXd fast = a.impulse[j] * std::ldexp(1.0, -400 * static_cast<int>(j + 1));
+      EXPECT_LE((b.impulse[j] - fast).norm(), 1e-12 * fast.norm()) << "j = " << j;
+    }
+    EXPECT_TRUE(impulsive);  // the mapping is exercised
+  }
+}
+
 }  // namespace
 }  // namespace lcsim::lcs
