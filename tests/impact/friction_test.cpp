@@ -159,6 +159,55 @@ TEST(FrictionImpact, PainleveCaseIsDiagnosedByName) {
   EXPECT_FALSE(ok.painleve);
 }
 
+// The modes' enumeration refuses what it cannot decide (issue 27). Two
+// copies of the skew contact (the same rows: W_g singular) at the velocity
+// with one motion alone: the enumeration meets the modes (stick, stick),
+// whose system has two equal pairs of rows, singular (the copies may share
+// the impulse in a continuum of ways), and names them. One skew contact and
+// 11 frictionless ones (4 x 2^11 = 8192 combinations, above 4096): not
+// enumerated, the sufficient condition's refusal ("not resolved").
+TEST(FrictionImpact, PainleveModesSingularOrAboveTheBoundAreRefusedByName) {
+  {
+    mech::MechanicalModel m = testing::make_model(Eigen::Matrix2d::Identity(),
+                                                  (Eigen::MatrixXd(2, 2) << 1, 0, 1, 0).finished());
+    m.restitution = vec({0, 0});
+    m.friction.push_back({0, vec({0.5, 1}), 2.5});
+    m.friction.push_back({1, vec({0.5, 1}), 2.5});
+    const ImpactInput in = testing::input(m, vec({-1, 3}), {0, 1}, m.restitution);
+    const ImpactResult r = make_impact_law("moreau")->apply(in, *lcp::make_solver("lemke"));
+    EXPECT_FALSE(r.ok());
+    EXPECT_TRUE(r.painleve);
+    EXPECT_NE(r.message.find("the system of the modes 0 ('c1') (stick) 1 ('c2') (stick) is "
+                             "singular"),
+              std::string::npos)
+        << r.message;
+  }
+  {
+    const int N = 13;
+    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(12, N);
+    E(0, 0) = 1.0;
+    for (int i = 1; i < 12; ++i) E(i, i + 1) = 1.0;
+    mech::MechanicalModel m = testing::make_model(Eigen::MatrixXd::Identity(N, N), E);
+    m.restitution = VectorXd::Zero(12);
+    VectorXd t = VectorXd::Zero(N);
+    t(0) = 0.5, t(1) = 1.0;
+    m.friction.push_back({0, t, 2.5});
+    VectorXd v = -VectorXd::Ones(N);
+    v(1) = 3.0;
+    IndexSet all;
+    for (int i = 0; i < 12; ++i) all.push_back(i);
+    const ImpactInput in = testing::input(m, v, all, m.restitution);
+    const ImpactResult r = make_impact_law("moreau")->apply(in, *lcp::make_solver("lemke"));
+    EXPECT_FALSE(r.ok());
+    EXPECT_TRUE(r.painleve);
+    EXPECT_NE(r.message.find("= -0.25"), std::string::npos) << r.message;
+    EXPECT_NE(r.message.find("above the enumeration's bound 4096: not enumerated"),
+              std::string::npos)
+        << r.message;
+    EXPECT_NE(r.message.find("(not resolved)"), std::string::npos) << r.message;
+  }
+}
+
 TEST(FrictionImpact, KanesParadoxIsReported) {
   // a = 0.5, e = 1, mu = 0.5, v- = (-1, -0.2): u_N- = -1, u_T- = -0.7.
   // Sticking: u_N+ = 1, u_T+ = 0.5 v1+ + v2+ = 0 gives v+ = (1, -0.5), the
