@@ -8,9 +8,10 @@ base 1 cm above the floor, spinning about z at 0.5 rad/s.
 
 writes OUT_DIR/chain.urdf and OUT_DIR/chain_scene.yaml (not shipped: at N =
 80 every contact lands at once, t = sqrt(2 * 0.01 / 9.81) = 0.045152 s, on
-80 contacts of rank 41, which the exact method cannot select a mode for yet;
-see docs/contacts.md). Run it with `lcsim analyze OUT_DIR/chain_scene.yaml`
-or `lcsim simulate --method moreau-jean ...`.
+80 contacts of rank 41, whose mode selection the exact method solves in
+scaled time, its levels' scale passing the double range; see
+docs/contacts.md). Run it with `lcsim analyze OUT_DIR/chain_scene.yaml`
+or `lcsim simulate --method event|moreau-jean ...`.
 """
 import os
 import sys

@@ -3,6 +3,8 @@
 
 #include <lcsim/impact/impact.hpp>
 #include <optional>
+#include <string>
+#include <vector>
 
 namespace lcsim::impact::detail {
 
@@ -81,6 +83,31 @@ void flag_friction_energy_gain(double surface_work, ImpactResult& out);
 bool no_painleve_after_solve(const MatrixXd& Wf, Eigen::Index nj,
                              const std::vector<Eigen::Index>& stick_rows,
                              const MatrixXd& slip_cols);
+// Issue 27 (painleve.cpp): when no_painleve_after_solve fails (a
+// sufficient condition), the impact is decided by enumerating the closed
+// contacts' modes of the planar Coulomb impact problem u = Wg lambda + b
+// (Wg over the nj closed normals, then the frictional rows; normal_of[f]
+// the normal of frictional row f; per frictional contact open, stick,
+// slip+, slip-, per frictionless one open or closed: 4 or 2 square systems
+// per contact, each solution kept when the mode's inequalities hold to 1e-9
+// of their terms). unique: exactly one motion (Wg lambda, equal to 1e-8 of
+// its terms), that of lambda_law (the LCP's solution in the same
+// coordinates), and every mode's system regular; else `message` says why
+// (two motions and the modes of both, a singular mode system, which may
+// hold a continuum, naming its modes, or more than kPainleveModeBound
+// combinations: not enumerated). labels: each normal's name in messages.
+constexpr long kPainleveModeBound = 4096;
+struct PainleveVerdict {
+  bool unique = false;
+  bool enumerated = false;  // false: above the bound, not decided
+  std::string message;
+};
+// Each closed normal's name in messages: "row ('name')".
+std::vector<std::string> closed_labels(const ImpactInput& in);
+PainleveVerdict decide_painleve_by_modes(const MatrixXd& Wg, const VectorXd& b, Eigen::Index nj,
+                                         const std::vector<int>& normal_of, const VectorXd& mu,
+                                         const VectorXd& lambda_law,
+                                         const std::vector<std::string>& labels);
 // The message of a friction impact whose LCP no solver solved (`tried`: the
 // solvers, in the order tried).
 std::string friction_lcp_failure(const std::string& tried, const lcp::Result& res);

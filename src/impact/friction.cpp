@@ -138,7 +138,8 @@ ClosedFriction closed_friction(const mech::MechanicalModel& m, const IndexSet& c
 // the impact, or sticking, its row held), judged by
 // detail::no_painleve_after_solve; the sign patterns this impact does not
 // take are not judged (before, every pattern was, up to 8 frictional
-// contacts, and none above). The message, or "" when there is none.
+// contacts, and none above). The message, or "" when there is none. Both
+// are sufficient conditions: painleve_decided then enumerates the modes.
 constexpr const char* kPainleveTail =
     "; the friction impact LCP may have no solution or several (not resolved)";
 
@@ -155,7 +156,7 @@ std::string painleve_alone(const mech::MechanicalModel& m, const IndexSet& close
     return text("Painlevé-type case at contact ", row, " ('", m.constraints[row],
                 "'): W_NN - mu |W_NT| = ", wnn, " - ", mu, " * ", std::abs(wnt), " = ", coef,
                 " <= 0, so sliding ", (wnt > 0 ? "along +t" : "along -t"),
-                " presses the contact shut", kPainleveTail);
+                " presses the contact shut");
   }
   return "";
 }
@@ -190,8 +191,27 @@ std::string painleve_solved(const ImpactInput& in, const ClosedFriction& c, cons
   return msg +
          ": with these modes of the impact LCP's solution the normal matrix W_NN - W_NT "
          "diag(sigma mu), the sticking rows eliminated, is not a P-matrix on contacts of "
-         "independent normal rows" +
-         kPainleveTail;
+         "independent normal rows";
+}
+
+// Issue 27: painleve_solved is a sufficient condition; when it fails, the
+// impact is decided by the contacts' modes (detail::decide_painleve_by_modes):
+// accepted ("") when they give one motion, the LCP's; else the refusal,
+// saying what the enumeration found (or that it was above its bound).
+// `alone`: painleve_alone's finding before the solve, judged the same way.
+std::string painleve_decided(const ImpactInput& in, const ClosedFriction& c, const MatrixXd& Wg,
+                             const std::string& alone, const VectorXd& rate_N,
+                             const VectorXd& lambda_N, const VectorXd& lambda_T,
+                             const VectorXd& v_after) {
+  std::string p = alone.empty() ? painleve_solved(in, c, Wg, v_after) : alone;
+  if (p.empty()) return p;
+  const Eigen::Index nj = lambda_N.size(), nf = lambda_T.size();
+  const VectorXd b = (VectorXd(nj + nf) << rate_N, c.T * in.v - c.velocity).finished();
+  const VectorXd lambda = (VectorXd(nj + nf) << lambda_N, lambda_T).finished();
+  const detail::PainleveVerdict d = detail::decide_painleve_by_modes(
+      Wg, b, nj, c.normal_of, c.mu, lambda, detail::closed_labels(in));
+  if (d.unique) return "";
+  return p + "; " + d.message + (d.enumerated ? "" : kPainleveTail);
 }
 
 void set_outcomes(const mech::MechanicalModel& m, const ImpactInput& in, const ClosedFriction& c,
@@ -258,12 +278,8 @@ ImpactResult moreau_friction(const ImpactInput& in, const lcp::Solver& solver) {
   s->L.triangularView<Eigen::Lower>().solveInPlace(MinvTt);
   s->L.transpose().triangularView<Eigen::Upper>().solveInPlace(MinvTt);
   const MatrixXd Wg = delassus(*s, c, MinvTt);
-  if (std::string p = painleve_alone(m, in.closed, c, s->W, Wg.topRightCorner(nj, nf));
-      !p.empty()) {
-    out.painleve = true;
-    out.message = p;
-    return out;
-  }
+  // A contact alone Painlevé-type is decided after the solve, as the modes.
+  const std::string alone = painleve_alone(m, in.closed, c, s->W, Wg.topRightCorner(nj, nf));
   // Newton's restitution on approaching contacts: u_N+ >= -e u_N- there; a
   // closed contact already separating (u_N- >= 0) only needs u_N+ >= 0.
   const VectorXd rate_N = s->a + s->e_J.cwiseProduct(s->a.cwiseMin(0.0));
@@ -272,7 +288,8 @@ ImpactResult moreau_friction(const ImpactInput& in, const lcp::Solver& solver) {
   const lcp::Result res = solve_friction_lcp(lcp, solver, &out.lcp_solves, &tried);
   out.lcp_status = res.status;
   if (!res.ok()) {
-    out.message = detail::friction_lcp_failure(tried, res);
+    out.painleve = !alone.empty();
+    out.message = out.painleve ? alone + kPainleveTail : detail::friction_lcp_failure(tried, res);
     return out;
   }
   const VectorXd* z = &res.z;
@@ -280,7 +297,8 @@ ImpactResult moreau_friction(const ImpactInput& in, const lcp::Solver& solver) {
   friction_impulses(*z, static_cast<int>(nj), c.normal_of, c.mu, lambda_N, lambda_T);
   const double tiny = detail::friction_mode_threshold(*s);
   const VectorXd v_after = in.v + s->MinvEt * lambda_N + MinvTt * lambda_T;
-  if (std::string p = painleve_solved(in, c, Wg, v_after); !p.empty()) {
+  if (std::string p = painleve_decided(in, c, Wg, alone, rate_N, lambda_N, lambda_T, v_after);
+      !p.empty()) {
     out.painleve = true;
     out.message = p;
     return out;

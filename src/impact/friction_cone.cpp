@@ -200,7 +200,7 @@ std::string cone_painleve_alone(const mech::MechanicalModel& m, const IndexSet& 
     return text("Painlevé-type case at contact ", row, " ('", m.constraints[row],
                 "'): W_NN - mu max_i |W_N D_i| = ", W(j, j), " - ", mu, " * ", w, " = ", coef,
                 " <= 0, so friction on the edge ", static_cast<int>(worst),
-                " or its opposite presses the contact shut", kPainleveTail);
+                " or its opposite presses the contact shut");
   }
   return "";
 }
@@ -268,8 +268,45 @@ std::string cone_painleve_solved(const mech::MechanicalModel& m, const ImpactInp
   return "Painlevé-type case at contacts" + which +
          ": with friction in the modes of the impact LCP's solution the normal matrix "
          "W_NN + W_ND diag(mu), the sticking rows eliminated, has a principal minor <= 0 on "
-         "contacts of independent normal rows" +
-         std::string(kPainleveTail);
+         "contacts of independent normal rows";
+}
+
+// Issue 27: cone_painleve_solved is a sufficient condition; when it fails
+// and every closed frictional contact has d = 1 (friction along t only, its
+// edges +t and -t), the impact is decided by the contacts' planar modes as
+// the planar law's (detail::decide_painleve_by_modes on the rows of +t),
+// so d = 1 keeps the planar law's diagnoses; with d >= 2 the modes (stick,
+// 2d edges, 2d faces per contact) are not enumerated and it is refused.
+// `alone`: cone_painleve_alone's finding before the solve (d = 1 only).
+std::string cone_painleve_decided(const mech::MechanicalModel& m, const ImpactInput& in,
+                                  const ClosedCone& c, const MatrixXd& Wb, const std::string& alone,
+                                  const VectorXd& rate_N, const VectorXd& rate_D, const VectorXd& z,
+                                  const VectorXd& v_after) {
+  std::string p = alone.empty() ? cone_painleve_solved(m, in, c, Wb, v_after) : alone;
+  if (p.empty()) return p;
+  if (std::any_of(c.d.begin(), c.d.end(), [](int d) { return d != 1; }))
+    return p +
+           "; the contacts' modes are enumerated for planar friction (d = 1) only: not "
+           "enumerated" +
+           kPainleveTail;
+  const Eigen::Index nj = rate_N.size(), nf = c.mu.size();
+  std::vector<Eigen::Index> idx;  // the normals, then each contact's +t row
+  for (Eigen::Index j = 0; j < nj; ++j) idx.push_back(j);
+  for (const int first : c.first) idx.push_back(nj + first);
+  const Eigen::Index n = nj + nf;
+  MatrixXd Wg(n, n);
+  VectorXd b(n), lambda(n);
+  for (Eigen::Index a = 0; a < n; ++a) {
+    const Eigen::Index ra = idx[static_cast<size_t>(a)];
+    for (Eigen::Index e = 0; e < n; ++e) Wg(a, e) = Wb(ra, idx[static_cast<size_t>(e)]);
+    b(a) = a < nj ? rate_N(a) : rate_D(ra - nj);
+    // lambda_T = beta_+t - beta_-t (cone_edge(1, 1) = (-1, 0)).
+    lambda(a) = a < nj ? z(a) : z(ra) - z(ra + 1);
+  }
+  const detail::PainleveVerdict d = detail::decide_painleve_by_modes(
+      Wg, b, nj, c.normal_of, c.mu, lambda, detail::closed_labels(in));
+  if (d.unique) return "";
+  return p + "; " + d.message + (d.enumerated ? "" : kPainleveTail);
 }
 
 // Impulses, outcomes and facets per constraint; planar contacts as
@@ -337,10 +374,13 @@ ImpactResult moreau_friction_cone(const ImpactInput& in, const lcp::Solver& solv
   Wb.topRightCorner(nj, ne) = s->EJ * MinvDt;
   Wb.bottomLeftCorner(ne, nj) = Wb.topRightCorner(nj, ne).transpose();
   Wb.bottomRightCorner(ne, ne) = c.D * MinvDt;
-  if (std::string p = cone_painleve_alone(m, in.closed, c, s->W, Wb.topRightCorner(nj, ne));
-      !p.empty()) {
+  // A contact alone Painlevé-type: refused here with d >= 2; with d = 1
+  // everywhere decided after the solve by the modes, as the planar law.
+  const std::string alone = cone_painleve_alone(m, in.closed, c, s->W, Wb.topRightCorner(nj, ne));
+  const bool planar = std::all_of(c.d.begin(), c.d.end(), [](int d) { return d == 1; });
+  if (!alone.empty() && !planar) {
     out.painleve = true;
-    out.message = p;
+    out.message = alone + kPainleveTail;
     return out;
   }
   const VectorXd rate_N = s->a + s->e_J.cwiseProduct(s->a.cwiseMin(0.0));
@@ -349,13 +389,16 @@ ImpactResult moreau_friction_cone(const ImpactInput& in, const lcp::Solver& solv
   const lcp::Result res = solve_friction_cone_lcp(lcp, solver, &out.lcp_solves, &tried);
   out.lcp_status = res.status;
   if (!res.ok()) {
-    out.message = detail::friction_lcp_failure(tried, res);
+    out.painleve = !alone.empty();
+    out.message = out.painleve ? alone + kPainleveTail : detail::friction_lcp_failure(tried, res);
     return out;
   }
   const VectorXd lambda_N = res.z.head(nj), beta = res.z.segment(nj, ne);
   const double tiny = detail::friction_mode_threshold(*s);
   const VectorXd v_after = in.v + s->MinvEt * lambda_N + MinvDt * beta;
-  if (std::string p = cone_painleve_solved(m, in, c, Wb, v_after); !p.empty()) {
+  if (std::string p =
+          cone_painleve_decided(m, in, c, Wb, alone, rate_N, lcp.q.segment(nj, ne), res.z, v_after);
+      !p.empty()) {
     out.painleve = true;
     out.message = p;
     return out;

@@ -51,6 +51,11 @@ VectorXd sub(const VectorXd& v, const std::vector<int>& r) {
   return s;
 }
 
+// X 2^e entry by entry (exact, barring overflow and underflow).
+MatrixXd ldexp_matrix(const MatrixXd& X, int e) {
+  return X.unaryExpr([e](double x) { return std::ldexp(x, e); });
+}
+
 // Free response coefficients C A^m x0 and their term scales |C| |A|^m |x0|,
 // computed on demand (a selection rarely needs more than a few orders).
 class FreeResponse {
@@ -424,6 +429,23 @@ bool later_levels_repeat(Ldcp& s, const Level& l, const VectorXd& up,
   return true;
 }
 
+// The levels' terms grow as |C| |A|^m |x0| (an 80-link chain lying on the
+// floor: ~200-fold per level, past 1e308 at level 133 of 171); a level whose
+// coefficients or scale are not finite (inf, or NaN from inf - inf or 0 *
+// inf) decides nothing. select_mode then solves the LDCP again with time
+// scaled (select_mode_time_scaled). The message starts with
+// kLevelsOverflow, which select_mode recognises.
+constexpr const char* kLevelsOverflow = "the LDCP's levels overflow";
+
+std::string levels_overflow(const Level& l) {
+  Eigen::Index r = 0;
+  for (; r < l.xi.size(); ++r)
+    if (!std::isfinite(l.xi(r)) || !std::isfinite(l.scale(r))) break;
+  return text(kLevelsOverflow, ": at level ", l.p, " constraint ", static_cast<int>(r),
+              "'s coefficient is ", l.xi(r), " with terms of size ", l.scale(r),
+              " (|C| |A|^m |x0| and the Markov parameters' terms past the double range)");
+}
+
 // Levels -n+1 .. n, as in the proof of Theorem 3.6.7, until the mode is
 // fixed. "" or why the LDCP has no (autonomous) solution.
 std::string solve_levels(Ldcp& s, int& lcp_solves) {
@@ -431,6 +453,7 @@ std::string solve_levels(Ldcp& s, int& lcp_solves) {
   for (int p = s.first; p <= s.sys.n(); ++p) {
     if (p > s.first && !s.u.back().isZero(0.0)) s.nonzero_levels.push_back(p - 1);
     Level l = level_coefficients(s, p);
+    if (!l.xi.allFinite() || !l.scale.allFinite()) return levels_overflow(l);
     l.I = rows_in(s.state, RowState::kActive);
     l.K = rows_in(s.state, RowState::kUndecided);
     VectorXd& up = s.u.emplace_back(VectorXd::Zero(s.sys.k()));  // u^p, 0 until solved
@@ -502,8 +525,10 @@ std::vector<int> undetermined_rows(const Ldcp& s) {
   return out;
 }
 
+namespace {
+
 // The driver: refusals, then the levels, then the mode and the jump.
-ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions& opt) {
+ModeSelection select_mode_once(const Lcs& sys, const VectorXd& x0, const LdcpOptions& opt) {
   ModeSelection out;
   const int n = sys.n();
   if (x0.size() != n) {
@@ -538,6 +563,66 @@ ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions&
   out.x_plus = x0 + impulsive_jump(s, out.impulse);
   out.status = Status::kOk;
   return out;
+}
+
+// log2 of the growth per order of |A|^m: the geometric mean over 2n + 1
+// orders (the most the levels read, rho_r + n <= 2n) of the factors by
+// which |A| multiplies a vector of ones, renormalised each time, so that
+// |A|^(2n+1) 1 <= 2^((2n+1) g) for the g returned (Perron–Frobenius: it is
+// at least the spectral radius of |A|). -inf when |A| is nilpotent.
+double log2_growth(const MatrixXd& A) {
+  const MatrixXd Aabs = A.cwiseAbs();
+  VectorXd v = VectorXd::Ones(A.rows());
+  const int orders = 2 * static_cast<int>(A.rows()) + 1;
+  double sum = 0.0;
+  for (int i = 0; i < orders; ++i) {
+    v = Aabs * v;
+    const double r = v.maxCoeff();
+    if (!(r > 0.0)) return -std::numeric_limits<double>::infinity();
+    sum += std::log2(r);
+    v /= r;
+  }
+  return sum / orders;
+}
+
+// Issue 27 (the 80-link chain): the LDCP in time tau = 2^e t, its system
+// (A, B) 2^-e (A, B) with 2^e the growth per order of |A|^m rounded up to a
+// power of two (log2_growth), so |A'|^m |x0| no longer grows with m. The
+// levels' signs and relative zero tests are those of the unscaled problem
+// (level p's coefficients of row r are multiplied by 2^(-e (rho_r + p)),
+// exactly, without rounding); tol_abs (an absolute tolerance) is taken in
+// the scaled units. The mode, the undetermined rows and the state after the
+// jump (x0 + B times the total impulse) are the system's; the impulse of
+// delta^(j) is 2^(-e (j + 1)) times the scaled one's (delta^(j)(t) =
+// 2^(e (j + 1)) delta^(j)(tau)), mapped back. Only ever run when the
+// unscaled levels overflowed (`first`), so every model whose levels stay
+// finite keeps its numbers byte for byte.
+ModeSelection select_mode_time_scaled(const Lcs& sys, const VectorXd& x0, const LdcpOptions& opt,
+                                      const ModeSelection& first) {
+  const double g = log2_growth(sys.A);
+  if (!std::isfinite(g) || g <= 0.0) return first;  // no growth to take out
+  const int e = static_cast<int>(std::ceil(g));
+  const Lcs scaled{ldexp_matrix(sys.A, -e), ldexp_matrix(sys.B, -e), sys.C, sys.D};
+  LdcpOptions o = opt;
+  o.data = nullptr;  // the scaled system's own Markov parameters
+  ModeSelection out = select_mode_once(scaled, x0, o);
+  out.lcp_solves += first.lcp_solves;
+  if (!out.ok()) {
+    out.message = text(first.message, "; solved again with time scaled by 2^", e,
+                       " (the growth per order of |A|^m): ", out.message);
+    return out;
+  }
+  for (size_t j = 0; j < out.impulse.size(); ++j)
+    out.impulse[j] = ldexp_matrix(out.impulse[j], -e * static_cast<int>(j + 1));
+  return out;
+}
+
+}  // namespace
+
+ModeSelection select_mode(const Lcs& sys, const VectorXd& x0, const LdcpOptions& opt) {
+  ModeSelection out = select_mode_once(sys, x0, opt);
+  if (out.ok() || out.message.rfind(kLevelsOverflow, 0) != 0) return out;
+  return select_mode_time_scaled(sys, x0, opt, out);
 }
 
 }  // namespace lcsim::lcs

@@ -122,19 +122,90 @@ mech::MechanicalModel skew(double a, double mu, double e) {
   return m;
 }
 
+// W_NN - mu |W_NT| = 1 - 2.5 * 0.5 = -0.25 < 0: sliding along +t presses
+// the contact shut. Whether that leaves several motions depends on the
+// velocity (issue 27: decided by the contact's modes, open, stick, slip+,
+// slip-; W = [1 0.5; 0.5 1.25], a = (v1, 0.5 v1 + v2)).
 TEST(FrictionImpact, PainleveCaseIsDiagnosedByName) {
-  // W_NN - mu |W_NT| = 1 - 2.5 * 0.5 = -0.25 < 0.
+  // v- = (0.1, 3), separating (a_N = 0.1), a_T = 3.05: three motions.
+  // Open: u_N = 0.1 >= 0. Slip+: u_N = 0.1 - 0.25 lambda_N = 0, lambda_N =
+  // 0.4, lambda_T = -1, u_T = 3.05 + (0.5 - 3.125) 0.4 = 2 > 0. Stick:
+  // W lambda = -a, lambda = (1.4, -3), |lambda_T| = 3 <= 2.5 * 1.4.
+  // (Slip-: u_N = 0.1 + 2.25 lambda_N = 0 needs lambda_N < 0.)
   const auto m = skew(0.5, 2.5, 0.0);
-  const ImpactResult r = hit(m, vec({-1, 3}));
+  const ImpactResult r = hit(m, vec({0.1, 3}));
   EXPECT_FALSE(r.ok());
   EXPECT_TRUE(r.painleve);
   EXPECT_NE(r.message.find("Painlevé-type case at contact 0 ('c1')"), std::string::npos)
       << r.message;
   EXPECT_NE(r.message.find("= -0.25"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("the impact has 3 motions"), std::string::npos) << r.message;
+  // v- = (-1, 3), approaching: one motion (this case was refused before
+  // issue 27's enumeration). Open: u_N = -1 < 0; slip+: u_N = -1 - 0.25
+  // lambda_N = 0 needs lambda_N < 0; slip-: lambda_N = 1/2.25, u_T = 2.5 +
+  // (0.5 + 3.125) / 2.25 > 0, not sliding along -t; stick: W lambda =
+  // (1, -2.5), lambda = (2.5, -3), |lambda_T| = 3 <= 6.25. So it sticks
+  // with v+ = v- + n 2.5 + t (-3) = (0, 0).
+  const ImpactResult one = hit(m, vec({-1, 3}));
+  ASSERT_TRUE(one.ok()) << one.message;
+  EXPECT_FALSE(one.painleve);
+  EXPECT_EQ(one.outcome[0], ContactOutcome::kStick);
+  EXPECT_NEAR(one.v_after.cwiseAbs().maxCoeff(), 0.0, kTol);
+  EXPECT_NEAR(one.impulse(0), 2.5, kTol);
+  EXPECT_NEAR(one.friction_impulse(0), -3.0, kTol);
   // mu = 1.9: coefficient 0.05 > 0, solved.
   const ImpactResult ok = hit(skew(0.5, 1.9, 0.0), vec({-1, 3}));
   EXPECT_TRUE(ok.ok()) << ok.message;
   EXPECT_FALSE(ok.painleve);
+}
+
+// The modes' enumeration refuses what it cannot decide (issue 27). Two
+// copies of the skew contact (the same rows: W_g singular) at the velocity
+// with one motion alone: the enumeration meets the modes (stick, stick),
+// whose system has two equal pairs of rows, singular (the copies may share
+// the impulse in a continuum of ways), and names them. One skew contact and
+// 11 frictionless ones (4 x 2^11 = 8192 combinations, above 4096): not
+// enumerated, the sufficient condition's refusal ("not resolved").
+TEST(FrictionImpact, PainleveModesSingularOrAboveTheBoundAreRefusedByName) {
+  {
+    mech::MechanicalModel m = testing::make_model(Eigen::Matrix2d::Identity(),
+                                                  (Eigen::MatrixXd(2, 2) << 1, 0, 1, 0).finished());
+    m.restitution = vec({0, 0});
+    m.friction.push_back({0, vec({0.5, 1}), 2.5});
+    m.friction.push_back({1, vec({0.5, 1}), 2.5});
+    const ImpactInput in = testing::input(m, vec({-1, 3}), {0, 1}, m.restitution);
+    const ImpactResult r = make_impact_law("moreau")->apply(in, *lcp::make_solver("lemke"));
+    EXPECT_FALSE(r.ok());
+    EXPECT_TRUE(r.painleve);
+    EXPECT_NE(r.message.find("the system of the modes 0 ('c1') (stick) 1 ('c2') (stick) is "
+                             "singular"),
+              std::string::npos)
+        << r.message;
+  }
+  {
+    const int N = 13;
+    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(12, N);
+    E(0, 0) = 1.0;
+    for (int i = 1; i < 12; ++i) E(i, i + 1) = 1.0;
+    mech::MechanicalModel m = testing::make_model(Eigen::MatrixXd::Identity(N, N), E);
+    m.restitution = VectorXd::Zero(12);
+    VectorXd t = VectorXd::Zero(N);
+    t(0) = 0.5, t(1) = 1.0;
+    m.friction.push_back({0, t, 2.5});
+    VectorXd v = -VectorXd::Ones(N);
+    v(1) = 3.0;
+    IndexSet all;
+    for (int i = 0; i < 12; ++i) all.push_back(i);
+    const ImpactInput in = testing::input(m, v, all, m.restitution);
+    const ImpactResult r = make_impact_law("moreau")->apply(in, *lcp::make_solver("lemke"));
+    EXPECT_FALSE(r.ok());
+    EXPECT_TRUE(r.painleve);
+    EXPECT_NE(r.message.find("= -0.25"), std::string::npos) << r.message;
+    EXPECT_NE(r.message.find("above the enumeration's bound 4096: not enumerated"),
+              std::string::npos)
+        << r.message;
+    EXPECT_NE(r.message.find("(not resolved)"), std::string::npos) << r.message;
+  }
 }
 
 TEST(FrictionImpact, KanesParadoxIsReported) {

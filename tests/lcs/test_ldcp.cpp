@@ -233,3 +233,86 @@ TEST(Ldcp, StopsAtRepeatingLevelsWithTheSameMode) {
 
 }  // namespace
 }  // namespace lcsim::lcs
+
+namespace lcsim::lcs {
+namespace {
+
+// The two carts of eq. (3.1) in a time 2^k times faster, t' = t / 2^k:
+// (A, B) 2^k (A, B). The same motion, so the same mode selection: the mode,
+// the undetermined rows and x_plus of the original, and each impulse of
+// delta^(j) 2^(-k (j + 1)) times the original's (delta^(j)(t) =
+// 2^(k (j + 1)) delta^(j)(t')).
+Lcs fast_carts(int k) {
+  Lcs s;
+  s.A.resize(4, 4);
+  s.A << 0, 0, 1, 0, 0, 0, 0, 1, -2, 1, 0, 0, 1, -1, 0, 0;
+  s.B = MatrixXd::Zero(4, 1);
+  s.B(2, 0) = 1;
+  s.A *= std::ldexp(1.0, k);  // exact: a power of two
+  s.B *= std::ldexp(1.0, k);
+  s.C = MatrixXd::Zero(1, 4);
+  s.C(0, 0) = 1;
+  s.D = MatrixXd::Zero(1, 1);
+  return s;
+}
+
+// Issue 27 (the 80-link chain's overflow): at (0, 0, 0, 1) the LDCP decides
+// at level 2 on C A^3 x0 (y''' = 1 > 0: the unconstrained mode, as
+// TwoCartsReleaseSelectsUnconstrained). With k = 400, A^3 x0 = 2^1200 (1,
+// -1, 0, 0) is past the double range (~2^1024), computed with level 1's
+// free response, before the level that decides: level 2's coefficient is
+// inf with terms of size inf. The levels are solved again with time scaled
+// back by the growth of |A|^m, and select the original's mode exactly
+// (script M = C A B 2^(2k) = 2^800 stays finite, so the leading index is
+// found as for k = 0). k = 0 and k = 300 (2^900: no overflow) take the
+// direct path.
+TEST(Ldcp, LevelsPastTheDoubleRangeAreSolvedInScaledTime) {
+  for (const int k : {0, 300, 400}) {
+    SCOPED_TRACE("k = " + std::to_string(k));
+    const ModeSelection sel = select_mode(fast_carts(k), Vector4d(0, 0, 0, 1));
+    ASSERT_TRUE(sel.ok()) << sel.message;
+    EXPECT_TRUE(sel.mode.empty());
+    EXPECT_TRUE(sel.undetermined.empty());
+    EXPECT_EQ(sel.x_plus, Vector4d(0, 0, 0, 1));
+    for (const VectorXd& u : sel.impulse) EXPECT_EQ(u(0), 0.0);
+  }
+}
+
+// The impulses mapped back: from y = q1 = -1 (a state that is not
+// consistent) the two carts, and the hook of Example 3.8.3 (the same A, its
+// B and C scaled alike), jump with impulses (delta and delta'), and the
+// levels after the jump overflow at k = 400 (without the scaled retry these
+// selections fail). The same mode, undetermined rows and x_plus as at
+// k = 0, and impulse[j] = the original's impulse[j] 2^(-400 (j + 1)). 1e-12:
+// the scaled run's A is 2^-e' A (e' >= 1, the growth of |A|, not 1), so its
+// products round differently from the original's; both are a few ulps of
+// O(1) numbers (the file's tolerance).
+TEST(Ldcp, ImpulsesOfTheScaledLevelsAreMappedBack) {
+  for (const bool with_hook : {false, true}) {
+    SCOPED_TRACE(with_hook ? "hook" : "two carts");
+    const Lcs s0 = with_hook ? hook() : two_carts();
+    Lcs s = s0;
+    s.A *= std::ldexp(1.0, 400);
+    s.B *= std::ldexp(1.0, 400);
+    const Vector4d x0(-1, 0, 0, 0);
+    const ModeSelection a = select_mode(s0, x0), b = select_mode(s, x0);
+    ASSERT_TRUE(a.ok()) << a.message;
+    ASSERT_TRUE(b.ok()) << b.message;
+    EXPECT_EQ(a.mode, b.mode);
+    EXPECT_EQ(a.undetermined, b.undetermined);
+    EXPECT_LE((a.x_plus - b.x_plus).norm(), 1e-12);
+    ASSERT_EQ(a.impulse.size(), b.impulse.size());
+    bool impulsive = false;
+    for (size_t j = 0; j < a.impulse.size(); ++j) {
+      impulsive = impulsive || !a.impulse[j].isZero(0.0);
+      // The original's impulse in the fast time (zero where it is zero;
+      // 2^-1200 and below underflow to zero, as the library's mapping does).
+      const VectorXd fast = a.impulse[j] * std::ldexp(1.0, -400 * static_cast<int>(j + 1));
+      EXPECT_LE((b.impulse[j] - fast).norm(), 1e-12 * fast.norm()) << "j = " << j;
+    }
+    EXPECT_TRUE(impulsive);  // the mapping is exercised
+  }
+}
+
+}  // namespace
+}  // namespace lcsim::lcs
