@@ -103,6 +103,10 @@ struct Ldcp {
   std::vector<RowState> state;
   std::vector<VectorXd> u;          // u^p for p = first..current, index p - first
   std::vector<int> nonzero_levels;  // the j with u^j != 0 (most levels are zero)
+  // mark_dependent's last active set and the undecided rows it found
+  // independent of it (the test is a function of the set and the row only:
+  // not made again while the set is the same).
+  std::vector<int> dep_active, dep_independent;
 };
 
 // Level p: the known part xi_p of the new coefficients y^{rho_r + p} (3.42),
@@ -376,8 +380,18 @@ void classify_undecided(Ldcp& s, const Level& l, VectorXd& up) {
 // and far below any independent row.
 void mark_dependent(Ldcp& s) {
   const std::vector<int> I = rows_in(s.state, RowState::kActive);
-  const std::vector<int> K = rows_in(s.state, RowState::kUndecided);
+  std::vector<int> K = rows_in(s.state, RowState::kUndecided);
   if (I.empty() || K.empty()) return;
+  if (I == s.dep_active) {
+    std::erase_if(K, [&](int r) {
+      return std::find(s.dep_independent.begin(), s.dep_independent.end(), r) !=
+             s.dep_independent.end();
+    });
+    if (K.empty()) return;
+  } else {
+    s.dep_active = I;
+    s.dep_independent.clear();
+  }
   const int n = s.sys.n(), k = s.sys.k();
   MatrixXd rows(n + k, static_cast<Eigen::Index>(I.size()));
   for (size_t i = 0; i < I.size(); ++i)
@@ -392,6 +406,8 @@ void mark_dependent(Ldcp& s) {
     if (!(size > 0.0)) continue;
     if ((rows * cod.solve(row) - row).norm() <= kDependence * size)
       s.state[static_cast<size_t>(r)] = RowState::kDependent;
+    else
+      s.dep_independent.push_back(r);
   }
 }
 
@@ -450,8 +466,18 @@ std::string levels_overflow(const Level& l) {
 // fixed. "" or why the LDCP has no (autonomous) solution.
 std::string solve_levels(Ldcp& s, int& lcp_solves) {
   const int start_lcp = s.opt.regular_only ? 1 : s.first;
+  // A free level whose rows all read orders rho_r + p < 1 with no nonzero
+  // level before it has xi = 0 and scale = 0: free_level decides nothing
+  // there (0 is within +-tol_abs), so only its u^p = 0 is kept.
+  int rho_max = std::numeric_limits<int>::min();
+  for (int r = 0; r < s.sys.k(); ++r) rho_max = std::max(rho_max, s.data.rho[r]);
+  const bool quiet_free = s.opt.tol_abs >= 0.0 && std::isfinite(s.opt.tol_rel);
   for (int p = s.first; p <= s.sys.n(); ++p) {
     if (p > s.first && !s.u.back().isZero(0.0)) s.nonzero_levels.push_back(p - 1);
+    if (p < start_lcp && quiet_free && s.nonzero_levels.empty() && rho_max + p < 1) {
+      s.u.emplace_back(VectorXd::Zero(s.sys.k()));
+      continue;
+    }
     Level l = level_coefficients(s, p);
     if (!l.xi.allFinite() || !l.scale.allFinite()) return levels_overflow(l);
     l.I = rows_in(s.state, RowState::kActive);
@@ -548,7 +574,7 @@ ModeSelection select_mode_once(const Lcs& sys, const VectorXd& x0, const LdcpOpt
   if (!out.message.empty()) return out;
   std::unique_ptr<lcp::Solver> own_solver;
   const lcp::Solver& solver = opt.solver ? *opt.solver : *(own_solver = lcp::make_solver("pivot"));
-  Ldcp s{sys, data, opt, solver, -n + 1, FreeResponse(sys, x0), {}, {}, {}};
+  Ldcp s{sys, data, opt, solver, -n + 1, FreeResponse(sys, x0), {}, {}, {}, {}, {}};
   s.state.assign(sys.k(), RowState::kUndecided);
   out.message = solve_levels(s, out.lcp_solves);
   if (!out.message.empty()) {

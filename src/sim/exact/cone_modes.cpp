@@ -134,12 +134,6 @@ std::string EventDriven::select_cone_friction(double t, const lcs::IndexSet& und
   }
   if (total == 1.0) return "";  // every contact's mode follows from its velocity
   if (!rows.empty()) project_rows(out.mode, rows, target, xa);
-  const mech::MechanicalModel& m = *model_.mechanical;
-  std::string names;
-  for (size_t f = 0; f < cand.size(); ++f)
-    if (cand[f].size() > 1)
-      names += text(names.empty() ? "'" : ", '",
-                    m.constraints[static_cast<size_t>(m.friction[f].contact)], "'");
   const size_t tries =
       total > static_cast<double>(kMaxCombinations) ? kMaxCombinations : static_cast<size_t>(total);
   std::string painleve;
@@ -162,6 +156,13 @@ std::string EventDriven::select_cone_friction(double t, const lcs::IndexSet& und
     }
   }
   if (!painleve.empty()) return painleve;
+  // The contacts with a choice, named only when none is consistent.
+  const mech::MechanicalModel& m = *model_.mechanical;
+  std::string names;
+  for (size_t f = 0; f < cand.size(); ++f)
+    if (cand[f].size() > 1)
+      names += text(names.empty() ? "'" : ", '",
+                    m.constraints[static_cast<size_t>(m.friction[f].contact)], "'");
   if (tries < total)
     return text("stick / slip selection at t = ", t, ": none of the first ", tries, " of ", total,
                 " combinations of stick and slip on the cone's edges and faces of the contacts ",

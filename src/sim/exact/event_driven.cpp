@@ -206,7 +206,7 @@ bool EventDriven::next_phase(RunState& r, LivelockGuard& livelock) {
   const Phase& phase = r.phase;
   PhaseMarch pm(phase, r.t, r.xa, opt_.dt_out,
                 [this, &phase]() -> StepExp& { return step_exp(phase, opt_.dt_out); });
-  pm.start = monitor_start(phase, pm.xstart, r.t, h_max);
+  pm.start = march_start(phase, r.xa, pm.xstart, r.t, h_max);
   if (sens_) sens_->check_phase_start(phase, r.t, pm.start.m0, ldcp_undetermined_);
   const double h_first = std::max(pm.start.h_first, 1e-15 * std::max(1.0, std::abs(r.t)));
   arm_monitors(pm);

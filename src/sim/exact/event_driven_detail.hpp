@@ -662,6 +662,10 @@ class EventDriven {
   // the checks of one chosen phase (consistent, lifting_normals) start its
   // monitors once. Valid until the next make_phase.
   const MonitorStart& selection_start(const Phase& ph, const VectorXd& xa, double t) const;
+  // monitor_start(ph, xstart = xa ./ ph.D, t, h_max) for the phase a run
+  // marches, the selection's start reused when it is the same (phase.cpp).
+  MonitorStart march_start(const Phase& ph, const VectorXd& xa, const VectorXd& xstart, double t,
+                           double h_max) const;
   mutable MonitorStart scratch_start_;
   std::map<std::pair<lcs::IndexSet, std::vector<FrictionMode>>, StepExp> step_cache_;
   // The cache entry for `phase`'s samples on a grid of step dt, reset when

@@ -69,12 +69,28 @@ void EventDriven::first_derivatives(const Phase& phase, const std::vector<Monito
   size_t remaining = nm;
   VectorXd Amx = xstart;
   VectorXd Amx_abs = xstart.cwiseAbs();
+  VectorXd next(Amx.size());  // the products' destination, swapped in (no allocation per order)
   MatrixXd Acl_abs;
+  bool finite = true;
   for (int m = 0; m <= n_ && remaining > 0; ++m) {
     if (m > 0) {
-      if (m == 1) Acl_abs = phase.Ab.cwiseAbs();
-      Amx = phase.times(Amx);
-      Amx_abs = Acl_abs * Amx_abs;
+      if (m == 1) {
+        Acl_abs = phase.Ab.cwiseAbs();
+        finite = phase.Ab.allFinite();
+      }
+      // Once A^m x and |A|^m |x| are exactly zero (a free flight's or a
+      // slide's state after its constant acceleration: m = 3), every later
+      // derivative and its zero test are too (finite A): no monitor can
+      // find its m0 or its next term there, so the orders up to n are not
+      // formed. The result is the same, bit for bit.
+      if (finite && ldcp_.tol_abs >= 0.0 && Amx.isZero(0.0) && Amx_abs.isZero(0.0)) break;
+      if (phase.use_sparse)
+        next.noalias() = phase.Ab_sparse * Amx;
+      else
+        next.noalias() = phase.Ab * Amx;
+      Amx.swap(next);
+      next.noalias() = Acl_abs * Amx_abs;
+      Amx_abs.swap(next);
     }
     for (size_t j = 0; j < nm; ++j) {
       if (done[j]) continue;

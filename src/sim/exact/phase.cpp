@@ -139,6 +139,26 @@ const EventDriven::MonitorStart& EventDriven::selection_start(const Phase& ph, c
   return *m->start;
 }
 
+// The selection's start (with the memo) serves the march when `ph` is the
+// memo's phase: built from the same mode, friction modes, undetermined set
+// (the run's phases are made with ldcp_undetermined_) and state, bit for
+// bit, started at the same t. Its h_first is min(1, T), T the monitors'
+// shortest time scale; for h_max <= 1, min(h_max, min(1, T)) is
+// min(h_max, T), the march's own, exactly.
+EventDriven::MonitorStart EventDriven::march_start(const Phase& ph, const VectorXd& xa,
+                                                   const VectorXd& xstart, double t,
+                                                   double h_max) const {
+  const PhaseMemo* m = phase_memo_ ? &*phase_memo_ : nullptr;
+  if (h_max <= 1.0 && m && m->start && m->start_t == t && m->mode == ph.mode &&
+      m->friction == ph.friction && m->undetermined == ldcp_undetermined_ &&
+      m->xa.size() == xa.size() && (m->xa.array() == xa.array()).all()) {
+    MonitorStart st = *m->start;
+    st.h_first = std::min(h_max, st.h_first);
+    return st;
+  }
+  return monitor_start(ph, xstart, t, h_max);
+}
+
 Phase EventDriven::build_phase(const lcs::IndexSet& mode, const std::vector<FrictionMode>& friction,
                                const lcs::IndexSet& undetermined, const VectorXd& xa,
                                std::string& err) const {
