@@ -43,9 +43,11 @@ TEST(FrictionCli, LawsAndMethodsWithoutFrictionAreInputErrors) {
   const CliRun r = lcsim("impacts '" + kRobots + "spinning_disk_friction.yaml' --rules flip");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("impact law 'flip' does not handle friction"), std::string::npos) << r.err;
-  const CliRun s = lcsim("simulate '" + kRobots + "block_on_floor_friction.yaml' --method euler");
+  // 'euler' simulates friction (tests/sim/test_euler_friction.cpp); Bullet's
+  // integrator does not.
+  const CliRun s = lcsim("simulate '" + kRobots + "block_on_floor_friction.yaml' --method bullet");
   EXPECT_EQ(s.exit_code, 2);
-  EXPECT_NE(s.err.find("method 'euler' does not support friction"), std::string::npos) << s.err;
+  EXPECT_NE(s.err.find("method 'bullet' does not support friction"), std::string::npos) << s.err;
 }
 
 TEST(FrictionCli, SimulateRecordsTheFrictionForce) {
