@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <lcsim/io/io.hpp>
 #include <lcsim/mech/cone_slide.hpp>
 #include <lcsim/mech/mech.hpp>
 #include <lcsim/sim/sim.hpp>
@@ -394,6 +395,57 @@ TEST(EulerFriction, PainleveTypeSlideStopsInOneStepAsMoreauJeans) {
   // Stopped after the first step: sliding speed t'v = v_x + 3 v_y zero.
   EXPECT_NEAR(e.samples[1].x(2) + 3 * e.samples[1].x(3), 0.0, 1e-12);
   EXPECT_LE(e.energy_final, 1e-12);
+}
+
+// A force input (docs/inputs.md) pushing the block on the floor along x,
+// push(t) = 10 t N (m = 1 kg, mu = 0.4): it sticks while push <= mu m g,
+// i.e. up to t_s = mu g/10, then v(t) = 5 (t - t_s)^2. Backward Euler takes
+// the push at the step's end, as on euler's LCS path: the block sticks (at
+// rest to 1e-15: the stick impulse cancels h push, below 4e-3 m/s, to a few
+// ulp) while push(t_{n+1}) <= mu g and then gains
+// h (push(t_{n+1}) - mu g) per step, a right Riemann sum of the linear
+// 10 (t - t_s): with t_s = (m - phi) h (m the first sliding step), the
+// error at T is 5 h (T - t_s) + 5 phi (1 - phi) h^2, so within 5 h^2/4 of
+// 5 h (T - t_s) (plus 1e-12 m/s, the rounding of 10^3 sums of terms below
+// 2 m/s). The same as Moreau–Jean at theta = 1 (its step force is f(t0 + h)
+// there, the gap stays at zero) to 1e-12.
+TEST(EulerFriction, ForceInputStartsTheSlideAtTheClosedForm) {
+  const mech::Model model = io::parse_matrix_model(R"(
+name: pushed_block
+inputs:
+  - {name: push, kind: pwl, points: [[0, 0], [1, 10]]}
+mechanical:
+  M: [[1, 0], [0, 1]]
+  E: [[0, 1]]
+  f: [0, -9.81]
+  force_inputs: [{input: push, gain: [1, 0]}]
+  friction:
+    - {contact: 0, tangent: [1, 0], mu: 0.4}
+initial: [0, 0, 0, 0]
+)",
+                                                   "pushed.yaml");
+  const double t_s = 0.4 * kG / 10, T = 1.0;
+  for (double h : {1e-3, 5e-4}) {
+    const sim::Trajectory tr = run_euler(model, model.initial, T, h);
+    ASSERT_EQ(tr.status, Status::kOk) << tr.message;
+    for (const sim::Sample& s : tr.samples) {
+      if (s.t == 0.0 || s.t > t_s) continue;
+      EXPECT_NEAR(s.x(0), 0.0, 1e-15) << s.t;
+      EXPECT_NEAR(s.x(2), 0.0, 1e-15) << s.t;
+      EXPECT_EQ(s.friction_mode[0], sim::FrictionMode::kStick) << s.t;
+    }
+    const double err = tr.final_state(2) - 5 * (T - t_s) * (T - t_s);
+    EXPECT_NEAR(err, 5 * h * (T - t_s), 5 * h * h / 4 + 1e-12) << "h = " << h;
+    std::printf("[ euler    ] pushed block, h = %g: v(T) error %.6e (5 h (T - t_s) = %.6e)\n", h,
+                err, 5 * h * (T - t_s));
+    sim::Options o;
+    o.t_end = T;
+    o.h = h;
+    o.theta = 1.0;
+    const sim::Trajectory mj = sim::make_integrator("moreau-jean")->run(model, model.initial, o);
+    ASSERT_EQ(mj.status, Status::kOk) << mj.message;
+    for (int j = 0; j < 4; ++j) EXPECT_NEAR(tr.final_state(j), mj.final_state(j), 1e-12) << j;
+  }
 }
 
 // Euler's LCS path takes asymmetric D or K; with friction the step factors
