@@ -124,7 +124,7 @@ TEST(Divergence, ShippedModelsStillComplete) {
     const mech::Model m = scene::load_model(std::string(LCSIM_SOURCE_DIR) + "/robots/" + name);
     for (const char* method : {"event", "moreau-jean", "euler"}) {
       auto integ = make_integrator(method);
-      if (integ->refuse(m, m.initial, Options{})) continue;  // e.g. euler and friction
+      if (integ->refuse(m, m.initial, Options{})) continue;  // a model it does not take
       const Trajectory tr = integ->run(m, m.initial, Options{});
       EXPECT_EQ(tr.status, RunStatus::kCompleted) << name << " " << method << ": " << tr.message;
     }

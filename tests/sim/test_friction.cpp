@@ -229,7 +229,8 @@ TEST(FrictionRefusal, MethodsWithoutFrictionRefuseIt) {
     EXPECT_EQ(tr.status, Status::kInvalidInput) << name;
     EXPECT_EQ(tr.message, "method '" + name +
                               "' does not support friction (model 'block' has 1 frictional "
-                              "contact in mechanical.friction); use method 'event', 'moreau-jean'");
+                              "contact in mechanical.friction); use method 'event', 'euler', "
+                              "'moreau-jean'");
   }
 }
 

@@ -5,7 +5,8 @@
 // run_euler is the driver; its stages are the members of EulerRun: set_up
 // (the LCS and the solver), refusal (the consistency guard of §7.3), factor
 // (one factorisation per step size), record, step (steps 4 and 5 of the
-// algorithm) and advance (the divergence guard, the sample).
+// algorithm) and advance (the divergence guard, the sample). A mechanical
+// model with friction is run by euler_friction.cpp instead.
 #include <algorithm>
 #include <lcsim/sim/sim.hpp>
 #include <memory>
@@ -274,6 +275,10 @@ class EulerRun {
 }  // namespace
 
 Trajectory run_euler(const mech::Model& model, const VectorXd& x0_user, const Options& opt) {
+  // Coulomb's law has no variables in the LCS (3.65): with friction the step
+  // is the mechanical one of euler_friction.cpp.
+  if (model.is_mechanical() && model.mechanical->has_friction())
+    return run_euler_friction(model, x0_user, opt);
   EulerRun run(model, opt);
   if (!run.set_up()) return run.set_up_failure(x0_user);
   VectorXd x = run.start(x0_user);

@@ -40,6 +40,8 @@ class EulerIntegrator : public Integrator {
     u.h = u.lcp_solver = u.force = u.dense_lcs = true;
     u.sensitivity = true;  // the discrete map's derivative (step_sensitivity.hpp)
     u.inputs = true;       // force inputs evaluated at each step's end (euler.cpp)
+    u.friction = true;     // Moreau–Jean's friction LCP at theta = 1 (euler_friction.cpp)
+    u.friction_3d = true;  // its cone in Stewart and Trinkle's form (the same)
     return u;
   }
   Trajectory integrate(const mech::Model& model, const VectorXd& x0,
