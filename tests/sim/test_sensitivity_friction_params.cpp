@@ -473,5 +473,47 @@ TEST(SensitivityFrictionParams, InputParametersAgainstFiniteDifferences) {
   EXPECT_EQ(expect_matches_fd(m, T, ps), 5 * (4 + 6));
 }
 
+// e[c] at a plastic impact (e = 0) has only one side (e >= 0); where the
+// contact is then held, any e > 0 bounces (another event sequence), so the
+// column is reported absent, with or without friction (the ball dropped on
+// its ground from 1 m, resting from t1 = 0.4515 s: the loss names `ground`
+// at t1, no number); where the contact leaves at once, e > 0 only adds a
+// small rate, the same sequence, and the right derivative is given: a unit
+// mass under a ceiling z <= 1, thrown up at 5 m/s from 0.5 m, reaches it at
+// t1 = (5 - v_a)/g with v_a = sqrt(25 - g), leaves at -e v_a, so at T = 0.4
+// s (s = T - t1) z = 1 - e v_a s - g s^2/2: dz/de = -v_a s, dv/de = -v_a, to
+// 1e-12.
+TEST(SensitivityFrictionParams, PlasticImpactRestitutionIsOneSided) {
+  const mech::Model ball = mech::ball_model(0.0);
+  const sim::Trajectory rest = sim::simulate(
+      ball, Eigen::Vector2d(1.0, 0.0),
+      [] {
+        sim::Options o;
+        o.t_end = 1.0;
+        o.sensitivity = {"x0", "e[0]"};
+        return o;
+      }(),
+      "event");
+  ASSERT_TRUE(rest.ok()) << rest.message;
+  ASSERT_EQ(rest.sensitivity_losses.size(), 1u);
+  EXPECT_NEAR(rest.sensitivity_losses[0].t, std::sqrt(2 / 9.81), 1e-12);
+  EXPECT_EQ(rest.sensitivity_losses[0].contact, ball.mechanical->constraints[0]);
+  EXPECT_TRUE(rest.dx_final_exists[0] && rest.dx_final_exists[1]);
+  EXPECT_FALSE(rest.dx_final_exists[2]);
+  EXPECT_EQ(rest.dx_final.col(2).cwiseAbs().maxCoeff(), 0.0);
+  const mech::Model ceiling = io::parse_matrix_model(
+      "name: ceiling\nmechanical:\n  M: [[1]]\n  E: [[-1]]\n  g: [1]\n  f: [-9.81]\n"
+      "  restitution: [0]\n  coordinates: [z]\n  constraints: [ceiling]\n"
+      "initial: [0.5, 5]\nt_end: 0.4\n",
+      "ceiling.yaml");
+  const double g = 9.81, va = std::sqrt(25 - g), s = 0.4 - (5 - va) / g;
+  const sim::Trajectory up = run(ceiling, 0.4, {"e[ceiling]"});
+  ASSERT_TRUE(up.ok()) << up.message;
+  ASSERT_EQ(up.events.size(), 1u);
+  ASSERT_TRUE(up.sensitivity_losses.empty()) << up.sensitivity_losses[0].reason;
+  EXPECT_NEAR(up.dx_final(0, 0), -va * s, 1e-12);
+  EXPECT_NEAR(up.dx_final(1, 0), -va, 1e-12);
+}
+
 }  // namespace
 }  // namespace lcsim

@@ -118,6 +118,8 @@ class Sensitivity {
   // The forcing structure of each parameter in the current phase (begin_phase).
   void forcing_structure();
   bool impact_map(double t, const EventResult::ImpactRound& round, MatrixXd& J, MatrixXd& dR);
+  // e[c] lost at a plastic impact after which the contact is held.
+  void plastic_restitution(const EventResult& ev, const Phase& next, double t);
   // An accumulation's limit as the run takes it (sensitivity_accumulation.cpp):
   // the M-orthogonal projection onto E_J q + g_J = 0, E_J v = 0 from
   // ev.limit_x; false (every column lost) where it has no derivative.

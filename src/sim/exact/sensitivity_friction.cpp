@@ -83,17 +83,14 @@ void mu_impact_columns(const mech::MechanicalModel& m, const std::vector<SensPar
 // whose restitution is on (approaching, a_c = E_c v < 0; `erate` holds a_c
 // there, 0 elsewhere and for the inelastic law): R's row moves by E_c, so
 // dlambda = -(X G B)^-1 unit_c a_c and dv+ = G B dlambda. Into dR's
-// velocity rows of the column. Returns the e[c] columns that have no
-// derivative: e_c = 0 on an approaching contact, which stays closed, where
-// any e_c > 0 makes it bounce (another event sequence: e >= 0, one side).
-std::vector<int> mass_restitution_impact_columns(const std::vector<SensParam>& params, int nx0,
-                                                 const MatrixXd& G, const std::vector<int>& A,
-                                                 const VectorXd& e, const VectorXd& erate,
-                                                 const FrictionImpactRows& s,
-                                                 const Eigen::FullPivLU<MatrixXd>& W,
-                                                 const VectorXd& lambda, MatrixXd& dR) {
+// velocity rows of the column. (At e_c = 0 the column is lost where the
+// contact is then held: Sensitivity::plastic_restitution.)
+void mass_restitution_impact_columns(const std::vector<SensParam>& params, int nx0,
+                                     const MatrixXd& G, const std::vector<int>& A,
+                                     const VectorXd& erate, const FrictionImpactRows& s,
+                                     const Eigen::FullPivLU<MatrixXd>& W, const VectorXd& lambda,
+                                     MatrixXd& dR) {
   const Eigen::Index N = G.rows(), na = s.B.cols();
-  std::vector<int> lost;
   for (size_t p = 0; p < params.size(); ++p) {
     const SensParam& sp = params[p];
     VectorXd dv;
@@ -107,10 +104,6 @@ std::vector<int> mass_restitution_impact_columns(const std::vector<SensParam>& p
     } else if (sp.kind == 'e') {
       const auto i = std::find(A.begin(), A.end(), sp.i) - A.begin();
       if (i == static_cast<long>(A.size()) || erate(i) == 0.0) continue;
-      if (e(sp.i) == 0.0) {
-        lost.push_back(nx0 + static_cast<int>(p));
-        continue;
-      }
       VectorXd unit = VectorXd::Zero(na);
       unit(i) = erate(i);
       dv = G * (s.B * VectorXd(-W.solve(unit)));
@@ -119,7 +112,6 @@ std::vector<int> mass_restitution_impact_columns(const std::vector<SensParam>& p
     }
     dR.block(N, nx0 + static_cast<Eigen::Index>(p), N, 1) = dv;
   }
-  return lost;
 }
 
 }  // namespace
@@ -197,13 +189,7 @@ bool Sensitivity::friction_impact_map(double t, const EventResult::ImpactRound& 
     J.block(N_, 2 * N_, N_, 1) = GB * W.solve(s.c);
   }
   mu_impact_columns(m, cols_.params, nx0_, G_, A, s, W, lambda, dR);
-  const std::vector<int> lost =
-      mass_restitution_impact_columns(cols_.params, nx0_, G_, A, e, erate, s, W, lambda, dR);
-  for (int c : lost)
-    lose(t, cols_.params[static_cast<size_t>(c - nx0_)].i,
-         "a plastic impact (e = 0) with friction: any restitution e > 0 makes the contact bounce "
-         "(another event sequence), so only a one-sided derivative in e exists",
-         {c});
+  mass_restitution_impact_columns(cols_.params, nx0_, G_, A, erate, s, W, lambda, dR);
   return true;
 }
 
