@@ -259,9 +259,11 @@ namespace lcsim::sim::detail {
 // M^-1 f), and Acl's velocity rows are Av + M^-1 G' F. A parameter of the
 // free acceleration (f[i], K[i][j], D[i][j]: dAv = M^-1 dH, one column)
 // leaves H, G and S as they are: dF = -S^-1 H dAv and dAcl = dAv + M^-1 G'
-// dF. A gap offset g[c] moves no phase (its term is the gap monitor's,
-// dh = 1). A singular S (a statically indeterminate stick, whose split the
-// phase chooses) loses the columns.
+// dF; so does a force input's own parameter (its dA's velocity rows; its
+// exosystem rows as they are). M[i][j] moves G = M^-1 and with it Av and S
+// (mass_phase_rows). A gap offset g[c] and a restitution e[c] move no phase
+// (g[c]'s term is the gap monitor's, dh = 1). A singular S (a statically
+// indeterminate stick, whose split the phase chooses) loses the columns.
 namespace {
 
 // M[i][j] (dM the unit entries (i, j) and (j, i)) in a friction phase: G =
