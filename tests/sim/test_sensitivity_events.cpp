@@ -310,21 +310,20 @@ TEST(SensitivityEvents, BlockSlidingToRestClosedForm) {
   EXPECT_NEAR(early.dx_final(0, 0), 1.0, 1e-13);
 }
 
-// What stays refused with friction: a parameter of M in the exact method,
-// and a second tangent (here not orthogonal to the normal: the model
-// check's refusal comes first) in either method (Moreau–Jean's step map is
-// test_sensitivity_stepping.cpp's).
+// What stays refused with friction: backward Euler (it does not simulate
+// friction), and a second tangent (here not orthogonal to the normal: the
+// model check's refusal comes first) in either method (Moreau–Jean's step
+// map is test_sensitivity_stepping.cpp's).
 TEST(SensitivityEvents, FrictionRefusals) {
   const mech::Model m = load("robots/block_on_floor_friction.yaml");
   sim::Options opt;
   opt.t_end = 0.1;
-  // (f[1] was refused here; f, g, K, D are computed now:
-  // tests/sim/test_sensitivity_friction_params.cpp.)
+  // (f[1], then M[0][0] were refused here; f, g, K, D, M, e and an input's
+  // parameters are computed now: tests/sim/test_sensitivity_friction_params.cpp.)
   opt.sensitivity = {"x0", "M[0][0]"};
-  sim::Trajectory tr = sim::simulate(m, m.initial, opt, "event");
+  sim::Trajectory tr = sim::simulate(m, m.initial, opt, "euler");
   EXPECT_EQ(tr.status, Status::kInvalidInput);
-  EXPECT_NE(tr.message.find("'M[0][0]': not computed with friction"), std::string::npos)
-      << tr.message;
+  EXPECT_NE(tr.message.find("'euler' does not support friction"), std::string::npos) << tr.message;
   opt.sensitivity = {"x0"};
   mech::Model m3 = m;
   m3.mechanical->friction[0].tangent2 = Eigen::SparseVector<double>(2);

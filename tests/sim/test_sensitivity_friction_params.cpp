@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <functional>
+#include <lcsim/io/model_file.hpp>
 #include <lcsim/scene/scene.hpp>
 #include <lcsim/sim/sim.hpp>
 #include <string>
@@ -198,6 +199,320 @@ TEST(SensitivityFrictionParams, MuAgainstFiniteDifferences) {
     total += per;
   }
   EXPECT_EQ(total, 5 + 6 + 5 + 6);
+}
+
+Param mass(int i, int j, double theta) {
+  return {"M[" + std::to_string(i) + "][" + std::to_string(j) + "]", theta,
+          [i, j](mech::MechanicalModel& m, double d) {
+            m.M.coeffRef(i, j) += d;
+            if (i != j) m.M.coeffRef(j, i) += d;
+          }};
+}
+
+Param restitution(int c, double e) {
+  return {"e[" + std::to_string(c) + "]", e,
+          [c](mech::MechanicalModel& m, double d) { m.restitution(c) += d; }};
+}
+
+// M[i][j] (the mass matrix moves G = M^-1: the phase's free acceleration,
+// its forces through S = H M^-1 G' and the stick / slip columns). The block
+// of robots/block_on_floor_friction.yaml, whose weight is the file's force
+// f_y = -9.81 N (not m g: it does not scale with the mass), sliding at v0 =
+// 2 m/s and pushed by f_x: the normal force N = 9.81 N holds y (M[1][1]
+// moves nothing: N does not depend on it), and along x m vx' = f_x - mu N,
+// so a = (mu N - f_x)/m, t* = v0/a = m v0/(mu N - f_x), x* = v0^2/(2 a) = m
+// v0^2/(2 (mu N - f_x)), after which it sticks (|f_x| <= mu N). At m = 1:
+// dx*/dm = x*, dt*/dm = t*, dv/dm = 0 after the stop; before it (T = 0.3 s)
+// x = v0 T - a T^2/2: dx/dm = a T^2/2, dv/dm = a T. With f_x = 0 and with a
+// push f_x = 1 N (the stop moves with m either way: the weight is a force).
+// To 1e-12 as above.
+TEST(SensitivityFrictionParams, MassClosedForms) {
+  const double v0 = 2.0, mu = 0.4, N = 9.81;
+  for (const double fx : {0.0, 1.0}) {
+    mech::Model m = load("robots/block_on_floor_friction.yaml");
+    m.mechanical->f(0) = fx;
+    const double a = mu * N - fx, ts = v0 / a, xs = v0 * v0 / (2 * a);
+    const sim::Trajectory tr = run(m, 1.0, {"M[0][0]", "M[1][1]", "M[x][y]"});
+    ASSERT_TRUE(tr.ok()) << tr.message;
+    ASSERT_EQ(tr.events.size(), 1u);  // slip -> stick
+    ASSERT_NEAR(tr.final_state(0), xs, 1e-12);
+    for (int c = 0; c < 3; ++c) ASSERT_TRUE(tr.dx_final_exists[static_cast<size_t>(c)]);
+    EXPECT_NEAR(tr.dx_final(0, 0), xs, 1e-12) << fx;
+    EXPECT_NEAR(tr.events[0].dt(0), ts, 1e-12) << fx;
+    for (int r : {1, 2, 3}) EXPECT_NEAR(tr.dx_final(r, 0), 0.0, 1e-12) << r;
+    for (int r = 0; r < 4; ++r) EXPECT_NEAR(tr.dx_final(r, 1), 0.0, 1e-12) << r;
+    EXPECT_NEAR(tr.events[0].dt(1), 0.0, 1e-12);
+    const double T = 0.3;
+    const sim::Trajectory early = run(m, T, {"M[0][0]", "M[1][1]"});
+    ASSERT_TRUE(early.ok()) << early.message;
+    EXPECT_NEAR(early.dx_final(0, 0), a * T * T / 2, 1e-12) << fx;
+    EXPECT_NEAR(early.dx_final(2, 0), a * T, 1e-12) << fx;
+    for (int r = 0; r < 4; ++r) EXPECT_NEAR(early.dx_final(r, 1), 0.0, 1e-12) << r;
+  }
+  // Through a sliding impact: dropped from y0 = 0.2 m at vx0 = 2 m/s,
+  // plastic, mass m along x (M[0][0]): the floor's impulse P_N = w (w =
+  // sqrt(2 g y0), M[1][1] = 1) at t1 = w/g, the tangential -mu P_N, so vx+ =
+  // vx0 - mu w/m, then sliding at mu N/m: at T = 0.4 s, s = T - t1, dvx/dm =
+  // mu w + mu N s and dx/dm = mu w s + mu N s^2/2 (m = 1).
+  mech::Model m = load("robots/block_on_floor_friction.yaml");
+  m.initial << 0, 0.2, 2, 0;
+  const double g = 9.81, w = std::sqrt(2 * g * 0.2), s = 0.4 - w / g;
+  const sim::Trajectory drop = run(m, 0.4, {"M[0][0]"});
+  ASSERT_TRUE(drop.ok()) << drop.message;
+  ASSERT_EQ(drop.events.size(), 1u);
+  ASSERT_TRUE(drop.dx_final_exists[0]);
+  EXPECT_NEAR(drop.dx_final(0, 0), mu * w * s + mu * N * s * s / 2, 1e-12);
+  EXPECT_NEAR(drop.dx_final(2, 0), mu * w + mu * N * s, 1e-12);
+  EXPECT_NEAR(drop.events[0].dt(0), 0.0, 1e-12);
+}
+
+// e[c] through impacts with friction: R = [(1 + e) E_A; T_S], e on where the
+// contact approaches. The block dropped from y0 = 0.2 m (w = sqrt(2 g y0),
+// t1 = w/g) on the floor with restitution e = 0.5: P_N = (1 + e) w, it leaves
+// at vy+ = e w, lands again at t2 = t1 + 2 e w/g (dt2/de = 2 w/g) at -e w,
+// leaves at e^2 w. Sliding (vx0 = 2 > mu (1 + e) w: vx+ = vx0 - mu (1 + e)
+// w, vx++ = vx+ - mu (1 + e) e w > 0, still sliding), in flight vx is
+// constant: at T = 0.3 s (between the impacts, s1 = T - t1) dx/de = -mu w
+// s1, dvx/de = -mu w, dy/de = w s1, dvy/de = w; at T = 0.45 s (s = T - t2,
+// before the third impact at 0.505 s) dx/de = -mu w (t2 - t1) + (vx+ -
+// vx++) 2w/g - mu w (2 + 2e) s, dvx/de = -mu w (2 + 2e), y = e^2 w s - g
+// s^2/2: dy/de = 2 e w s - (e^2 w - g s) 2w/g, dvy/de = 2 e w + 2 w.
+// Sticking (vx0 = 0.5 <= mu (1 + e) w): vx+ = 0 and x = vx0 t1 whatever e,
+// the same y derivatives. dt1/de = 0. To 1e-12 as above.
+TEST(SensitivityFrictionParams, RestitutionClosedForms) {
+  const double mu = 0.4, g = 9.81, e = 0.5, w = std::sqrt(2 * g * 0.2);
+  const double t1 = w / g, t2 = t1 + 2 * e * w / g;
+  for (const double vx0 : {2.0, 0.5}) {
+    mech::Model m = load("robots/block_on_floor_friction.yaml");
+    m.mechanical->restitution = VectorXd::Constant(1, e);
+    m.initial << 0, 0.2, vx0, 0;
+    const bool slides = vx0 > mu * (1 + e) * w;
+    const sim::Trajectory one = run(m, 0.3, {"e[floor]"});
+    ASSERT_TRUE(one.ok()) << one.message;
+    ASSERT_EQ(one.events.size(), 1u);
+    ASSERT_TRUE(one.dx_final_exists[0]);
+    const double s1 = 0.3 - t1;
+    EXPECT_NEAR(one.dx_final(0, 0), slides ? -mu * w * s1 : 0.0, 1e-12) << vx0;
+    EXPECT_NEAR(one.dx_final(2, 0), slides ? -mu * w : 0.0, 1e-12) << vx0;
+    EXPECT_NEAR(one.dx_final(1, 0), w * s1, 1e-12) << vx0;
+    EXPECT_NEAR(one.dx_final(3, 0), w, 1e-12) << vx0;
+    EXPECT_NEAR(one.events[0].dt(0), 0.0, 1e-12);
+    const double T = 0.45, s = T - t2;
+    const sim::Trajectory two = run(m, T, {"e[floor]"});
+    ASSERT_TRUE(two.ok()) << two.message;
+    ASSERT_EQ(two.events.size(), 2u);
+    ASSERT_TRUE(two.dx_final_exists[0]);
+    ASSERT_NEAR(two.events[1].t, t2, 1e-12);
+    EXPECT_NEAR(two.events[1].dt(0), 2 * w / g, 1e-12) << vx0;
+    const double dx =
+        -mu * w * (t2 - t1) + mu * (1 + e) * e * w * 2 * w / g - mu * w * (2 + 2 * e) * s;
+    EXPECT_NEAR(two.dx_final(0, 0), slides ? dx : 0.0, 1e-12) << vx0;
+    EXPECT_NEAR(two.dx_final(2, 0), slides ? -mu * w * (2 + 2 * e) : 0.0, 1e-12) << vx0;
+    EXPECT_NEAR(two.dx_final(1, 0), 2 * e * w * s - (e * e * w - g * s) * 2 * w / g, 1e-12);
+    EXPECT_NEAR(two.dx_final(3, 0), 2 * e * w + 2 * w, 1e-12) << vx0;
+  }
+}
+
+// The bar of tests/sim/test_sensitivity_events.cpp (x, y, theta; M =
+// diag(1, 1, 0.1); gap y - 0.5 theta, tangent x' + 0.2 y' + 0.4 theta':
+// W_NT = -1.8) from (0, 0.3, 0, 1, 0, 0.4).
+mech::Model coupled_bar(double mu, double e) {
+  mech::Model m;
+  m.name = "bar";
+  mech::MechanicalModel& b = m.mechanical.emplace();
+  Eigen::SparseMatrix<double> M(3, 3), E(1, 3);
+  M.insert(0, 0) = 1, M.insert(1, 1) = 1, M.insert(2, 2) = 0.1;
+  E.insert(0, 1) = 1, E.insert(0, 2) = -0.5;
+  b.M = M;
+  b.D = Eigen::SparseMatrix<double>(3, 3);
+  b.K = Eigen::SparseMatrix<double>(3, 3);
+  b.E = E;
+  b.f = VectorXd::Zero(3);
+  b.f(1) = -9.81;
+  b.g = VectorXd::Zero(1);
+  b.coordinates = {"x", "y", "theta"};
+  b.constraints = {"corner"};
+  b.restitution = VectorXd::Constant(1, e);
+  mech::FrictionalContact fc;
+  fc.contact = 0;
+  fc.tangent = Eigen::SparseVector<double>(3);
+  fc.tangent.insert(0) = 1;
+  fc.tangent.insert(1) = 0.2;
+  fc.tangent.insert(2) = 0.4;
+  fc.mu = mu;
+  b.friction = {fc};
+  m.initial = VectorXd(6);
+  m.initial << 0, 0.3, 0, 1, 0, 0.4;
+  return m;
+}
+
+// M[i][j] and e[c] against central differences (tests/support/
+// sensitivity_fd.hpp: x(T) and every event time): the coupled bar landing
+// with mu = 1.5 (stick) and mu = 0.2 (slip), plastic, to 0.6 s, and with mu
+// = 0.2, e = 0.5 (two bouncing impacts) to 0.55 s (M[0][0], M[1][1],
+// M[2][2], M[1][2], M[0][2], e[0]; at e = 0, e[0] is reported absent at the
+// impact: any e > 0 bounces); the four planar friction files, which start
+// on their floor and have no impact (M[0][0], M[1][1], M[0][1] at t_end),
+// and the spinning disk (impacts with e = 0.5 and stick at 0, 0.306 and
+// 0.459 s, to 0.5 s, before its accumulation, whose limit's derivative is
+// that of the limit as the run takes it, off by the order of its tail:
+// docs/sensitivities.md; M and e[0]). Counts asserted.
+TEST(SensitivityFrictionParams, MassAndRestitutionAgainstFiniteDifferences) {
+  int total = 0;
+  struct Bar {
+    double mu, e, T;
+  };
+  for (const auto& [mu, e, T] : {Bar{1.5, 0.0, 0.6}, Bar{0.2, 0.0, 0.6}, Bar{0.2, 0.5, 0.55}}) {
+    const mech::Model m = coupled_bar(mu, e);
+    const sim::Trajectory plain = run(m, T);
+    ASSERT_TRUE(plain.ok()) << plain.message;
+    const int per = static_cast<int>(6 + plain.events.size());
+    const std::vector<Param> ps = {mass(0, 0, 1), mass(1, 1, 1), mass(2, 2, 0.1),
+                                   mass(1, 2, 0), mass(0, 2, 0), restitution(0, e)};
+    const int n = expect_matches_fd(m, T, ps);
+    EXPECT_EQ(n, (e > 0 ? 6 : 5) * per) << "bar, mu = " << mu << ", e = " << e;
+    if (e == 0) {
+      const sim::Trajectory tr = run(m, T, {"e[corner]"});
+      ASSERT_EQ(tr.sensitivity_losses.size(), 1u);
+      EXPECT_EQ(tr.sensitivity_losses[0].contact, "corner");
+      EXPECT_EQ(tr.sensitivity_losses[0].t, plain.events[0].t);
+      EXPECT_NE(tr.sensitivity_losses[0].reason.find("one-sided"), std::string::npos);
+    }
+    total += n;
+  }
+  struct File {
+    const char* name;
+    double T;
+  };
+  for (const auto& [name, T_file] :
+       {File{"robots/block_on_floor_friction.yaml", 0}, File{"robots/mass_spring_friction.yaml", 0},
+        File{"robots/incline_friction.yaml", 0}, File{"robots/belt_friction.yaml", 0},
+        File{"robots/spinning_disk_friction.yaml", 0.5}}) {  // 0: the file's t_end
+    const mech::Model m = load(name);
+    const double T = T_file > 0 ? T_file : m.t_end;
+    const sim::Trajectory plain = run(m, T);
+    ASSERT_TRUE(plain.ok()) << plain.message;
+    const int per = static_cast<int>(m.initial.size() + plain.events.size());
+    std::vector<Param> ps = {mass(0, 0, 1), mass(1, 1, 1), mass(0, 1, 0)};
+    const double e = m.mechanical->restitution(0);
+    if (e > 0.0) ps.push_back(restitution(0, e));
+    const int n = expect_matches_fd(m, T, ps);
+    EXPECT_EQ(n, static_cast<int>(ps.size()) * per) << name;
+    std::cout << name << " to " << T << " s: " << plain.events.size() << " events, " << n
+              << " entries\n";
+    total += n;
+  }
+  EXPECT_EQ(total, 5 * 7 + 5 * 7 + 6 * 8 + 3 * 5 + 3 * 6 + 3 * 5 + 3 * 6 + 4 * 9);
+}
+
+// The block of robots/block_on_floor_friction.yaml at rest on its floor
+// (mu = 0.4, N = 9.81 N), pushed along x by a force input `push`.
+mech::Model pushed_block(const std::string& input) {
+  return io::parse_matrix_model(
+      "name: pushed_block\ninputs:\n  - " + input +
+          "\nmechanical:\n  M: [[1, 0], [0, 1]]\n  E: [[0, 1]]\n  f: [0, -9.81]\n"
+          "  coordinates: [x, y]\n  constraints: [floor]\n"
+          "  force_inputs: [{input: push, gain: [1, 0]}]\n"
+          "  friction:\n    - {contact: floor, tangent: [1, 0], mu: 0.4}\n"
+          "initial: [0, 0, 0, 0]\nt_end: 1.8\n",
+      "pushed_block.yaml");
+}
+
+// An input's own parameters through the friction phase: they move the force
+// column of the free acceleration (and the exosystem), so the forces' dF =
+// -S^-1 H dAv as f[i]'s. The block at rest pushed by the ramp f_x = P t /
+// t1 (pwl points (0, 0), (t1, P), P = 6 N, t1 = 2 s): it sticks until P t /
+// t1 = mu N, ts = mu N t1 / P (the stick force's monitor reaching the
+// cone's edge), then slides with x'' = P s / t1 - mu N, the integrand zero
+// at ts, so at T = 1.8 s: dx(T)/dP = int_ts^T (T - s) s / t1 ds = (T^3/6 -
+// T ts^2/2 + ts^3/3) / t1, dv/dP = (T^2 - ts^2) / (2 t1), dts/dP = -ts/P;
+// t1 enters through P / t1 only, so d/dt1 = -(P / t1) d/dP. To 1e-12 (a
+// margin ~100 over the run's rounding on entries up to 0.6).
+TEST(SensitivityFrictionParams, InputParametersClosedForms) {
+  const mech::Model m = pushed_block("{name: push, kind: pwl, points: [[0, 0], [2, 6]]}");
+  const double P = 6, t1 = 2, muN = 0.4 * 9.81, ts = muN * t1 / P, T = 1.8;
+  const sim::Trajectory tr = run(m, T, {"pwl_v[push][1]", "pwl_t[push][1]"});
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  ASSERT_EQ(tr.events.size(), 1u);  // stick -> slip
+  ASSERT_NEAR(tr.events[0].t, ts, 1e-12);
+  ASSERT_TRUE(tr.dx_final_exists[0] && tr.dx_final_exists[1]);
+  const double dx = (T * T * T / 6 - T * ts * ts / 2 + ts * ts * ts / 3) / t1;
+  const double dv = (T * T - ts * ts) / (2 * t1);
+  EXPECT_NEAR(tr.dx_final(0, 0), dx, 1e-12);
+  EXPECT_NEAR(tr.dx_final(2, 0), dv, 1e-12);
+  EXPECT_NEAR(tr.events[0].dt(0), -ts / P, 1e-12);
+  EXPECT_NEAR(tr.dx_final(0, 1), -P / t1 * dx, 1e-12);
+  EXPECT_NEAR(tr.dx_final(2, 1), -P / t1 * dv, 1e-12);
+  EXPECT_NEAR(tr.events[0].dt(1), P / t1 * ts / P, 1e-12);
+  for (int c = 0; c < 2; ++c)
+    for (int r : {1, 3}) EXPECT_NEAR(tr.dx_final(r, c), 0.0, 1e-12);
+}
+
+// A damped sine push (amplitude 8 N, 0.4 Hz, damping 0.1 1/s, phase 0.3,
+// offset 0.5 N), to 4.5 s through six stick / slip events (stick -> slip+
+// at 0.058 s, a reversal slip+ -> slip- at 1.465 s, stick at 2.454 s, slip+
+// at 2.615 s, stick at 3.808 s, slip- at 4.018 s): its five parameters
+// against central differences (counts asserted).
+TEST(SensitivityFrictionParams, InputParametersAgainstFiniteDifferences) {
+  const mech::Model m = pushed_block(
+      "{name: push, kind: damped_sine, amplitude: 8, frequency: 0.4, damping: 0.1, phase: 0.3, "
+      "offset: 0.5}");
+  const double T = 4.5;
+  const sim::Trajectory plain = run(m, T);
+  ASSERT_TRUE(plain.ok()) << plain.message;
+  ASSERT_EQ(plain.events.size(), 6u);
+  auto input = [](const char* column, double theta, double mech::Input::*field) {
+    return Param{column, theta,
+                 [field](mech::MechanicalModel& mm, double d) { mm.inputs[0].*field += d; }};
+  };
+  const std::vector<Param> ps = {input("amplitude[push]", 8, &mech::Input::amplitude),
+                                 input("frequency[push]", 0.4, &mech::Input::frequency),
+                                 input("damping[push]", 0.1, &mech::Input::damping),
+                                 input("phase[push]", 0.3, &mech::Input::phase),
+                                 input("offset[push]", 0.5, &mech::Input::offset)};
+  EXPECT_EQ(expect_matches_fd(m, T, ps), 5 * (4 + 6));
+}
+
+// e[c] at a plastic impact (e = 0) has only one side (e >= 0); where the
+// contact is then held, any e > 0 bounces (another event sequence), so the
+// column is reported absent, with or without friction (the ball dropped on
+// its ground from 1 m, resting from t1 = 0.4515 s: the loss names `ground`
+// at t1, no number); where the contact leaves at once, e > 0 only adds a
+// small rate, the same sequence, and the right derivative is given: a unit
+// mass under a ceiling z <= 1, thrown up at 5 m/s from 0.5 m, reaches it at
+// t1 = (5 - v_a)/g with v_a = sqrt(25 - g), leaves at -e v_a, so at T = 0.4
+// s (s = T - t1) z = 1 - e v_a s - g s^2/2: dz/de = -v_a s, dv/de = -v_a, to
+// 1e-12.
+TEST(SensitivityFrictionParams, PlasticImpactRestitutionIsOneSided) {
+  const mech::Model ball = mech::ball_model(0.0);
+  const sim::Trajectory rest = sim::simulate(
+      ball, Eigen::Vector2d(1.0, 0.0),
+      [] {
+        sim::Options o;
+        o.t_end = 1.0;
+        o.sensitivity = {"x0", "e[0]"};
+        return o;
+      }(),
+      "event");
+  ASSERT_TRUE(rest.ok()) << rest.message;
+  ASSERT_EQ(rest.sensitivity_losses.size(), 1u);
+  EXPECT_NEAR(rest.sensitivity_losses[0].t, std::sqrt(2 / 9.81), 1e-12);
+  EXPECT_EQ(rest.sensitivity_losses[0].contact, ball.mechanical->constraints[0]);
+  EXPECT_TRUE(rest.dx_final_exists[0] && rest.dx_final_exists[1]);
+  EXPECT_FALSE(rest.dx_final_exists[2]);
+  EXPECT_EQ(rest.dx_final.col(2).cwiseAbs().maxCoeff(), 0.0);
+  const mech::Model ceiling = io::parse_matrix_model(
+      "name: ceiling\nmechanical:\n  M: [[1]]\n  E: [[-1]]\n  g: [1]\n  f: [-9.81]\n"
+      "  restitution: [0]\n  coordinates: [z]\n  constraints: [ceiling]\n"
+      "initial: [0.5, 5]\nt_end: 0.4\n",
+      "ceiling.yaml");
+  const double g = 9.81, va = std::sqrt(25 - g), s = 0.4 - (5 - va) / g;
+  const sim::Trajectory up = run(ceiling, 0.4, {"e[ceiling]"});
+  ASSERT_TRUE(up.ok()) << up.message;
+  ASSERT_EQ(up.events.size(), 1u);
+  ASSERT_TRUE(up.sensitivity_losses.empty()) << up.sensitivity_losses[0].reason;
+  EXPECT_NEAR(up.dx_final(0, 0), -va * s, 1e-12);
+  EXPECT_NEAR(up.dx_final(1, 0), -va, 1e-12);
 }
 
 }  // namespace

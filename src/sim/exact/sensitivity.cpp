@@ -737,9 +737,37 @@ void Sensitivity::after_event(const EventResult& ev, const Phase& next, double t
     }
   }
   limit(ev.rounds.size());
+  if (mech_) plastic_restitution(ev, next, t);
   const VectorXd xdot_plus = next.Acl * x_plus;
   MatrixXd S = J * S_minus_ + (J * xdot_minus_ - xdot_plus) * dtau_ + dR;
   begin_phase(next, t, x_plus, S);
+}
+
+// e[c] at a plastic impact (e_c = 0, the law's restitution, on a contact
+// that approached in one of the event's rounds, E_c v < 0) after which the
+// contact is held: any e_c > 0 makes it bounce instead (another event
+// sequence), so only a one-sided derivative exists and the column is lost
+// (the map's own dv+/de_c is no derivative of the run there). A contact that
+// leaves after a plastic impact keeps its column: with e_c > 0 it leaves
+// with a small rate, the same sequence. The law `inelastic` ignores e.
+void Sensitivity::plastic_restitution(const EventResult& ev, const Phase& next, double t) {
+  if (law_ == 'i') return;
+  const MatrixXd E = dense(model_.mechanical->E);
+  for (size_t p = 0; p < cols_.params.size(); ++p) {
+    const SensParam& sp = cols_.params[p];
+    if (sp.kind != 'e' || std::find(next.mode.begin(), next.mode.end(), sp.i) == next.mode.end())
+      continue;
+    const bool approached = std::any_of(ev.rounds.begin(), ev.rounds.end(), [&](const auto& rd) {
+      return rd.restitution(sp.i) == 0.0 &&
+             std::find(rd.closed.begin(), rd.closed.end(), sp.i) != rd.closed.end() &&
+             E.row(sp.i).dot(rd.v_before) < 0.0;
+    });
+    if (approached)
+      lose(t, sp.i,
+           "a plastic impact (e = 0) after which the contact is held: any restitution e > 0 "
+           "makes it bounce (another event sequence), so only a one-sided derivative in e exists",
+           {nx0_ + static_cast<int>(p)});
+  }
 }
 
 void Sensitivity::check_phase_start(const Phase& ph, double t, const std::vector<int>& m0,

@@ -39,6 +39,10 @@ struct SensParam {
 // '2' v2, 'd' width, 'r' rise, 'l' fall, 'T' period of a piecewise linear
 // input (a pulse's names move its points).
 bool input_param_kind(char kind);
+// Such a parameter's dA of the augmented LCS (the exosystem's rows; a sine
+// force's amplitude in the velocity rows, M^-1 gain): what a friction
+// phase's forces and closed loop move by (sensitivity_friction.cpp).
+MatrixXd input_param_dA(const mech::MechanicalModel& m, const lcs::Lcs& sys, const SensParam& p);
 // Parses amplitude[in], offset[in], ..., pwl_v[in][k], pwl_t[in][k]: "" or
 // the input error; false (untouched) when `s` is none of those names.
 bool parse_input_param(const mech::MechanicalModel& m, const std::string& s, SensParam& p,
@@ -114,6 +118,8 @@ class Sensitivity {
   // The forcing structure of each parameter in the current phase (begin_phase).
   void forcing_structure();
   bool impact_map(double t, const EventResult::ImpactRound& round, MatrixXd& J, MatrixXd& dR);
+  // e[c] lost at a plastic impact after which the contact is held.
+  void plastic_restitution(const EventResult& ev, const Phase& next, double t);
   // An accumulation's limit as the run takes it (sensitivity_accumulation.cpp):
   // the M-orthogonal projection onto E_J q + g_J = 0, E_J v = 0 from
   // ev.limit_x; false (every column lost) where it has no derivative.

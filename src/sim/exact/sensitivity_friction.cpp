@@ -76,6 +76,44 @@ void mu_impact_columns(const mech::MechanicalModel& m, const std::vector<SensPar
   }
 }
 
+// M[i][j] and e[c] through one impact round at its outcome (the map's
+// rows X, R, B, c do not depend on either; G = M^-1 does). M[i][j] (dM the
+// unit entries (i, j), (j, i)): dG = -G dM G, so dlambda = -(X G B)^-1 X dG
+// B lambda and dv+ = dG B lambda + G B dlambda. e[c] of a contact on A
+// whose restitution is on (approaching, a_c = E_c v < 0; `erate` holds a_c
+// there, 0 elsewhere and for the inelastic law): R's row moves by E_c, so
+// dlambda = -(X G B)^-1 unit_c a_c and dv+ = G B dlambda. Into dR's
+// velocity rows of the column. (At e_c = 0 the column is lost where the
+// contact is then held: Sensitivity::plastic_restitution.)
+void mass_restitution_impact_columns(const std::vector<SensParam>& params, int nx0,
+                                     const MatrixXd& G, const std::vector<int>& A,
+                                     const VectorXd& erate, const FrictionImpactRows& s,
+                                     const Eigen::FullPivLU<MatrixXd>& W, const VectorXd& lambda,
+                                     MatrixXd& dR) {
+  const Eigen::Index N = G.rows(), na = s.B.cols();
+  for (size_t p = 0; p < params.size(); ++p) {
+    const SensParam& sp = params[p];
+    VectorXd dv;
+    if (sp.kind == 'M') {
+      MatrixXd dM = MatrixXd::Zero(N, N);
+      dM(sp.i, sp.j) = dM(sp.j, sp.i) = 1.0;
+      const MatrixXd dG = -G * dM * G;
+      const VectorXd dGBl = dG * (s.B * lambda);
+      const VectorXd dlambda = na > 0 ? VectorXd(-W.solve(s.X * dGBl)) : VectorXd();
+      dv = na > 0 ? VectorXd(dGBl + G * (s.B * dlambda)) : VectorXd::Zero(N);
+    } else if (sp.kind == 'e') {
+      const auto i = std::find(A.begin(), A.end(), sp.i) - A.begin();
+      if (i == static_cast<long>(A.size()) || erate(i) == 0.0) continue;
+      VectorXd unit = VectorXd::Zero(na);
+      unit(i) = erate(i);
+      dv = G * (s.B * VectorXd(-W.solve(unit)));
+    } else {
+      continue;
+    }
+    dR.block(N, nx0 + static_cast<Eigen::Index>(p), N, 1) = dv;
+  }
+}
+
 }  // namespace
 
 bool Sensitivity::friction_impact_map(double t, const EventResult::ImpactRound& rd, MatrixXd& J,
@@ -118,6 +156,7 @@ bool Sensitivity::friction_impact_map(double t, const EventResult::ImpactRound& 
   const int ns = static_cast<int>(s.stuck.size()), na = a + ns;
   s.X = MatrixXd::Zero(na, N_), s.R = MatrixXd::Zero(na, N_), s.B = MatrixXd::Zero(N_, na);
   s.c = VectorXd::Zero(na);
+  VectorXd erate = VectorXd::Zero(na);  // a_r where e_r is on (e[c]'s term)
   for (int i = 0; i < a; ++i) {
     const int r = A[static_cast<size_t>(i)];
     const double ar = E.row(r).dot(v);
@@ -130,6 +169,7 @@ bool Sensitivity::friction_impact_map(double t, const EventResult::ImpactRound& 
     }
     s.X.row(i) = E.row(r);
     s.R.row(i) = (1.0 + (ar < 0.0 ? e(r) : 0.0)) * E.row(r);
+    if (ar < 0.0 && law_ != 'i') erate(i) = ar;
     s.B.col(i) = E.row(r).transpose();
   }
   add_tangent_rows(m, A, s);
@@ -149,6 +189,7 @@ bool Sensitivity::friction_impact_map(double t, const EventResult::ImpactRound& 
     J.block(N_, 2 * N_, N_, 1) = GB * W.solve(s.c);
   }
   mu_impact_columns(m, cols_.params, nx0_, G_, A, s, W, lambda, dR);
+  mass_restitution_impact_columns(cols_.params, nx0_, G_, A, erate, s, W, lambda, dR);
   return true;
 }
 
@@ -218,9 +259,36 @@ namespace lcsim::sim::detail {
 // M^-1 f), and Acl's velocity rows are Av + M^-1 G' F. A parameter of the
 // free acceleration (f[i], K[i][j], D[i][j]: dAv = M^-1 dH, one column)
 // leaves H, G and S as they are: dF = -S^-1 H dAv and dAcl = dAv + M^-1 G'
-// dF. A gap offset g[c] moves no phase (its term is the gap monitor's,
-// dh = 1). A singular S (a statically indeterminate stick, whose split the
-// phase chooses) loses the columns.
+// dF; so does a force input's own parameter (its dA's velocity rows; its
+// exosystem rows as they are). M[i][j] moves G = M^-1 and with it Av and S
+// (mass_phase_rows). A gap offset g[c] and a restitution e[c] move no phase
+// (g[c]'s term is the gap monitor's, dh = 1). A singular S (a statically
+// indeterminate stick, whose split the phase chooses) loses the columns.
+namespace {
+
+// M[i][j] (dM the unit entries (i, j) and (j, i)) in a friction phase: G =
+// M^-1 moves by dG = -G dM G, so the free acceleration Av = G [-K -D f ...]
+// by dAv = -G dM Av, S = H G Gc' by dS = H dG Gc', the forces F = -S^-1 H
+// Av by dF = -S^-1 (dS F + H dAv), and Acl's velocity rows Av + G Gc' F by
+// dAv + dG Gc' F + G Gc' dF. Returns those rows (N x n); dF is set (rows of
+// F; none when every contact is open).
+MatrixXd mass_phase_rows(const SensParam& sp, const MatrixXd& G, const MatrixXd& Av,
+                         const MatrixXd& H, const MatrixXd& Gc, const MatrixXd& F,
+                         const Eigen::FullPivLU<MatrixXd>& lu, MatrixXd& dF) {
+  const Eigen::Index N = G.rows();
+  MatrixXd dM = MatrixXd::Zero(N, N);
+  dM(sp.i, sp.j) = dM(sp.j, sp.i) = 1.0;
+  const MatrixXd dG = -G * dM * G;
+  const MatrixXd dAv = -G * (dM * Av);
+  dF = MatrixXd::Zero(H.rows(), Av.cols());
+  if (H.rows() == 0) return dAv;
+  const MatrixXd dGGt = dG * Gc.transpose();
+  dF = -lu.solve(H * dGGt * F + H * dAv);
+  return dAv + dGGt * F + G * Gc.transpose() * dF;
+}
+
+}  // namespace
+
 void Sensitivity::friction_mode_derivatives(const Phase& ph, double t) {
   const mech::MechanicalModel& m = *model_.mechanical;
   const size_t P = cols_.params.size();
@@ -268,7 +336,9 @@ void Sensitivity::friction_mode_derivatives(const Phase& ph, double t) {
     if (sp.kind == 'K') dAv.col(sp.j) = -G_.col(sp.i);
     if (sp.kind == 'D') dAv.col(N_ + sp.j) = -G_.col(sp.i);
     MatrixXd dA = MatrixXd::Zero(n_, n_);
-    if (sp.kind == 'u') {
+    if (sp.kind == 'M') {
+      dA.middleRows(N_, N_) = mass_phase_rows(sp, G_, Av, H, Gc, friction_F_, lu, dF);
+    } else if (sp.kind == 'u') {
       // mu of a sliding contact: its normal's force column -sigma mu t
       // moves by dGc = -sigma t, so dF = -S^-1 H M^-1 dGc' F and dAcl's
       // velocity rows M^-1 (dGc' F + G' dF). Sticking: no phase term.
@@ -282,6 +352,10 @@ void Sensitivity::friction_mode_derivatives(const Phase& ph, double t) {
         dA.middleRows(N_, N_) = G_ * dGc.transpose() * friction_F_ + GGt * dF;
       }
     } else {
+      // An input's own parameter (a force input's; moving stops are not
+      // simulated with friction): its dA's velocity rows are dAv, its
+      // exosystem rows stay as they are.
+      if (input_param_kind(sp.kind)) dA = input_param_dA(m, sys_, sp), dAv = dA.middleRows(N_, N_);
       if (nI + ns > 0) dF = -lu.solve(H * dAv);
       dA.middleRows(N_, N_) = dAv + GGt * dF;
     }

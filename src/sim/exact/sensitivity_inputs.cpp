@@ -197,6 +197,10 @@ InputDelta input_delta(const mech::MechanicalModel& m, const lcs::Lcs& sys, cons
 
 }  // namespace
 
+MatrixXd input_param_dA(const mech::MechanicalModel& m, const lcs::Lcs& sys, const SensParam& p) {
+  return input_delta(m, sys, p).A;
+}
+
 bool input_param_kind(char kind) {
   return std::string_view("aowzpvty12drlT").find(kind) != std::string_view::npos;
 }

@@ -314,15 +314,19 @@ std::string refuse_friction(const mech::Model& model, const Options& opt, std::s
     return head + "method '" + std::string(method) +
            "' does not compute sensitivities through stick / slip (methods 'event' and "
            "'moreau-jean' do)";
-  // The free acceleration's parameters and the gap offsets: f, K, D, g
-  // (sensitivity_friction.cpp); the rest moves the friction's own columns or
-  // its impacts.
-  for (const std::string& s : opt.sensitivity)
+  // The free acceleration's parameters, the gap offsets, the mass matrix and
+  // the restitutions: f, K, D, g, M, e, and a force input's own parameters
+  // (sensitivity_friction.cpp; a model with friction has no moving stop).
+  for (const std::string& s : opt.sensitivity) {
+    detail::SensParam input;
+    std::string input_error;  // parse_sensitivity reports it
     if (s != "x0" && s.rfind("mu[", 0) != 0 &&
-        !(s.size() > 1 && std::string("fgKD").find(s[0]) != std::string::npos && s[1] == '['))
+        !(s.size() > 1 && std::string("fgKDMe").find(s[0]) != std::string::npos && s[1] == '[') &&
+        !detail::parse_input_param(m, s, input, input_error))
       return "Options::sensitivity '" + s + "': not computed with friction (model '" + model.name +
              "' has mechanical.friction; through planar stick / slip x0, f[i], g[c], K[i][j], "
-             "D[i][j] and mu[c] are)";
+             "D[i][j], M[i][j], e[c], mu[c] and an input's own parameters are)";
+  }
   return "";
 }
 
