@@ -304,7 +304,9 @@ std::string refuse_friction(const mech::Model& model, const Options& opt, std::s
       "Options::sensitivity: model '" + model.name + "' has mechanical.friction; ";
   if (method == "moreau-jean") return "";
   const mech::MechanicalModel& m = *model.mechanical;
-  for (size_t f = 0; f < m.friction.size(); ++f)
+  // The exact method differentiates 3-D phases (sensitivity_cone.cpp) and
+  // reports 3-D impacts absent by name.
+  for (size_t f = 0; f < m.friction.size() && !used.event_search; ++f)
     if (m.friction[f].is_3d())
       return head + "mechanical.friction[" + std::to_string(f) +
              "] is a 3-D contact (tangent2): sensitivities through 3-D friction are not computed "
