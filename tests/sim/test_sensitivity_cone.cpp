@@ -318,8 +318,9 @@ TEST(SensitivityCone, BoxSlidingToRestAgainstCentralDifferences) {
 // start slides and stops again within a time proportional to the
 // perturbation, so its velocity's derivative is zero and its position's
 // moves by O(perturbation^2): dx(T)/dv0 = 0, dv(T)/dv0 = 0, dx(T)/dx0 = 1,
-// and a push's or mu's derivative is zero while it sticks. To 1e-12 (the
-// phase is exact to rounding).
+// and a push's or mu's derivative is zero while it sticks (the velocity
+// rows of S projected at t = 0, sensitivity_cone.cpp; d = 1 and the planar
+// model too). To 1e-12 (the phase is exact to rounding).
 TEST(SensitivityCone, StickAtRestStart) {
   for (int d : {2, 4}) {
     const sim::Trajectory tr =
@@ -331,6 +332,21 @@ TEST(SensitivityCone, StickAtRestStart) {
       for (int r = 0; r < 6; ++r)
         EXPECT_NEAR(tr.dx_final(r, c), (c == r && c < 2) ? 1.0 : 0.0, 1e-12) << r << ", " << c;
     }
+  }
+  // Planar (one tangent, x; the planar model and a 3-D contact with d = 1)
+  // pushed along x: the same along x, while y (no friction) moves freely:
+  // dy(T)/dvy0 = T, dvy/dvy0 = 1.
+  for (const bool planar : {true, false}) {
+    const sim::Trajectory tr =
+        run(point(1, 1.0, 0.0, planar), VectorXd::Zero(6), 0.5, {"x0", "f[0]", "mu[floor]"});
+    ASSERT_TRUE(tr.ok()) << tr.message;
+    ASSERT_TRUE(tr.events.empty());
+    for (int c : {0, 3, 6, 7})
+      for (int r : {0, 1, 3, 4})
+        EXPECT_NEAR(tr.dx_final(r, c), c == r && c == 0 ? 1.0 : 0.0, 1e-12) << r << ", " << c;
+    EXPECT_NEAR(tr.dx_final(1, 4), 0.5, 1e-12);
+    EXPECT_NEAR(tr.dx_final(4, 4), 1.0, 1e-12);
+    EXPECT_NEAR(tr.dx_final(0, 4), 0.0, 1e-12);
   }
 }
 
@@ -398,6 +414,65 @@ TEST(SensitivityCone, ImpactWithThreeDFrictionIsReportedAbsent) {
   ASSERT_FALSE(bt.sensitivity_losses.empty());
   EXPECT_EQ(bt.sensitivity_losses.front().contact.rfind("box", 0), 0u);
   for (size_t c = 0; c < bt.dx_final_exists.size(); ++c) EXPECT_FALSE(bt.dx_final_exists[c]);
+}
+
+// Stick -> slip at the polygon's boundary and back: the point (2 kg, at
+// rest on the floor) pulled by springs k = 20 N/m on x and y from a free
+// 1 kg mass (x2, y2) launched at (3, 1) m/s: the spring force grows past mu
+// m g = 5.9 N, the stick force leaves the polygon (a
+// slip from rest, its sliding monitor starting at order 2), the slide turns
+// through edges and faces and sticks again as the spring swings back. x0,
+// f, K, mu against central differences at x(T) and every event.
+TEST(SensitivityCone, SpringPulledStickSlipAgainstCentralDifferences) {
+  int compared = 0;
+  for (int d : {2, 4}) {
+    mech::MechanicalModel m;
+    m.M = Eigen::VectorXd((Eigen::VectorXd(5) << 2, 2, 2, 1, 1).finished())
+              .asDiagonal()
+              .toDenseMatrix()
+              .sparseView();
+    Eigen::MatrixXd K = Eigen::MatrixXd::Zero(5, 5);
+    for (const auto& [a, b] : {std::pair{0, 3}, std::pair{1, 4}}) {
+      K(a, a) = K(b, b) = 20.0;
+      K(a, b) = K(b, a) = -20.0;
+    }
+    m.K = K.sparseView();
+    m.D = Eigen::SparseMatrix<double>(5, 5);
+    m.E = (Eigen::RowVectorXd(5) << 0, 0, 1, 0, 0).finished().sparseView();
+    m.f = (VectorXd(5) << 0, 0, -2.0 * kG, 0, 0).finished();
+    m.constraints = {"floor"};
+    mech::FrictionalContact c(0, (VectorXd(5) << 1, 0, 0, 0, 0).finished(), kMu);
+    c.tangent2 = (VectorXd(5) << 0, 1, 0, 0, 0).finished().sparseView();
+    c.edges = d;
+    m.friction.push_back(c);
+    const mech::Model model = mech::model_of(m, "pulled3d");
+    std::vector<test_support::FdColumn> params;
+    params.push_back(
+        param("f[3]", 0.0, [](mech::MechanicalModel& mm, double dd) { mm.f(3) += dd; }));
+    params.push_back(param(
+        "K[0][3]", -20.0, [](mech::MechanicalModel& mm, double dd) { mm.K.coeffRef(0, 3) += dd; }));
+    params.push_back(param("mu[floor]", kMu,
+                           [](mech::MechanicalModel& mm, double dd) { mm.friction[0].mu += dd; }));
+    // From rest (stuck; the first event is stick -> slip): the parameters
+    // (a perturbed velocity would slide and stick again: StickAtRestStart).
+    const VectorXd rest = (VectorXd(10) << 0, 0, 0, 0, 0, 0, 0, 0, 3, 1).finished();
+    const sim::Trajectory tr = run(model, rest, 1.0, {});
+    ASSERT_TRUE(tr.ok()) << tr.message;
+    EXPECT_EQ(tr.events.size(), d == 2 ? 5u : 2u);
+    compared += expect_fd(model, rest, 1.0, params);
+    // Sliding at the start (0.5, -0.3) m/s: x0 and the parameters.
+    const VectorXd x0 = (VectorXd(10) << 0, 0, 0, 0, 0, 0.5, -0.3, 0, 3, 1).finished();
+    std::vector<test_support::FdColumn> cols = x0_columns(x0);
+    cols.insert(cols.end(), params.begin(), params.end());
+    const sim::Trajectory ts = run(model, x0, 1.0, {});
+    ASSERT_TRUE(ts.ok()) << ts.message;
+    EXPECT_EQ(ts.events.size(), d == 2 ? 2u : 4u);
+    compared += expect_fd(model, x0, 1.0, cols);
+  }
+  // From rest: 3 columns on 10 states and 5 (d = 2) or 2 events; sliding:
+  // x0's 10 entries less z, vz (a zero gap at the start) and the 3
+  // parameters, on 10 states and 2 (d = 2) or 4 events.
+  EXPECT_EQ(compared, 3 * 15 + 3 * 12 + 11 * 12 + 11 * 14);
 }
 
 }  // namespace

@@ -749,7 +749,9 @@ void Sensitivity::after_event(const EventResult& ev, const Phase& next, double t
   limit(ev.rounds.size());
   const VectorXd xdot_plus = next.Acl * x_plus;
   MatrixXd S = J * S_minus_ + (J * xdot_minus_ - xdot_plus) * dtau_ + dR;
-  if (has_3d_ && t == 0.0 && trigger < 0) project_cone_start(next, S);
+  // A start at rest (stick) or on a face's bisector: see project_friction_start.
+  if (mech_ && model_.mechanical->has_friction() && t == 0.0 && trigger < 0)
+    project_friction_start(next, S);
   begin_phase(next, t, x_plus, S);
 }
 

@@ -164,7 +164,7 @@ class Sensitivity {
   double cone_monitor_dh(size_t p, size_t monitor, const VectorXd& x) const;
   void check_cone_start(const Monitor& mon, FrictionMode mode, double t, int m0, int trigger,
                         bool stuck);
-  void project_cone_start(const Phase& ph, MatrixXd& S) const;
+  void project_friction_start(const Phase& ph, MatrixXd& S) const;
   // Before an event ended by monitor `mon` of a cone entry: the losses of
   // its non-generic forms (a slide stopping on an edge, a stick force
   // reaching the polygon at a vertex).

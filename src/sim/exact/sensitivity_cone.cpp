@@ -23,7 +23,10 @@
 // of the held rows: the velocity's derivative is the M-orthogonal
 // projection onto H v = 0 (the saltation of the slip -> stick or edge ->
 // face event as its time goes to 0), the positions' is unchanged (they
-// move by O(perturbation^2)).
+// move by O(perturbation^2)). The same holds for a planar contact sticking
+// at the start (its row t), so the projection is applied on every model
+// with friction (before it, a planar stick at t = 0 gave dv(T)/dv0 = 1 and
+// dx(T)/dv0 = T where both are 0).
 //
 // 3-D impacts (impact::moreau with a cone, Stewart–Trinkle at its outcome)
 // are not differentiated: a round with a 3-D contact loses every column,
@@ -183,7 +186,10 @@ double Sensitivity::cone_monitor_dh(size_t p, size_t monitor, const VectorXd& x)
 // stick force leaving the polygon at a vertex: both of the edge's bisector
 // monitors at zero); the bisector just crossed by a moving velocity from
 // one edge's region into the next (m0 = 1: a face whose force would leave
-// the face, so the velocity crosses its bisector transversally). At t = 0, slip from rest (a push
+// the face, so the velocity crosses its bisector transversally); a sliding
+// velocity that passed through zero (a face slide's speed reaching zero
+// under a pull beyond the polygon, as a planar slip reverses: the new
+// slip starts from rest along the acceleration, m0 = 1). At t = 0, slip from rest (a push
 // beyond the polygon): the x0 entries that move the sliding velocity are one-sided, the others
 // kept. Anything else (a stick force on the polygon's boundary, a face
 // force at an end of the face, a velocity on the boundary of an edge's
@@ -198,8 +204,8 @@ void Sensitivity::check_cone_start(const Monitor& mon, FrictionMode mode, double
       (VectorXd(fc.tangent).cwiseAbs() + VectorXd(fc.tangent2).cwiseAbs()).dot(v.cwiseAbs());
   const bool at_rest = std::hypot(s1, s2) <= kSqrtEps * scale;
   const bool edge = cone_slip(mode) && !cone_on_face(mode);
-  if (!mon.multiplier && mon.constraint == trigger && !(edge && at_rest) &&
-      ((m0 == 1 && !stuck && !at_rest) || (m0 == 2 && stuck)))
+  if (!mon.multiplier && mon.constraint == trigger &&
+      ((m0 == 1 && !stuck) || (m0 == 2 && stuck && !(edge && at_rest))))
     return;
   if (t == 0.0 && trigger < 0 && !mon.multiplier && at_rest && m0 == 1) {
     std::vector<int> cols;
@@ -279,7 +285,7 @@ void Sensitivity::check_cone_event(double tau, const VectorXd& x_minus, size_t m
 // At t = 0: the velocity rows of S projected M-orthogonally onto H v = 0
 // (the phase's normals and the rows mode selection set to zero: stick's t,
 // t2, a face's cross row), see the header.
-void Sensitivity::project_cone_start(const Phase& ph, MatrixXd& S) const {
+void Sensitivity::project_friction_start(const Phase& ph, MatrixXd& S) const {
   const mech::MechanicalModel& m = *model_.mechanical;
   std::vector<RowVectorXd> held;
   for (size_t f = 0; f < ph.friction.size(); ++f) {
