@@ -34,6 +34,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <string>
 
 #include "sim/exact/sensitivity.hpp"
 
@@ -125,6 +126,12 @@ void Sensitivity::cone_mode_derivatives(const Phase& ph, double t) {
   if (nc > 0) friction_F_ = -lu.solve(H * Av);
   for (size_t p = 0; p < P; ++p) {
     const SensParam& sp = cols_.params[p];
+    if (std::string("fKDuge").find(sp.kind) == std::string::npos) {
+      // M[i][j], an input's: not derived here (never a silent zero).
+      lose(t, -1, "'" + sp.name + "' is not computed through 3-D friction",
+           {nx0_ + static_cast<int>(p)});
+      continue;
+    }
     MatrixXd dAv = MatrixXd::Zero(N_, n_), dF = MatrixXd::Zero(nc, n_);
     if (sp.kind == 'f') dAv.col(2 * N_) = G_.col(sp.i);
     if (sp.kind == 'K') dAv.col(sp.j) = -G_.col(sp.i);
