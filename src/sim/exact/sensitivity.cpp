@@ -740,8 +740,10 @@ void Sensitivity::after_event(const EventResult& ev, const Phase& next, double t
       limit(i);
       const auto& rd = ev.rounds[i];
       MatrixXd Jr, dRr = MatrixXd::Zero(n_, m_);
-      if (friction && has_3d_ && !cone_impact_covered(t, rd)) break;
-      if (friction ? !friction_impact_map(t, rd, Jr, dRr) : !impact_map(t, rd, Jr, dRr)) break;
+      if (friction
+              ? !(has_3d_ ? cone_impact_map(t, rd, Jr, dRr) : friction_impact_map(t, rd, Jr, dRr))
+              : !impact_map(t, rd, Jr, dRr))
+        break;
       J = Jr * J;
       dR = Jr * dR + dRr;
     }

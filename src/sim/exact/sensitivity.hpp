@@ -8,7 +8,7 @@
 //   sensitivity_friction.cpp  an impact with planar friction at its outcome
 //   sensitivity_cone.cpp   phases with 3-D contacts on a polyhedral cone
 //                          (stick, edge and face slip), their monitors and
-//                          starts; 3-D impacts reported absent
+//                          starts; sensitivity_cone_impact.cpp their impacts
 //   sensitivity_lcs.cpp    a general LCS's parts: dAcl/dtheta of a mode for
 //                          the entries of A, B, C, D, and the jump P_I x
 //   sensitivity_inputs.cpp an input's own parameters (a sine's, a piecewise
@@ -159,7 +159,9 @@ class Sensitivity {
   // entries as friction_mode_derivatives); a cone monitor's parameter term;
   // a cone monitor starting at zero; at t = 0 the projection of S onto the
   // rows that mode selection put at zero (stick, a face's cross row); an
-  // impact round with a 3-D contact (false: every column lost, by name).
+  // impact round with a 3-D contact closed (sensitivity_cone_impact.cpp:
+  // Stewart–Trinkle at its outcome; false, every column lost, where it is
+  // not locally constant), else friction_impact_map.
   void cone_mode_derivatives(const Phase& ph, double t);
   double cone_monitor_dh(size_t p, size_t monitor, const VectorXd& x) const;
   void check_cone_start(const Monitor& mon, FrictionMode mode, double t, int m0, int trigger,
@@ -169,7 +171,7 @@ class Sensitivity {
   // its non-generic forms (a slide stopping on an edge, a stick force
   // reaching the polygon at a vertex).
   void check_cone_event(double tau, const VectorXd& x_minus, size_t monitor);
-  bool cone_impact_covered(double t, const EventResult::ImpactRound& round);
+  bool cone_impact_map(double t, const EventResult::ImpactRound& round, MatrixXd& J, MatrixXd& dR);
   bool is_cone_entry(int f) const {
     return f >= 0 && static_cast<size_t>(f) < cone_d_.size() &&
            cone_d_[static_cast<size_t>(f)] >= 2;

@@ -28,9 +28,7 @@
 // with friction (before it, a planar stick at t = 0 gave dv(T)/dv0 = 1 and
 // dx(T)/dv0 = T where both are 0).
 //
-// 3-D impacts (impact::moreau with a cone, Stewart–Trinkle at its outcome)
-// are not differentiated: a round with a 3-D contact loses every column,
-// naming the contact.
+// Impacts with a 3-D contact: sensitivity_cone_impact.cpp.
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -311,21 +309,6 @@ void Sensitivity::project_friction_start(const Phase& ph, MatrixXd& S) const {
   // multipliers still give the projection onto H v = 0.
   const MatrixXd V = S.middleRows(N_, N_);
   S.middleRows(N_, N_) = V - GHt * (H * GHt).completeOrthogonalDecomposition().solve(H * V);
-}
-
-// An impact round with a 3-D contact closed: its derivative (Stewart–
-// Trinkle at the outcome) is not computed; every column lost, by name.
-bool Sensitivity::cone_impact_covered(double t, const EventResult::ImpactRound& rd) {
-  const mech::MechanicalModel& m = *model_.mechanical;
-  for (const mech::FrictionalContact& fc : m.friction)
-    if (fc.is_3d() &&
-        std::find(rd.closed.begin(), rd.closed.end(), fc.contact) != rd.closed.end()) {
-      lose_all(t, fc.contact,
-               "an impact with 3-D friction: its derivative is not computed (3-D impacts are "
-               "absent)");
-      return false;
-    }
-  return true;
 }
 
 }  // namespace lcsim::sim::detail
