@@ -284,7 +284,7 @@ void Sensitivity::check_cone_event(double tau, const VectorXd& x_minus, size_t m
                  : "coinciding stick / slip events (another friction monitor reaches zero with "
                    "this one: contacts turning or stopping together, a stick force at the "
                    "polygon's vertex), no derivative in the entries that part them",
-       cols, true);
+       cols);
 }
 
 // At t = 0: the velocity rows of S projected M-orthogonally onto H v = 0
