@@ -52,6 +52,11 @@ Sensitivity::Sensitivity(const mech::Model& model, const lcs::Lcs& sys, const Se
   m_ = nx0_ + static_cast<int>(cols.params.size());
   exists_.assign(static_cast<size_t>(m_), 1);
   if (mech_) G_ = dense(model.mechanical->M).inverse();
+  if (mech_)
+    for (const mech::FrictionalContact& fc : model.mechanical->friction) {
+      cone_d_.push_back(model.mechanical->edges_of(fc));
+      has_3d_ = has_3d_ || fc.is_3d();
+    }
 }
 
 std::vector<std::string> Sensitivity::column_names() const {
@@ -246,7 +251,8 @@ void Sensitivity::begin_phase(const Phase& ph, double t0, const VectorXd& xa, co
   for (Monitor& mon : monitors_) mon.w = mon.w.cwiseQuotient(ph.D.transpose());
   const bool friction = mech_ && model_.mechanical->has_friction() && !cols_.params.empty();
   if (std::any_of(exists_.begin(), exists_.end(), [](char e) { return e != 0; }))
-    friction ? friction_mode_derivatives(ph, t0) : mode_derivatives(ph.mode, t0);
+    friction ? (has_3d_ ? cone_mode_derivatives(ph, t0) : friction_mode_derivatives(ph, t0))
+             : mode_derivatives(ph.mode, t0);
   else
     dAb_.clear(), dF_.assign(cols_.params.size(), MatrixXd()),
         dW_.assign(cols_.params.size(), MatrixXd());  // at() carries nothing
@@ -560,7 +566,9 @@ void Sensitivity::before_event(double tau, const VectorXd& x_minus, int monitor)
     const SensParam& sp = cols_.params[p];
     const Eigen::Index c = nx0_ + static_cast<Eigen::Index>(p);
     if (mon.friction >= 0) {  // a stick force's or a sliding velocity's
-      if (dF_[p].size() > 0) dh(c) += friction_monitor_dh(p, static_cast<size_t>(monitor), x_minus);
+      if (dF_[p].size() > 0)
+        dh(c) += has_3d_ ? cone_monitor_dh(p, static_cast<size_t>(monitor), x_minus)
+                         : friction_monitor_dh(p, static_cast<size_t>(monitor), x_minus);
       continue;
     }
     if (!mon.multiplier && sp.kind == 'g' && sp.i == mon.constraint) dh(c) += 1.0;
@@ -571,6 +579,7 @@ void Sensitivity::before_event(double tau, const VectorXd& x_minus, int monitor)
     }
   }
   dtau_ = -dh / rate;
+  if (has_3d_) check_cone_event(tau, x_minus, static_cast<size_t>(monitor));
   for (int c = 0; c < m_; ++c)
     if (!exists_[static_cast<size_t>(c)]) dtau_(c) = 0.0;
 }
@@ -731,7 +740,10 @@ void Sensitivity::after_event(const EventResult& ev, const Phase& next, double t
       limit(i);
       const auto& rd = ev.rounds[i];
       MatrixXd Jr, dRr = MatrixXd::Zero(n_, m_);
-      if (friction ? !friction_impact_map(t, rd, Jr, dRr) : !impact_map(t, rd, Jr, dRr)) break;
+      if (friction
+              ? !(has_3d_ ? cone_impact_map(t, rd, Jr, dRr) : friction_impact_map(t, rd, Jr, dRr))
+              : !impact_map(t, rd, Jr, dRr))
+        break;
       J = Jr * J;
       dR = Jr * dR + dRr;
     }
@@ -740,6 +752,9 @@ void Sensitivity::after_event(const EventResult& ev, const Phase& next, double t
   if (mech_) plastic_restitution(ev, next, t);
   const VectorXd xdot_plus = next.Acl * x_plus;
   MatrixXd S = J * S_minus_ + (J * xdot_minus_ - xdot_plus) * dtau_ + dR;
+  // A start at rest (stick) or on a face's bisector: see project_friction_start.
+  if (mech_ && model_.mechanical->has_friction() && t == 0.0 && trigger < 0)
+    project_friction_start(next, S);
   begin_phase(next, t, x_plus, S);
 }
 
@@ -784,7 +799,11 @@ void Sensitivity::check_phase_start(const Phase& ph, double t, const std::vector
     const Monitor& mon = ph.monitors[j];
     if (m0[j] == 0) continue;
     if (mon.friction >= 0) {
-      check_friction_start(mon, t, m0[j], trigger, stuck);
+      if (is_cone_entry(mon.friction))
+        check_cone_start(mon, ph.friction[static_cast<size_t>(mon.friction)], t, m0[j], trigger,
+                         stuck);
+      else
+        check_friction_start(mon, t, m0[j], trigger, stuck);
       continue;
     }
     // A multiplier starting at zero (with a nonzero rate for the contact

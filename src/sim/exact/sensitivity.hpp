@@ -6,6 +6,9 @@
 //                          equation S' = Acl S + (dAcl/dtheta) x, at an event
 //                          the saltation matrix
 //   sensitivity_friction.cpp  an impact with planar friction at its outcome
+//   sensitivity_cone.cpp   phases with 3-D contacts on a polyhedral cone
+//                          (stick, edge and face slip), their monitors and
+//                          starts; sensitivity_cone_impact.cpp their impacts
 //   sensitivity_lcs.cpp    a general LCS's parts: dAcl/dtheta of a mode for
 //                          the entries of A, B, C, D, and the jump P_I x
 //   sensitivity_inputs.cpp an input's own parameters (a sine's, a piecewise
@@ -157,6 +160,28 @@ class Sensitivity {
   void input_start(MatrixXd& S);
   VectorXd input_impact_dv(size_t p, const std::vector<int>& A, const MatrixXd& EA,
                            const Eigen::LDLT<MatrixXd>& Wf, const VectorXd& one_e) const;
+  // Models with a 3-D contact (sensitivity_cone.cpp): a phase's dAcl and
+  // dF for f[i], K[i][j], D[i][j], mu[c] with cone rows and columns (planar
+  // entries as friction_mode_derivatives); a cone monitor's parameter term;
+  // a cone monitor starting at zero; at t = 0 the projection of S onto the
+  // rows that mode selection put at zero (stick, a face's cross row); an
+  // impact round with a 3-D contact closed (sensitivity_cone_impact.cpp:
+  // Stewart–Trinkle at its outcome; false, every column lost, where it is
+  // not locally constant), else friction_impact_map.
+  void cone_mode_derivatives(const Phase& ph, double t);
+  double cone_monitor_dh(size_t p, size_t monitor, const VectorXd& x) const;
+  void check_cone_start(const Monitor& mon, FrictionMode mode, double t, int m0, int trigger,
+                        bool stuck);
+  void project_friction_start(const Phase& ph, MatrixXd& S) const;
+  // Before an event ended by monitor `mon` of a cone entry: the losses of
+  // its non-generic forms (a slide stopping on an edge, a stick force
+  // reaching the polygon at a vertex).
+  void check_cone_event(double tau, const VectorXd& x_minus, size_t monitor);
+  bool cone_impact_map(double t, const EventResult::ImpactRound& round, MatrixXd& J, MatrixXd& dR);
+  bool is_cone_entry(int f) const {
+    return f >= 0 && static_cast<size_t>(f) < cone_d_.size() &&
+           cone_d_[static_cast<size_t>(f)] >= 2;
+  }
   std::string contact_name(int r) const;
   bool same_event(const Monitor& other, const Monitor& mon) const;
   void check_friction_start(const Monitor& mon, double t, int m0, int trigger, bool stuck);
@@ -240,6 +265,12 @@ class Sensitivity {
   std::vector<int> co_triggers_;
   bool trigger_stick_ = false;
   std::vector<Eigen::Index> stick_row_;  // per friction entry: its row of dF (-1 if not stuck)
+  // Models with a 3-D contact: d per friction entry (1 planar), the phase's
+  // modes and each entry's first held row of dF / friction_F_ (-1 if none).
+  bool has_3d_ = false;
+  std::vector<int> cone_d_;
+  std::vector<FrictionMode> cone_modes_;
+  std::vector<Eigen::Index> cone_first_;
   MatrixXd friction_F_;  // the friction phase's forces (normals, sticking tangents)  //
                          // the trigger was a stick force reaching the cone's edge
 };
