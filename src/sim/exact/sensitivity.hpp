@@ -108,6 +108,9 @@ class Sensitivity {
   struct DenseBlock;
   const DenseBlock& dense_block(double tau, bool params);
   const DenseBlock* find_block(double tau, bool params) const;
+  // Marks the kept blocks formed from the current phase's matrices
+  // (DenseBlock::fits), once per phase: find_block then compares lengths only.
+  void match_blocks();
   // A large phase: whether the x0 block goes by Phi (formed, Pade) rather
   // than by the Taylor action on its columns, by their estimated costs.
   bool x0_by_exponential(double tau) const;
@@ -200,10 +203,18 @@ class Sensitivity {
     // columns (one augmented exponential of size n + their count).
     MatrixXd Gamma;
     std::vector<MatrixXd> Psi;  // per parameter (Van Loan, size 2n), others
+    // Formed from the current phase's mode, Ab, D and constant forcings
+    // (fits), and its parameters' forcings dAb too (fits_params): set by
+    // match_blocks at each phase start and for a block formed in it.
+    bool fits = false, fits_params = false;
+    // Steps it served, and when it was formed: once the cache is full, the
+    // least used block goes (an event's one-off length before a grid step's).
+    mutable long uses = 0;
+    long formed = 0;
   };
   bool dense_ = false;
   std::vector<DenseBlock> dense_cache_;
-  size_t dense_next_ = 0;  // the cache's slot to reuse once full
+  long dense_formed_ = 0;  // blocks formed so far (DenseBlock::formed)
   MatrixXd next_;          // at_dense's product (kept: no allocation per sample)
   VectorXd znext_;
   double Ab_norm1_ = 0.0;  // ||Ab||_1 (norm1_ adds the parameters')
