@@ -444,10 +444,11 @@ bool Sensitivity::x0_by_exponential(double tau) const {
 // count, one for all of them; its upper-left block is Phi); for the others
 // Psi_p, the upper-right block of e^{[Ab dAb_p; 0 Ab] tau} (Van Loan, size
 // 2n). By Pade with scaling and squaring. Kept per tau and phase matrix
-// (samples share dt_out; phases of one mode share Ab), eight at most.
+// (samples share dt_out; phases of one mode share Ab), the least recently
+// used dropped first.
 const Sensitivity::DenseBlock& Sensitivity::dense_block(double tau, bool params) {
   if (const DenseBlock* c = find_block(tau, params)) {
-    ++c->uses;
+    c->used = ++dense_clock_;
     return *c;
   }
   DenseBlock b;
@@ -480,16 +481,22 @@ const Sensitivity::DenseBlock& Sensitivity::dense_block(double tau, bool params)
   }
   b.fits = true;
   b.fits_params = params;
-  b.uses = 1;
-  b.formed = dense_formed_++;
-  if (dense_cache_.size() < 8) {
+  b.used = ++dense_clock_;
+  // As many blocks as fit in ~4 MB (a block keeps Ab and Phi, and per
+  // parameter dAb and Psi: (2 + 2P) n^2 doubles), 8 to 32: a grid step's
+  // length takes several roundings of dt (t_k - t_(k-1)), each its own
+  // block, and phases of a few modes alternate (the NAO legs to 0.28 s: 19
+  // blocks, 19 exponentials, where 8 kept the same 19).
+  const double block_bytes = 8.0 * (2.0 + 2.0 * static_cast<double>(cols_.params.size())) *
+                             static_cast<double>(n_) * static_cast<double>(n_);
+  const size_t capacity = static_cast<size_t>(std::clamp(4e6 / block_bytes, 8.0, 32.0));
+  if (dense_cache_.size() < capacity) {
     dense_cache_.push_back(std::move(b));
     return dense_cache_.back();
   }
-  auto worse = [](const DenseBlock& x, const DenseBlock& y) {
-    return x.uses != y.uses ? x.uses < y.uses : x.formed < y.formed;
-  };
-  DenseBlock& slot = *std::min_element(dense_cache_.begin(), dense_cache_.end(), worse);
+  DenseBlock& slot =
+      *std::min_element(dense_cache_.begin(), dense_cache_.end(),
+                        [](const DenseBlock& x, const DenseBlock& y) { return x.used < y.used; });
   slot = std::move(b);
   return slot;
 }

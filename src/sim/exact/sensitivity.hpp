@@ -207,15 +207,14 @@ class Sensitivity {
     // (fits), and its parameters' forcings dAb too (fits_params): set by
     // match_blocks at each phase start and for a block formed in it.
     bool fits = false, fits_params = false;
-    // Steps it served, and when it was formed: once the cache is full, the
-    // least used block goes (an event's one-off length before a grid step's).
-    mutable long uses = 0;
-    long formed = 0;
+    // When it last served a step (dense_clock_): once the cache is full, the
+    // least recently used block goes.
+    mutable long used = 0;
   };
   bool dense_ = false;
   std::vector<DenseBlock> dense_cache_;
-  long dense_formed_ = 0;  // blocks formed so far (DenseBlock::formed)
-  MatrixXd next_;          // at_dense's product (kept: no allocation per sample)
+  long dense_clock_ = 0;  // steps served by blocks so far (DenseBlock::used)
+  MatrixXd next_;         // at_dense's product (kept: no allocation per sample)
   VectorXd znext_;
   double Ab_norm1_ = 0.0;  // ||Ab||_1 (norm1_ adds the parameters')
   // Per parameter in the current phase: the nonzero columns of dAb when few
