@@ -23,6 +23,34 @@ namespace {
 
 MatrixXd dense(const Eigen::SparseMatrix<double>& A) { return MatrixXd(A); }
 
+// e^{[Ab b; 0 0] tau} (Pade with scaling and squaring, Eigen's): Phi =
+// e^{Ab tau} its upper-left block, Gamma = int_0^tau e^{Ab s} ds b its
+// upper-right one (b: none, or the constant forcings' columns). Up to 16
+// rows in a matrix type of that bounded size, whose temporaries live on the
+// stack: the same arithmetic (the same products and pivots, the same
+// numbers bit for bit), without the ~20 heap allocations of the dynamic
+// type's, which cost a small phase's exponential (n = 12) about a sixth.
+template <class Mat>
+void augmented_exp_as(const MatrixXd& Ab, const MatrixXd& b, double tau, MatrixXd& Phi,
+                      MatrixXd& Gamma) {
+  const Eigen::Index n = Ab.rows(), nc = b.cols();
+  Mat big = Mat::Zero(n + nc, n + nc);
+  big.topLeftCorner(n, n) = Ab * tau;
+  big.topRightCorner(n, nc) = b * tau;
+  const Mat e = big.exp();
+  Phi = e.topLeftCorner(n, n);
+  Gamma = e.topRightCorner(n, nc);
+}
+
+void augmented_exp(const MatrixXd& Ab, const MatrixXd& b, double tau, MatrixXd& Phi,
+                   MatrixXd& Gamma) {
+  using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 16, 16>;
+  if (Ab.rows() + b.cols() <= 16)
+    augmented_exp_as<Small>(Ab, b, tau, Phi, Gamma);
+  else
+    augmented_exp_as<MatrixXd>(Ab, b, tau, Phi, Gamma);
+}
+
 // The exosystem columns of H = [-K -D f H_w] (docs/inputs.md): a force input
 // enters the v rows of A as M^{-1} gain times its output row, so H_w is gain
 // times that row at the input's exosystem states (after (q, v, 1)).
@@ -271,6 +299,7 @@ void Sensitivity::begin_phase(const Phase& ph, double t0, const VectorXd& xa, co
   zc_ = xa.cwiseQuotient(D_);
   dense_ = !use_sparse_ && n_ <= Phase::kDenseExpMax;
   forcing_structure();
+  match_blocks();
 }
 
 // Each parameter's forcing dAb z along the phase: dAb's nonzero columns
@@ -421,9 +450,13 @@ bool Sensitivity::x0_by_exponential(double tau) const {
 // count, one for all of them; its upper-left block is Phi); for the others
 // Psi_p, the upper-right block of e^{[Ab dAb_p; 0 Ab] tau} (Van Loan, size
 // 2n). By Pade with scaling and squaring. Kept per tau and phase matrix
-// (samples share dt_out; phases of one mode share Ab), eight at most.
+// (samples share dt_out; phases of one mode share Ab), the least recently
+// used dropped first.
 const Sensitivity::DenseBlock& Sensitivity::dense_block(double tau, bool params) {
-  if (const DenseBlock* c = find_block(tau, params)) return *c;
+  if (const DenseBlock* c = find_block(tau, params)) {
+    c->used = ++dense_clock_;
+    return *c;
+  }
   DenseBlock b;
   b.tau = tau;
   b.params = params;
@@ -434,14 +467,7 @@ const Sensitivity::DenseBlock& Sensitivity::dense_block(double tau, bool params)
   if (params) b.dAb = dAb_;
   if (params) {
     const Eigen::Index nc = static_cast<Eigen::Index>(const_.size());
-    if (nc > 0) {
-      MatrixXd big = MatrixXd::Zero(n_ + nc, n_ + nc);
-      big.topLeftCorner(n_, n_) = Ab_;
-      big.topRightCorner(n_, nc) = forcing_;
-      const MatrixXd e = (big * tau).exp();
-      b.Phi = e.topLeftCorner(n_, n_);
-      b.Gamma = e.topRightCorner(n_, nc);
-    }
+    if (nc > 0) augmented_exp(Ab_, forcing_, tau, b.Phi, b.Gamma);
     b.Psi.assign(cols_.params.size(), MatrixXd());
     for (size_t p = 0; p < cols_.params.size() && p < dAb_.size(); ++p) {
       const MatrixXd& d = dAb_[p];
@@ -455,22 +481,43 @@ const Sensitivity::DenseBlock& Sensitivity::dense_block(double tau, bool params)
       if (b.Phi.size() == 0) b.Phi = e.topLeftCorner(n_, n_);  // e^{Ab tau}
     }
   }
-  if (b.Phi.size() == 0) b.Phi = (Ab_ * tau).exp();
-  if (dense_cache_.size() < 8) {
+  if (b.Phi.size() == 0) {
+    MatrixXd none;
+    augmented_exp(Ab_, MatrixXd(n_, 0), tau, b.Phi, none);
+  }
+  b.fits = true;
+  b.fits_params = params;
+  b.used = ++dense_clock_;
+  // As many blocks as fit in ~4 MB (a block keeps Ab and Phi, and per
+  // parameter dAb and Psi: (2 + 2P) n^2 doubles), 8 to 32: a grid step's
+  // length takes several roundings of dt (t_k - t_(k-1)), each its own
+  // block, and phases of a few modes alternate (the NAO legs to 0.28 s: 19
+  // blocks, 19 exponentials, where 8 kept the same 19).
+  const double block_bytes = 8.0 * (2.0 + 2.0 * static_cast<double>(cols_.params.size())) *
+                             static_cast<double>(n_) * static_cast<double>(n_);
+  const size_t capacity = static_cast<size_t>(std::clamp(4e6 / block_bytes, 8.0, 32.0));
+  if (dense_cache_.size() < capacity) {
     dense_cache_.push_back(std::move(b));
     return dense_cache_.back();
   }
-  DenseBlock& slot = dense_cache_[dense_next_++ % dense_cache_.size()];
+  DenseBlock& slot =
+      *std::min_element(dense_cache_.begin(), dense_cache_.end(),
+                        [](const DenseBlock& x, const DenseBlock& y) { return x.used < y.used; });
   slot = std::move(b);
   return slot;
 }
 
 // The kept block for tau of this phase's matrix (its mode, Ab, D and
-// constant forcings: dAb and Psi follow from the mode and D), or null. The
-// same tau exactly: grid steps that differ from dt by an ulp (the rounding
-// of k dt) take their own exponential, as before, so S is not moved even by
-// rounding (the system identification example's Gauss-Newton stops on a
-// cost that must fall at 1e-10 relative steps).
+// constant forcings, and with `params` its parameters' forcings: fits and
+// fits_params, set once per phase by match_blocks), or null. The same tau
+// exactly: grid steps that differ from dt by an ulp (the rounding of k dt)
+// take their own exponential, so S is not moved even by rounding. Taking
+// them as dt (as GridSampler::at takes the plain run's samples) would save
+// 11 of the 19 exponentials of the NAO legs' f[0] run to 0.28 s, but it
+// moves S by ~1e-16 relative, and the system identification example's
+// Gauss-Newton (examples/python/system_identification.py), which stops on
+// a cost that must not rise at 1e-10 relative steps, then fails to converge
+// on seed 1 (measured).
 namespace {
 // Two phases' parameter forcings dAb, bit for bit (a block's Psi is formed
 // from them: the mode and Ab alone do not fix an input's or a friction
@@ -485,11 +532,16 @@ bool same_forcings(const std::vector<MatrixXd>& a, const std::vector<MatrixXd>& 
 
 const Sensitivity::DenseBlock* Sensitivity::find_block(double tau, bool params) const {
   for (const DenseBlock& c : dense_cache_)
-    if (c.tau == tau && (c.params || !params) && c.mode == mode_ && c.Ab.rows() == Ab_.rows() &&
-        c.Ab == Ab_ && c.D == D_ && c.forcing.cols() == forcing_.cols() && c.forcing == forcing_ &&
-        (!params || same_forcings(c.dAb, dAb_)))
-      return &c;
+    if (c.tau == tau && c.fits && (!params || c.fits_params)) return &c;
   return nullptr;
+}
+
+void Sensitivity::match_blocks() {
+  for (DenseBlock& c : dense_cache_) {
+    c.fits = c.mode == mode_ && c.Ab.rows() == Ab_.rows() && c.Ab == Ab_ && c.D == D_ &&
+             c.forcing.cols() == forcing_.cols() && c.forcing == forcing_;
+    c.fits_params = c.fits && c.params && same_forcings(c.dAb, dAb_);
+  }
 }
 
 // A dense phase (n <= Phase::kDenseExpMax, as the phase's own exponential):

@@ -115,6 +115,9 @@ class Sensitivity {
   struct DenseBlock;
   const DenseBlock& dense_block(double tau, bool params);
   const DenseBlock* find_block(double tau, bool params) const;
+  // Marks the kept blocks formed from the current phase's matrices
+  // (DenseBlock::fits), once per phase: find_block then compares lengths only.
+  void match_blocks();
   // A large phase: whether the x0 block goes by Phi (formed, Pade) rather
   // than by the Taylor action on its columns, by their estimated costs.
   bool x0_by_exponential(double tau) const;
@@ -231,11 +234,18 @@ class Sensitivity {
     // columns (one augmented exponential of size n + their count).
     MatrixXd Gamma;
     std::vector<MatrixXd> Psi;  // per parameter (Van Loan, size 2n), others
+    // Formed from the current phase's mode, Ab, D and constant forcings
+    // (fits), and its parameters' forcings dAb too (fits_params): set by
+    // match_blocks at each phase start and for a block formed in it.
+    bool fits = false, fits_params = false;
+    // When it last served a step (dense_clock_): once the cache is full, the
+    // least recently used block goes.
+    mutable long used = 0;
   };
   bool dense_ = false;
   std::vector<DenseBlock> dense_cache_;
-  size_t dense_next_ = 0;  // the cache's slot to reuse once full
-  MatrixXd next_;          // at_dense's product (kept: no allocation per sample)
+  long dense_clock_ = 0;  // steps served by blocks so far (DenseBlock::used)
+  MatrixXd next_;         // at_dense's product (kept: no allocation per sample)
   VectorXd znext_;
   double Ab_norm1_ = 0.0;  // ||Ab||_1 (norm1_ adds the parameters')
   // Per parameter in the current phase: the nonzero columns of dAb when few
