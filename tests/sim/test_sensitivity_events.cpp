@@ -323,14 +323,32 @@ TEST(SensitivityEvents, FrictionRefusals) {
   opt.sensitivity = {"x0", "M[0][0]"};
   sim::Trajectory tr = sim::simulate(m, m.initial, opt, "euler");
   EXPECT_EQ(tr.status, Status::kInvalidInput);
-  EXPECT_NE(tr.message.find("'euler' does not support friction"), std::string::npos) << tr.message;
-  opt.sensitivity = {"x0"};
-  mech::Model m3 = m;
-  m3.mechanical->friction[0].tangent2 = Eigen::SparseVector<double>(2);
-  m3.mechanical->friction[0].tangent2.insert(1) = 1.0;
-  for (const char* method : {"event", "moreau-jean"}) {
-    tr = sim::simulate(m3, m3.initial, opt, method);
-    EXPECT_EQ(tr.status, Status::kInvalidInput) << method;
+  EXPECT_NE(tr.message.find("method 'euler' does not compute sensitivities through stick / slip"),
+            std::string::npos)
+      << tr.message;
+  // A point sliding on a floor with a 3-D cone: the exact method computes x0,
+  // f, g, K, D and mu through it (tests/sim/test_sensitivity_cone.cpp) and
+  // refuses M, e and an input's parameters by name.
+  mech::MechanicalModel p;
+  p.M = Eigen::MatrixXd::Identity(3, 3).sparseView();
+  p.E = Eigen::RowVector3d(0, 0, 1).sparseView();
+  p.f = Eigen::Vector3d(0, 0, -9.81);
+  mech::FrictionalContact c(0, Eigen::Vector3d(1, 0, 0), 0.3);
+  c.tangent2 = Eigen::Vector3d(0, 1, 0).sparseView();
+  p.friction.push_back(c);
+  const mech::Model m3 = mech::model_of(p, "point3d");
+  const VectorXd x0 = (VectorXd(6) << 0, 0, 0, 1, 0.5, 0).finished();
+  opt.sensitivity = {"x0", "mu[0]"};
+  tr = sim::simulate(m3, x0, opt, "event");
+  EXPECT_TRUE(tr.ok()) << tr.message;
+  for (const char* name : {"M[0][0]", "e[0]"}) {
+    opt.sensitivity = {"x0", name};
+    tr = sim::simulate(m3, x0, opt, "event");
+    EXPECT_EQ(tr.status, Status::kInvalidInput) << name;
+    EXPECT_EQ(tr.message, "Options::sensitivity '" + std::string(name) +
+                              "': not computed through 3-D friction (model 'point3d' has a 3-D "
+                              "contact at mechanical.friction[0]; through 3-D stick / slip x0, "
+                              "f[i], g[c], K[i][j], D[i][j] and mu[c] are)");
   }
 }
 
