@@ -125,7 +125,7 @@ std::string EventDriven::select_cone_friction(double t, const lcs::IndexSet& und
                                               VectorXd& xa, EventResult& out) {
   std::vector<RowVectorXd> rows;
   std::vector<double> target;
-  const std::vector<std::vector<FrictionMode>> cand = cone_candidates(out.mode, xa, rows, target);
+  std::vector<std::vector<FrictionMode>> cand = cone_candidates(out.mode, xa, rows, target);
   out.friction.clear();
   double total = 1.0;  // combinations (may be many: only kMaxCombinations are tried)
   for (const auto& c : cand) {
@@ -134,6 +134,10 @@ std::string EventDriven::select_cone_friction(double t, const lcs::IndexSet& und
   }
   if (total == 1.0) return "";  // every contact's mode follows from its velocity
   if (!rows.empty()) project_rows(out.mode, rows, target, xa);
+  // Beyond the bound the enumeration would see a few of them: the cone
+  // LCP's guess first (cone_guess.cpp).
+  if (total > static_cast<double>(kMaxCombinations))
+    cone_lcp_guess(out.mode, xa, cand, out.lcp_solves);
   const size_t tries =
       total > static_cast<double>(kMaxCombinations) ? kMaxCombinations : static_cast<size_t>(total);
   std::string painleve;

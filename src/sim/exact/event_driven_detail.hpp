@@ -419,6 +419,10 @@ class EventDriven {
                                                          std::vector<double>& zero_target) const;
   void project_rows(const lcs::IndexSet& mode, const std::vector<RowVectorXd>& rows,
                     const std::vector<double>& target, VectorXd& xa) const;
+  // The acceleration-level cone LCP's guess moved to the front of each 3-D
+  // contact's candidates (cone_guess.cpp).
+  void cone_lcp_guess(const lcs::IndexSet& mode, const VectorXd& xa,
+                      std::vector<std::vector<FrictionMode>>& cand, long& solves) const;
   // held: the constraints the ending phase kept closed (empty at the start).
   EventResult process_event(double t, const VectorXd& xa, const lcs::IndexSet& held = {});
   // The accumulation that an impact of contact r at t (time resolution
