@@ -342,6 +342,7 @@ TEST(Friction3dImpact, InelasticRandomCoupledImpactsObeyCoulombAndLoseEnergy) {
     }
   }
   // Fixed seed: most draws are solvable (small enough mu |W_ND|).
+  std::printf("[ random cone ] solved %d, Painlevé-type (newton) %d\n", solved, painleve);
   EXPECT_GT(solved, 250) << painleve << " Painlevé-type draws";
 }
 
