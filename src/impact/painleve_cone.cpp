@@ -9,11 +9,9 @@
 // mu lambda_N e_i, e_i minimising u_T . e over the vertices); slip on face k
 // (friction on the side from e_k to e_(k+1), u_T orthogonal to that side,
 // e_k minimising u_T . e). Each mode is a square linear system.
-#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <lcsim/core/format.hpp>
-#include <optional>
 
 #include "impact/detail.hpp"
 
@@ -253,10 +251,11 @@ struct ModeOutcome {
 // affine set x0 + ker A. When Wg P ker A = 0 every impulse of it gives the
 // same velocity (velocity uniqueness, not impulse uniqueness, is what
 // counts): the mode is the law's motion when that velocity is the law's, no
-// motion when the inequalities have no point in the set (feasible_in_kernel),
-// else another motion. When the velocity is free in the set, a feasible
-// point means a continuum of motions may exist: refused. Lemke failing
-// otherwise: not decided, refused.
+// motion when the inequalities have no point in the set (polyhedron: no
+// vertex), else another motion. When the velocity moves over the set: one
+// motion if every vertex gives the same velocity and no ray moves it, else
+// a continuum (refused). A kernel too large for polyhedron(): not decided,
+// refused.
 ModeOutcome solve_cone_mode(const ConeProblemView& v, const std::vector<int>& modes,
                             const VectorXd& lambda_law) {
   const ConeModesProblem& p = v.p;
