@@ -450,6 +450,12 @@ TEST(Friction3dImpact, PainleveIsJudgedOnTheSolvedModesWithManyContacts) {
           r.message.find("Painlevé-type case at contacts 0 ('c1') (edge 0) 1 ('c2') (edge 0)"),
           std::string::npos)
           << r.message;
+      // Issue 27 (d >= 2 by the modes): the enumeration finds these three.
+      EXPECT_NE(r.message.find("the impact has 3 motions: the modes 0 ('c1') (slip-edge-0) 1 "
+                               "('c2') (open)"),
+                std::string::npos)
+          << r.message;
+      std::printf("[ painleve ] both along -y: %s\n", r.message.c_str());
       // The three solutions of the frozen normal LCP w = Ns l + q >= 0, l >= 0.
       for (const Eigen::Vector2d& l : {Eigen::Vector2d(1, 0), Eigen::Vector2d(0, 1),
                                        Eigen::Vector2d(Eigen::Vector2d(1, 1) / (1 + mu * c))}) {
