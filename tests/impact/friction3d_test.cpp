@@ -397,6 +397,40 @@ TEST(Friction3dImpact, PainleveCaseIsDiagnosedByName) {
   }
 }
 
+// Issue 27 at d >= 2, above the enumeration's bound: PainleveCaseIsDiagnosedByName's
+// contact (mu = 1.5, W_NN - mu max_i |W_N D_i| = -0.555556) and four
+// independent point masses landing beside it, every contact at d = 4: 18^5
+// = 1889568 combinations of modes, above kConePainleveModeBound = 200000,
+// so the sufficient condition's refusal stands and says so.
+TEST(Friction3dImpact, PainleveAboveTheConeModeBoundKeepsTheRefusal) {
+  Eigen::MatrixXd M = Eigen::MatrixXd::Identity(15, 15);
+  M(0, 1) = M(1, 0) = 0.8;
+  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(5, 15);
+  for (int i = 0; i < 5; ++i) E(i, 3 * i) = 1.0;
+  mech::MechanicalModel model = testing::make_model(M, E);
+  VectorXd v = VectorXd::Zero(15);
+  for (int i = 0; i < 5; ++i) {
+    VectorXd t = VectorXd::Zero(15), t2 = VectorXd::Zero(15);
+    t(3 * i + 1) = 1.0, t2(3 * i + 2) = 1.0;
+    mech::FrictionalContact fc(i, t, i == 0 ? 1.5 : 0.5);
+    fc.tangent2 = t2.sparseView();
+    fc.edges = 4;
+    model.friction.push_back(fc);
+    v(3 * i) = -1.0, v(3 * i + 1) = 2.0, v(3 * i + 2) = 1.0;
+  }
+  ASSERT_FALSE(mech::check_mechanical(model));
+  const ImpactResult r = by("cone", model, v, VectorXd::Zero(5));
+  EXPECT_TRUE(r.painleve);
+  EXPECT_FALSE(r.ok());
+  EXPECT_NE(r.message.find("Painlevé-type case at contact 0 ('c1')"), std::string::npos)
+      << r.message;
+  EXPECT_NE(r.message.find("= -0.555556"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("above the enumeration's bound 200000: not enumerated"),
+            std::string::npos)
+      << r.message;
+  EXPECT_NE(r.message.find("(not resolved)"), std::string::npos) << r.message;
+}
+
 // Issue 27: the Painlevé test judges the modes of the solved impact, not
 // every edge choice in advance; with four contacts at d = 4 (8^4 = 4096
 // choices, above the 256 the enumeration took, so it judged nothing) it is
