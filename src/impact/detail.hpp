@@ -108,6 +108,26 @@ PainleveVerdict decide_painleve_by_modes(const MatrixXd& Wg, const VectorXd& b, 
                                          const std::vector<int>& normal_of, const VectorXd& mu,
                                          const VectorXd& lambda_law,
                                          const std::vector<std::string>& labels);
+// Issue 27 for cones with d >= 2 (painleve_cone.cpp): the same decision
+// for the polyhedral cone law. Wg, b over the nj closed normals, then per
+// frictional contact f its tangent rows t1 (and t2 when d[f] >= 2) from
+// first_t[f]; normal_of[f] its normal. Per contact open, stick, slip on edge
+// i (2d), slip on face k (2d) (d = 1: open, stick, edges 0 and 1; no
+// friction: open, closed), each a square system; a singular one is judged
+// by velocity uniqueness (painleve_cone.cpp, solve_cone_mode). Above
+// kConePainleveModeBound combinations (18^4 = 104976 for four contacts at
+// d = 4), not enumerated.
+constexpr long kConePainleveModeBound = 200000;
+struct ConeModesProblem {
+  MatrixXd Wg;
+  VectorXd b;
+  Eigen::Index nj = 0;
+  std::vector<int> normal_of, d;
+  std::vector<Eigen::Index> first_t;
+  VectorXd mu;
+};
+PainleveVerdict decide_cone_painleve_by_modes(const ConeModesProblem& p, const VectorXd& lambda_law,
+                                              const std::vector<std::string>& labels);
 // The message of a friction impact whose LCP no solver solved (`tried`: the
 // solvers, in the order tried).
 std::string friction_lcp_failure(const std::string& tried, const lcp::Result& res);

@@ -271,24 +271,67 @@ std::string cone_painleve_solved(const mech::MechanicalModel& m, const ImpactInp
          "contacts of independent normal rows";
 }
 
+// Issue 27 with d >= 2 (painleve_cone.cpp): the impact problem in each
+// contact's tangent coordinates (t1 = the edge 0, t2 = (D_k - cos D_0)/sin
+// of the edge k at a quarter turn, or the edge 1 for odd d), the LCP's
+// solution there (tangential), decided by the modes open, stick, 2d edges,
+// 2d faces per contact.
+detail::PainleveVerdict cone_decided_by_modes(const ImpactInput& in, const ClosedCone& c,
+                                              const MatrixXd& Wb, const VectorXd& rate_N,
+                                              const VectorXd& rate_D, const VectorXd& z) {
+  const Eigen::Index nj = rate_N.size(), nb = Wb.rows();
+  detail::ConeModesProblem p;
+  p.nj = nj;
+  p.normal_of = c.normal_of;
+  p.d = c.d;
+  p.mu = c.mu;
+  Eigen::Index n = nj;
+  for (const int d : c.d) {
+    p.first_t.push_back(n);
+    n += d >= 2 ? 2 : 1;
+  }
+  MatrixXd S = MatrixXd::Zero(n, nb);  // [u_N; u_t] = S [u_N; u_D]
+  VectorXd lambda = VectorXd::Zero(n);
+  S.topLeftCorner(nj, nj).setIdentity();
+  lambda.head(nj) = z.head(nj);
+  const VectorXd beta = z.segment(nj, nb - nj);
+  for (size_t f = 0; f < c.d.size(); ++f) {
+    const Eigen::Index t = p.first_t[f], e0 = nj + c.first[f];
+    const auto [f1, f2] = tangential(c, f, beta);
+    S(t, e0) = 1.0;
+    lambda(t) = f1;
+    if (c.d[f] < 2) continue;
+    const int k = c.d[f] % 2 == 0 ? c.d[f] / 2 : 1;
+    const auto [ck, sk] = cone_edge(k, c.d[f]);
+    S(t + 1, e0 + k) = 1.0 / sk;
+    S(t + 1, e0) = -ck / sk;
+    lambda(t + 1) = f2;
+  }
+  VectorXd rates(nb);
+  rates << rate_N, rate_D;
+  p.Wg = S * Wb * S.transpose();
+  p.b = S * rates;
+  return detail::decide_cone_painleve_by_modes(p, lambda, detail::closed_labels(in));
+}
+
 // Issue 27: cone_painleve_solved is a sufficient condition; when it fails
-// and every closed frictional contact has d = 1 (friction along t only, its
-// edges +t and -t), the impact is decided by the contacts' planar modes as
-// the planar law's (detail::decide_painleve_by_modes on the rows of +t),
-// so d = 1 keeps the planar law's diagnoses; with d >= 2 the modes (stick,
-// 2d edges, 2d faces per contact) are not enumerated and it is refused.
-// `alone`: cone_painleve_alone's finding before the solve (d = 1 only).
+// (or a contact alone is Painlevé-type, `alone`, found before the solve),
+// the impact is decided by the contacts' modes: with every closed
+// frictional contact at d = 1 (friction along t only, its edges +t and -t)
+// as the planar law's (detail::decide_painleve_by_modes on the rows of +t),
+// so d = 1 keeps the planar law's diagnoses; with any d >= 2 by
+// cone_decided_by_modes.
 std::string cone_painleve_decided(const mech::MechanicalModel& m, const ImpactInput& in,
                                   const ClosedCone& c, const MatrixXd& Wb, const std::string& alone,
                                   const VectorXd& rate_N, const VectorXd& rate_D, const VectorXd& z,
                                   const VectorXd& v_after) {
   std::string p = alone.empty() ? cone_painleve_solved(m, in, c, Wb, v_after) : alone;
   if (p.empty()) return p;
-  if (std::any_of(c.d.begin(), c.d.end(), [](int d) { return d != 1; }))
-    return p +
-           "; the contacts' modes are enumerated for planar friction (d = 1) only: not "
-           "enumerated" +
-           kPainleveTail;
+  if (std::any_of(c.d.begin(), c.d.end(), [](int d) { return d != 1; })) {
+    const detail::PainleveVerdict d = cone_decided_by_modes(in, c, Wb, rate_N, rate_D, z);
+    if (d.unique) return "";
+    return p + "; " + d.message + (d.enumerated ? "" : kPainleveTail);
+  }
   const Eigen::Index nj = rate_N.size(), nf = c.mu.size();
   std::vector<Eigen::Index> idx;  // the normals, then each contact's +t row
   for (Eigen::Index j = 0; j < nj; ++j) idx.push_back(j);
@@ -374,15 +417,9 @@ ImpactResult moreau_friction_cone(const ImpactInput& in, const lcp::Solver& solv
   Wb.topRightCorner(nj, ne) = s->EJ * MinvDt;
   Wb.bottomLeftCorner(ne, nj) = Wb.topRightCorner(nj, ne).transpose();
   Wb.bottomRightCorner(ne, ne) = c.D * MinvDt;
-  // A contact alone Painlevé-type: refused here with d >= 2; with d = 1
-  // everywhere decided after the solve by the modes, as the planar law.
+  // A contact alone Painlevé-type is decided after the solve by the modes
+  // (issue 27), as the planar law's; refused when no solver solves the LCP.
   const std::string alone = cone_painleve_alone(m, in.closed, c, s->W, Wb.topRightCorner(nj, ne));
-  const bool planar = std::all_of(c.d.begin(), c.d.end(), [](int d) { return d == 1; });
-  if (!alone.empty() && !planar) {
-    out.painleve = true;
-    out.message = alone + kPainleveTail;
-    return out;
-  }
   const VectorXd rate_N = s->a + s->e_J.cwiseProduct(s->a.cwiseMin(0.0));
   const FrictionLcp lcp = cone_lcp(Wb, rate_N, c.D * in.v - c.edge_velocity, c);
   std::string tried;

@@ -342,6 +342,7 @@ TEST(Friction3dImpact, InelasticRandomCoupledImpactsObeyCoulombAndLoseEnergy) {
     }
   }
   // Fixed seed: most draws are solvable (small enough mu |W_ND|).
+  std::printf("[ random cone ] solved %d, Painlevé-type (newton) %d\n", solved, painleve);
   EXPECT_GT(solved, 250) << painleve << " Painlevé-type draws";
 }
 
@@ -360,16 +361,74 @@ TEST(Friction3dImpact, PainleveCaseIsDiagnosedByName) {
     ASSERT_FALSE(mech::check_mechanical(model));
     const ImpactResult r = by("cone", model, vec({-1, 2, 1}), vec({0.0}));
     if (mu * 0.8 > 1) {
-      EXPECT_TRUE(r.painleve);
-      EXPECT_FALSE(r.ok());
-      EXPECT_NE(r.message.find("Painlevé-type case at contact 0 ('c1')"), std::string::npos)
-          << r.message;
-      EXPECT_NE(r.message.find("= -0.555556"), std::string::npos) << r.message;  // -0.2/0.36
+      // Issue 27: the contact alone is Painlevé-type, and the modes decide
+      // (open, stick, 8 edges, 8 faces). Approaching at v- = (-1, 2, 1) it
+      // has one motion: sliding along t near (1, 1), friction at the vertex
+      // e_5 = -(1, 1)/sqrt 2 of the polygon, lambda = lambda_N (1, -a, -a),
+      // a = mu/sqrt 2; u_N = 0 gives lambda_N = 0.36/(1 + 0.8 a), and v+ =
+      // v- + M^-1 lambda. Tolerance 1e-12: an O(1) LCP's rounding.
+      EXPECT_FALSE(r.painleve) << r.message;
+      ASSERT_TRUE(r.ok()) << r.message;
+      const double a = mu / std::sqrt(2.0), ln = 0.36 / (1 + 0.8 * a);
+      EXPECT_NEAR(r.impulse(0), ln, 1e-12);
+      EXPECT_NEAR(r.friction_impulse(0), -a * ln, 1e-12);
+      EXPECT_NEAR(r.friction_impulse2(0), -a * ln, 1e-12);
+      EXPECT_NEAR(r.v_after(0), 0.0, 1e-12);
+      EXPECT_NEAR(r.v_after(1), 2 - ln * (0.8 + a) / 0.36, 1e-12);
+      EXPECT_NEAR(r.v_after(2), 1 - a * ln, 1e-12);
+      // Separating at v- = (0.1, -3, 0) it has three: open (v+ = v-);
+      // stick (lambda = -M v-: lambda_N = 2.3, |lambda_T| = 2.92 inside the
+      // polygon mu lambda_N conv{D_i}); slipping along -y with friction
+      // mu lambda_N along +y (edge 0: lambda_N = 0.18, v+_y = -2.65).
+      const ImpactResult s = by("cone", model, vec({0.1, -3, 0}), vec({0.0}));
+      EXPECT_TRUE(s.painleve);
+      EXPECT_FALSE(s.ok());
+      EXPECT_NE(s.message.find("Painlevé-type case at contact 0 ('c1')"), std::string::npos)
+          << s.message;
+      EXPECT_NE(s.message.find("= -0.555556"), std::string::npos) << s.message;  // -0.2/0.36
+      EXPECT_NE(s.message.find("the impact has 3 motions: the modes 0 ('c1') (open) and the "
+                               "modes 0 ('c1') (stick)"),
+                std::string::npos)
+          << s.message;
     } else {
       EXPECT_FALSE(r.painleve) << r.message;
       EXPECT_TRUE(r.ok()) << r.message;
     }
   }
+}
+
+// Issue 27 at d >= 2, above the enumeration's bound: PainleveCaseIsDiagnosedByName's
+// contact (mu = 1.5, W_NN - mu max_i |W_N D_i| = -0.555556) and four
+// independent point masses landing beside it, every contact at d = 4: 18^5
+// = 1889568 combinations of modes, above kConePainleveModeBound = 200000,
+// so the sufficient condition's refusal stands and says so.
+TEST(Friction3dImpact, PainleveAboveTheConeModeBoundKeepsTheRefusal) {
+  Eigen::MatrixXd M = Eigen::MatrixXd::Identity(15, 15);
+  M(0, 1) = M(1, 0) = 0.8;
+  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(5, 15);
+  for (int i = 0; i < 5; ++i) E(i, 3 * i) = 1.0;
+  mech::MechanicalModel model = testing::make_model(M, E);
+  VectorXd v = VectorXd::Zero(15);
+  for (int i = 0; i < 5; ++i) {
+    VectorXd t = VectorXd::Zero(15), t2 = VectorXd::Zero(15);
+    t(3 * i + 1) = 1.0, t2(3 * i + 2) = 1.0;
+    mech::FrictionalContact fc(i, t, i == 0 ? 1.5 : 0.5);
+    fc.tangent2 = t2.sparseView();
+    fc.edges = 4;
+    model.friction.push_back(fc);
+    v(3 * i) = -1.0, v(3 * i + 1) = 2.0, v(3 * i + 2) = 1.0;
+  }
+  ASSERT_FALSE(mech::check_mechanical(model));
+  const ImpactResult r = by("cone", model, v, VectorXd::Zero(5));
+  EXPECT_TRUE(r.painleve);
+  EXPECT_FALSE(r.ok());
+  EXPECT_NE(r.message.find("Painlevé-type case at contact 0 ('c1')"), std::string::npos)
+      << r.message;
+  EXPECT_NE(r.message.find("= -0.555556"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("above the enumeration's bound 200000: not enumerated"),
+            std::string::npos)
+      << r.message;
+  EXPECT_NE(r.message.find("(not resolved)"), std::string::npos) << r.message;
 }
 
 // Issue 27: the Painlevé test judges the modes of the solved impact, not
@@ -425,6 +484,12 @@ TEST(Friction3dImpact, PainleveIsJudgedOnTheSolvedModesWithManyContacts) {
           r.message.find("Painlevé-type case at contacts 0 ('c1') (edge 0) 1 ('c2') (edge 0)"),
           std::string::npos)
           << r.message;
+      // Issue 27 (d >= 2 by the modes): the enumeration finds these three.
+      EXPECT_NE(r.message.find("the impact has 3 motions: the modes 0 ('c1') (slip-edge-0) 1 "
+                               "('c2') (open)"),
+                std::string::npos)
+          << r.message;
+      std::printf("[ painleve ] both along -y: %s\n", r.message.c_str());
       // The three solutions of the frozen normal LCP w = Ns l + q >= 0, l >= 0.
       for (const Eigen::Vector2d& l : {Eigen::Vector2d(1, 0), Eigen::Vector2d(0, 1),
                                        Eigen::Vector2d(Eigen::Vector2d(1, 1) / (1 + mu * c))}) {

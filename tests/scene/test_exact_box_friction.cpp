@@ -76,14 +76,14 @@ class ExactBoxFriction : public test_support::SceneFiles {
   }
   // robots/box_drop_scene.yaml with friction and a horizontal velocity
   // (vx, vy) in the world (m/s).
-  std::string drop(int d, double vx, double vy) {
+  std::string drop(int d, double vx, double vy, double mu = kMu) {
     write("box.urdf", io::read_file(kRobots + "box.urdf"));
     return write("drop.yaml",
                  "name: box_drop\nurdf: box.urdf\n"
                  "base: {type: floating, pose: {xyz: [0, 0, 0.05]}}\n"
                  "planes:\n  - {name: floor, point: [0, 0, 0], normal: [0, 0, 1]}\n"
                  "contacts:\n  - {link: box, plane: floor, friction: " +
-                     format_number(kMu) + ", d: " + std::to_string(d) +
+                     format_number(mu) + ", d: " + std::to_string(d) +
                      "}\ninitial:\n  q: {box.z: 0.25}\n  v: {box.x: " + format_number(vx) +
                      ", box.y: " + format_number(vy) + "}\nt_end: 2\n");
   }
@@ -205,6 +205,39 @@ TEST_F(ExactBoxFriction, BoxLandingFlatSlidesToRestAsOnePointMass) {
     const VectorXd& xf = tr.final_state;
     EXPECT_NEAR(xf(0), x, 1e-12) << at;
     EXPECT_NEAR(xf(1), y, 1e-12) << at;
+    EXPECT_NEAR(xf(2), 0.05, 1e-12) << at;
+    EXPECT_LE(xf.segment(3, 3).cwiseAbs().maxCoeff(), 1e-12) << at;  // level, no yaw
+    EXPECT_LE(xf.segment(6, 6).cwiseAbs().maxCoeff(), 1e-12) << at;  // at rest
+    expect_laws(*model.mechanical, tr, at);
+  }
+}
+
+// Issue 27 at d >= 2: the box landing flat at mu = 100 with the sideways
+// velocity of robots/box_slide_scene.yaml (1, 0.4) m/s. Each corner alone
+// is Painlevé-type (W_NN - mu max_i |W_N D_i| = 5.08 - 100 * 1.24 < 0 at
+// d = 4), so the cone law enumerates the four corners' modes (18^4 = 104976
+// at d = 4, 10^4 at d = 2; the normal block of the coplanar corners is
+// singular, judged by velocity uniqueness) and finds one motion: every
+// corner sticks. Closed form (one point mass): |s| = 1.08 m/s < mu V =
+// 198 m/s, so the impact stops it; it rests where it lands, (vx, vy) t_i.
+// Tolerance 1e-12 as BoxLandingFlatSlidesToRestAsOnePointMass.
+TEST_F(ExactBoxFriction, BoxLandingFlatAtHighMuSticksWhereItLands) {
+  const double ti = std::sqrt(2 * kDrop / kG), vx = 1.0, vy = 0.4;
+  for (const int d : {2, 4}) {
+    const std::string at = "d = " + std::to_string(d);
+    const mech::Model model = scene::load_model(drop(d, vx, vy, 100.0));
+    sim::Options o;
+    o.t_end = 0.5;
+    const sim::Trajectory tr = sim::make_integrator("event")->run(model, model.initial, o);
+    ASSERT_EQ(tr.status, Status::kOk) << at << ": " << tr.message;
+    ASSERT_FALSE(tr.events.empty()) << at;
+    const sim::Event& impact = tr.events.front();
+    EXPECT_EQ(impact.type, sim::EventType::kImpact) << at;
+    EXPECT_NEAR(impact.t, ti, 1e-12) << at;
+    EXPECT_LE(impact.state_after.segment(6, 6).cwiseAbs().maxCoeff(), 1e-12) << at;
+    const VectorXd& xf = tr.final_state;
+    EXPECT_NEAR(xf(0), vx * ti, 1e-12) << at;
+    EXPECT_NEAR(xf(1), vy * ti, 1e-12) << at;
     EXPECT_NEAR(xf(2), 0.05, 1e-12) << at;
     EXPECT_LE(xf.segment(3, 3).cwiseAbs().maxCoeff(), 1e-12) << at;  // level, no yaw
     EXPECT_LE(xf.segment(6, 6).cwiseAbs().maxCoeff(), 1e-12) << at;  // at rest
