@@ -489,10 +489,10 @@ const Sensitivity::DenseBlock& Sensitivity::dense_block(double tau, bool params)
   b.fits_params = params;
   b.used = ++dense_clock_;
   // As many blocks as fit in ~4 MB (a block keeps Ab and Phi, and per
-  // parameter dAb and Psi: (2 + 2P) n^2 doubles), 8 to 32: a grid step's
-  // length takes several roundings of dt (t_k - t_(k-1)), each its own
-  // block, and phases of a few modes alternate (the NAO legs to 0.28 s: 19
-  // blocks, 19 exponentials, where 8 kept the same 19).
+  // parameter dAb and Psi: (2 + 2P) n^2 doubles), 8 to 32: phases of a few
+  // modes alternate, and each event leaves steps of new lengths (the NAO
+  // legs to 0.28 s: 19 exponentials before grid steps' roundings of dt were
+  // taken as dt by find_block, where 8 kept blocks gave the same 19).
   const double block_bytes = 8.0 * (2.0 + 2.0 * static_cast<double>(cols_.params.size())) *
                              static_cast<double>(n_) * static_cast<double>(n_);
   const size_t capacity = static_cast<size_t>(std::clamp(4e6 / block_bytes, 8.0, 32.0));
