@@ -114,6 +114,14 @@ void EventDriven::record(Trajectory& tr, double t, const VectorXd& xa, const Pha
   s.mode = ph.mode;
   s.configuration = config_;
   fill_friction(s, ph, xa);
+  if (sens_ && opt_.sample_sink) {
+    // Streamed: dx in the run's own storage, lent to the sink's view of s
+    // (as Trajectory::record_sample hands it on) and taken back.
+    sens_->fill_sample(t, s);
+    opt_.sample_sink(s);
+    sens_->take_back(s);
+    return;
+  }
   if (sens_) sens_->fill(t, s.dx, s.dx_exists);
   tr.record_sample(std::move(s), opt_);
 }

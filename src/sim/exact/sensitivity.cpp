@@ -489,10 +489,10 @@ const Sensitivity::DenseBlock& Sensitivity::dense_block(double tau, bool params)
   b.fits_params = params;
   b.used = ++dense_clock_;
   // As many blocks as fit in ~4 MB (a block keeps Ab and Phi, and per
-  // parameter dAb and Psi: (2 + 2P) n^2 doubles), 8 to 32: a grid step's
-  // length takes several roundings of dt (t_k - t_(k-1)), each its own
-  // block, and phases of a few modes alternate (the NAO legs to 0.28 s: 19
-  // blocks, 19 exponentials, where 8 kept the same 19).
+  // parameter dAb and Psi: (2 + 2P) n^2 doubles), 8 to 32: phases of a few
+  // modes alternate, and each event leaves steps of new lengths (the NAO
+  // legs to 0.28 s: 19 exponentials before grid steps' roundings of dt were
+  // taken as dt by find_block, where 8 kept blocks gave the same 19).
   const double block_bytes = 8.0 * (2.0 + 2.0 * static_cast<double>(cols_.params.size())) *
                              static_cast<double>(n_) * static_cast<double>(n_);
   const size_t capacity = static_cast<size_t>(std::clamp(4e6 / block_bytes, 8.0, 32.0));
@@ -509,15 +509,13 @@ const Sensitivity::DenseBlock& Sensitivity::dense_block(double tau, bool params)
 
 // The kept block for tau of this phase's matrix (its mode, Ab, D and
 // constant forcings, and with `params` its parameters' forcings: fits and
-// fits_params, set once per phase by match_blocks), or null. The same tau
-// exactly: grid steps that differ from dt by an ulp (the rounding of k dt)
-// take their own exponential, so S is not moved even by rounding. Taking
-// them as dt (as GridSampler::at takes the plain run's samples) would save
-// 11 of the 19 exponentials of the NAO legs' f[0] run to 0.28 s, but it
-// moves S by ~1e-16 relative, and the system identification example's
-// Gauss-Newton (examples/python/system_identification.py), which stops on
-// a cost that must not rise at 1e-10 relative steps, then fails to converge
-// on seed 1 (measured).
+// fits_params, set once per phase by match_blocks), or null. A step from
+// the cursor tc_ to t = tc_ + tau within 4 ulps of t (or of tau) of a kept
+// length is taken as that length, the nearest: grid steps t_k - t_(k-1)
+// differ from dt by the rounding of k dt, an ulp or two of t, as
+// GridSampler::at takes the plain run's samples. That saves 11 of the 19
+// exponentials of the NAO legs' f[0] run to 0.28 s and moves S by rounding
+// (bench/README.md gives the measured change).
 namespace {
 // Two phases' parameter forcings dAb, bit for bit (a block's Psi is formed
 // from them: the mode and Ab alone do not fix an input's or a friction
@@ -531,9 +529,13 @@ bool same_forcings(const std::vector<MatrixXd>& a, const std::vector<MatrixXd>& 
 }  // namespace
 
 const Sensitivity::DenseBlock* Sensitivity::find_block(double tau, bool params) const {
-  for (const DenseBlock& c : dense_cache_)
-    if (c.tau == tau && c.fits && (!params || c.fits_params)) return &c;
-  return nullptr;
+  const double ulps = 4.0 * kEps * std::max(std::abs(tc_ + tau), tau);
+  const DenseBlock* best = nullptr;
+  for (const DenseBlock& c : dense_cache_) {
+    if (!c.fits || (params && !c.fits_params) || std::abs(c.tau - tau) > ulps) continue;
+    if (best == nullptr || std::abs(c.tau - tau) < std::abs(best->tau - tau)) best = &c;
+  }
+  return best;
 }
 
 void Sensitivity::match_blocks() {
@@ -557,7 +559,8 @@ const MatrixXd& Sensitivity::at_dense(double t, double tau) {
     Sc_.col(nx0_ + const_[k].first) +=
         b.Gamma.col(static_cast<Eigen::Index>(k)) * zc_(const_[k].second);
   for (size_t p = 0; p < b.Psi.size(); ++p)
-    if (b.Psi[p].size() > 0) Sc_.col(nx0_ + static_cast<Eigen::Index>(p)) += b.Psi[p] * zc_;
+    if (b.Psi[p].size() > 0)
+      Sc_.col(nx0_ + static_cast<Eigen::Index>(p)).noalias() += b.Psi[p] * zc_;
   Sc_ = D_.asDiagonal() * Sc_;
   znext_.noalias() = b.Phi * zc_;
   zc_.swap(znext_);
@@ -571,6 +574,17 @@ void Sensitivity::fill(double t, MatrixXd& dx, std::vector<char>& exists) {
   for (int c = 0; c < m_; ++c)
     if (!exists_[static_cast<size_t>(c)]) dx.col(c).setZero();
   exists = exists_;
+}
+
+void Sensitivity::fill_sample(double t, Sample& s) {
+  s.dx.swap(spare_dx_);
+  s.dx_exists.swap(spare_exists_);
+  fill(t, s.dx, s.dx_exists);  // the same size each time: no allocation
+}
+
+void Sensitivity::take_back(Sample& s) {
+  spare_dx_.swap(s.dx);
+  spare_exists_.swap(s.dx_exists);
 }
 
 void Sensitivity::before_event(double tau, const VectorXd& x_minus, int monitor) {

@@ -74,6 +74,11 @@ class Sensitivity {
   const MatrixXd& at(double t);
   // Fills a sample's or the final dx and its existence flags.
   void fill(double t, MatrixXd& dx, std::vector<char>& exists);
+  // The same into a streamed sample (Options::sample_sink) in storage this
+  // run keeps: fill_sample lends it to s.dx and s.dx_exists, take_back takes
+  // it back once the sink has seen s, so no sample allocates its dx.
+  void fill_sample(double t, Sample& s);
+  void take_back(Sample& s);
   // Before the re-initialisation at tau: S-, and dtau/dtheta from the
   // monitor `monitor` of the ending phase (-1 at t = 0).
   void before_event(double tau, const VectorXd& x_minus, int monitor);
@@ -198,6 +203,8 @@ class Sensitivity {
   MatrixXd G_;  // M^{-1} (mechanical)
   std::vector<char> exists_;
   std::vector<SensitivityLoss> losses_;
+  MatrixXd spare_dx_;  // a streamed sample's dx and flags (fill_sample)
+  std::vector<char> spare_exists_;
   // The current phase: start, closed loop, balancing, monitors, derivatives.
   double t0_ = 0.0;
   MatrixXd S0_;
