@@ -448,6 +448,31 @@ TEST(SensitivityCone, BoxLandingOnFourCornersIsACoincidence) {
   for (size_t c = 0; c < bt.dx_final_exists.size(); ++c) EXPECT_FALSE(bt.dx_final_exists[c]);
 }
 
+// The point (2 kg) on the floor pulled by springs k = 20 N/m on x and y from
+// a free 1 kg mass (x2, y2), d edge pairs (SpringPulledStickSlip...).
+mech::Model pulled(int d) {
+  mech::MechanicalModel m;
+  m.M = Eigen::VectorXd((Eigen::VectorXd(5) << 2, 2, 2, 1, 1).finished())
+            .asDiagonal()
+            .toDenseMatrix()
+            .sparseView();
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(5, 5);
+  for (const auto& [a, b] : {std::pair{0, 3}, std::pair{1, 4}}) {
+    K(a, a) = K(b, b) = 20.0;
+    K(a, b) = K(b, a) = -20.0;
+  }
+  m.K = K.sparseView();
+  m.D = Eigen::SparseMatrix<double>(5, 5);
+  m.E = (Eigen::RowVectorXd(5) << 0, 0, 1, 0, 0).finished().sparseView();
+  m.f = (VectorXd(5) << 0, 0, -2.0 * kG, 0, 0).finished();
+  m.constraints = {"floor"};
+  mech::FrictionalContact c(0, (VectorXd(5) << 1, 0, 0, 0, 0).finished(), kMu);
+  c.tangent2 = (VectorXd(5) << 0, 1, 0, 0, 0).finished().sparseView();
+  c.edges = d;
+  m.friction.push_back(c);
+  return mech::model_of(m, "pulled3d");
+}
+
 // Stick -> slip at the polygon's boundary and back: the point (2 kg, at
 // rest on the floor) pulled by springs k = 20 N/m on x and y from a free
 // 1 kg mass (x2, y2) launched at (3, 1) m/s: the spring force grows past mu
@@ -458,26 +483,7 @@ TEST(SensitivityCone, BoxLandingOnFourCornersIsACoincidence) {
 TEST(SensitivityCone, SpringPulledStickSlipAgainstCentralDifferences) {
   int compared = 0;
   for (int d : {2, 4}) {
-    mech::MechanicalModel m;
-    m.M = Eigen::VectorXd((Eigen::VectorXd(5) << 2, 2, 2, 1, 1).finished())
-              .asDiagonal()
-              .toDenseMatrix()
-              .sparseView();
-    Eigen::MatrixXd K = Eigen::MatrixXd::Zero(5, 5);
-    for (const auto& [a, b] : {std::pair{0, 3}, std::pair{1, 4}}) {
-      K(a, a) = K(b, b) = 20.0;
-      K(a, b) = K(b, a) = -20.0;
-    }
-    m.K = K.sparseView();
-    m.D = Eigen::SparseMatrix<double>(5, 5);
-    m.E = (Eigen::RowVectorXd(5) << 0, 0, 1, 0, 0).finished().sparseView();
-    m.f = (VectorXd(5) << 0, 0, -2.0 * kG, 0, 0).finished();
-    m.constraints = {"floor"};
-    mech::FrictionalContact c(0, (VectorXd(5) << 1, 0, 0, 0, 0).finished(), kMu);
-    c.tangent2 = (VectorXd(5) << 0, 1, 0, 0, 0).finished().sparseView();
-    c.edges = d;
-    m.friction.push_back(c);
-    const mech::Model model = mech::model_of(m, "pulled3d");
+    const mech::Model model = pulled(d);
     std::vector<test_support::FdColumn> params;
     params.push_back(
         param("f[3]", 0.0, [](mech::MechanicalModel& mm, double dd) { mm.f(3) += dd; }));
@@ -620,7 +626,8 @@ test_support::FdColumn mass_entry(int i, int j, double theta) {
 // with springs (phases: edge, face, stick), the landings of
 // LandingAgainstCentralDifferences with e = 0.5 (bouncing: two impacts, the
 // slide after each on an edge's region or a face) and the spring-pulled
-// stick -> slip -> stick (the stick and slip forces moved by G).
+// point from rest (SpringPulledStickSlip...: stick -> slip, turns, stick;
+// the stick and slip forces moved by G).
 TEST(SensitivityCone, MassAndRestitutionAgainstCentralDifferences) {
   int compared = 0;
   for (const Case& c : {Case{2, 0.3}, Case{4, -0.35}}) {
@@ -644,9 +651,14 @@ TEST(SensitivityCone, MassAndRestitutionAgainstCentralDifferences) {
                              mm.restitution(0) += dd;
                            })});
   }
+  for (int d : {2, 4})
+    compared += expect_fd(pulled(d), (VectorXd(10) << 0, 0, 0, 0, 0, 0, 0, 0, 3, 1).finished(), 1.0,
+                          {mass_entry(0, 0, 2.0), mass_entry(2, 2, 2.0), mass_entry(3, 3, 1.0),
+                           mass_entry(0, 3, 0.0)});
   // 4 columns on 6 states and 2 events: the turn and the stop; the two
-  // landings (T = 0.45 s between the second and the third).
-  EXPECT_EQ(compared, 2 * 4 * 8 + 2 * 4 * 8);
+  // landings (T = 0.45 s between the second and the third); pulled from
+  // rest, 10 states and 5 (d = 2) or 2 events.
+  EXPECT_EQ(compared, 2 * 4 * 8 + 2 * 4 * 8 + 4 * 15 + 4 * 12);
 }
 
 // A unit point at rest on the floor (mu = 0.4, N = 9.81 N, d edge pairs)
