@@ -304,8 +304,8 @@ std::string refuse_friction(const mech::Model& model, const Options& opt, std::s
       "Options::sensitivity: model '" + model.name + "' has mechanical.friction; ";
   if (method == "moreau-jean") return "";
   const mech::MechanicalModel& m = *model.mechanical;
-  // The exact method differentiates 3-D phases (sensitivity_cone.cpp) and
-  // reports 3-D impacts absent by name.
+  // The exact method differentiates 3-D phases and impacts
+  // (sensitivity_cone*.cpp); the other methods (but moreau-jean) do not.
   for (size_t f = 0; f < m.friction.size() && !used.event_search; ++f)
     if (m.friction[f].is_3d())
       return head + "mechanical.friction[" + std::to_string(f) +
