@@ -624,8 +624,9 @@ test_support::FdColumn mass_entry(int i, int j, double theta) {
 
 // M[i][j] and e[c] against central differences: the point sliding to rest
 // with springs (phases: edge, face, stick), the landings of
-// LandingAgainstCentralDifferences with e = 0.5 (bouncing: two impacts, the
-// slide after each on an edge's region or a face) and the spring-pulled
+// LandingAgainstCentralDifferences with e = 0.5 at 3 m/s (bouncing: two
+// impacts, the slide after each on an edge's region or a face) and at 0.3
+// m/s (stuck at the first impact, leaving without sliding velocity) and the spring-pulled
 // point from rest (SpringPulledStickSlip...: stick -> slip, turns, stick;
 // the stick and slip forces moved by G).
 TEST(SensitivityCone, MassAndRestitutionAgainstCentralDifferences) {
@@ -639,26 +640,27 @@ TEST(SensitivityCone, MassAndRestitutionAgainstCentralDifferences) {
                           {mass_entry(0, 0, 2.0), mass_entry(1, 1, 2.0), mass_entry(2, 2, 2.0),
                            mass_entry(0, 1, 0.0)});
   }
-  for (int d : {2, 4}) {
-    mech::Model m = point(d, 0.3, -0.2);
-    m.mechanical->restitution = VectorXd::Constant(1, 0.5);
-    m = mech::model_of(*m.mechanical, "point3d");
-    VectorXd x0 = sliding(3.0, 0.3 * kPi / d);
-    x0(2) = 0.2;
-    compared += expect_fd(m, x0, 0.45,
-                          {mass_entry(0, 0, 2.0), mass_entry(2, 2, 2.0), mass_entry(0, 2, 0.0),
-                           param("e[floor]", 0.5, [](mech::MechanicalModel& mm, double dd) {
-                             mm.restitution(0) += dd;
-                           })});
-  }
+  for (int d : {2, 4})
+    for (const double s0 : {3.0, 0.3}) {
+      mech::Model m = point(d, 0.3, -0.2);
+      m.mechanical->restitution = VectorXd::Constant(1, 0.5);
+      m = mech::model_of(*m.mechanical, "point3d");
+      VectorXd x0 = sliding(s0, 0.3 * kPi / d);
+      x0(2) = 0.2;
+      compared += expect_fd(m, x0, 0.45,
+                            {mass_entry(0, 0, 2.0), mass_entry(2, 2, 2.0), mass_entry(0, 2, 0.0),
+                             param("e[floor]", 0.5, [](mech::MechanicalModel& mm, double dd) {
+                               mm.restitution(0) += dd;
+                             })});
+    }
   for (int d : {2, 4})
     compared += expect_fd(pulled(d), (VectorXd(10) << 0, 0, 0, 0, 0, 0, 0, 0, 3, 1).finished(), 1.0,
                           {mass_entry(0, 0, 2.0), mass_entry(2, 2, 2.0), mass_entry(3, 3, 1.0),
                            mass_entry(0, 3, 0.0)});
   // 4 columns on 6 states and 2 events: the turn and the stop; the two
-  // landings (T = 0.45 s between the second and the third); pulled from
-  // rest, 10 states and 5 (d = 2) or 2 events.
-  EXPECT_EQ(compared, 2 * 4 * 8 + 2 * 4 * 8 + 4 * 15 + 4 * 12);
+  // landings (T = 0.45 s between the second and the third), four runs;
+  // pulled from rest, 10 states and 5 (d = 2) or 2 events.
+  EXPECT_EQ(compared, 2 * 4 * 8 + 4 * 4 * 8 + 4 * 15 + 4 * 12);
 }
 
 // A unit point at rest on the floor (mu = 0.4, N = 9.81 N, d edge pairs)
