@@ -25,7 +25,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <functional>
+#include <lcsim/io/model_file.hpp>
 #include <lcsim/mech/cone_slide.hpp>
 #include <lcsim/mech/mech.hpp>
 #include <lcsim/scene/scene.hpp>
@@ -446,6 +448,31 @@ TEST(SensitivityCone, BoxLandingOnFourCornersIsACoincidence) {
   for (size_t c = 0; c < bt.dx_final_exists.size(); ++c) EXPECT_FALSE(bt.dx_final_exists[c]);
 }
 
+// The point (2 kg) on the floor pulled by springs k = 20 N/m on x and y from
+// a free 1 kg mass (x2, y2), d edge pairs (SpringPulledStickSlip...).
+mech::Model pulled(int d) {
+  mech::MechanicalModel m;
+  m.M = Eigen::VectorXd((Eigen::VectorXd(5) << 2, 2, 2, 1, 1).finished())
+            .asDiagonal()
+            .toDenseMatrix()
+            .sparseView();
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(5, 5);
+  for (const auto& [a, b] : {std::pair{0, 3}, std::pair{1, 4}}) {
+    K(a, a) = K(b, b) = 20.0;
+    K(a, b) = K(b, a) = -20.0;
+  }
+  m.K = K.sparseView();
+  m.D = Eigen::SparseMatrix<double>(5, 5);
+  m.E = (Eigen::RowVectorXd(5) << 0, 0, 1, 0, 0).finished().sparseView();
+  m.f = (VectorXd(5) << 0, 0, -2.0 * kG, 0, 0).finished();
+  m.constraints = {"floor"};
+  mech::FrictionalContact c(0, (VectorXd(5) << 1, 0, 0, 0, 0).finished(), kMu);
+  c.tangent2 = (VectorXd(5) << 0, 1, 0, 0, 0).finished().sparseView();
+  c.edges = d;
+  m.friction.push_back(c);
+  return mech::model_of(m, "pulled3d");
+}
+
 // Stick -> slip at the polygon's boundary and back: the point (2 kg, at
 // rest on the floor) pulled by springs k = 20 N/m on x and y from a free
 // 1 kg mass (x2, y2) launched at (3, 1) m/s: the spring force grows past mu
@@ -456,26 +483,7 @@ TEST(SensitivityCone, BoxLandingOnFourCornersIsACoincidence) {
 TEST(SensitivityCone, SpringPulledStickSlipAgainstCentralDifferences) {
   int compared = 0;
   for (int d : {2, 4}) {
-    mech::MechanicalModel m;
-    m.M = Eigen::VectorXd((Eigen::VectorXd(5) << 2, 2, 2, 1, 1).finished())
-              .asDiagonal()
-              .toDenseMatrix()
-              .sparseView();
-    Eigen::MatrixXd K = Eigen::MatrixXd::Zero(5, 5);
-    for (const auto& [a, b] : {std::pair{0, 3}, std::pair{1, 4}}) {
-      K(a, a) = K(b, b) = 20.0;
-      K(a, b) = K(b, a) = -20.0;
-    }
-    m.K = K.sparseView();
-    m.D = Eigen::SparseMatrix<double>(5, 5);
-    m.E = (Eigen::RowVectorXd(5) << 0, 0, 1, 0, 0).finished().sparseView();
-    m.f = (VectorXd(5) << 0, 0, -2.0 * kG, 0, 0).finished();
-    m.constraints = {"floor"};
-    mech::FrictionalContact c(0, (VectorXd(5) << 1, 0, 0, 0, 0).finished(), kMu);
-    c.tangent2 = (VectorXd(5) << 0, 1, 0, 0, 0).finished().sparseView();
-    c.edges = d;
-    m.friction.push_back(c);
-    const mech::Model model = mech::model_of(m, "pulled3d");
+    const mech::Model model = pulled(d);
     std::vector<test_support::FdColumn> params;
     params.push_back(
         param("f[3]", 0.0, [](mech::MechanicalModel& mm, double dd) { mm.f(3) += dd; }));
@@ -503,6 +511,234 @@ TEST(SensitivityCone, SpringPulledStickSlipAgainstCentralDifferences) {
   // x0's 10 entries less z, vz (a zero gap at the start) and the 3
   // parameters, on 10 states and 2 (d = 2) or 4 events.
   EXPECT_EQ(compared, 3 * 15 + 3 * 12 + 11 * 12 + 11 * 14);
+}
+
+// M[i][j] through 3-D phases (sensitivity_cone.cpp: dG = -G dM G moves the
+// free acceleration, the forces and the loop). Gravity is the fixed force
+// f_z = -2 g (not m g): the normal force stays 2 g, the deceleration is a =
+// 2 mu g / m, and every time and distance of the closed form is
+// proportional to 1/a, so to m: in the direction dM = I (the sum of the
+// columns M[0][0], M[1][1], M[2][2]) d(value)/dm = value/m, m = 2. The
+// velocity at rest and z stay 0. kTol as above (the same events).
+TEST(SensitivityCone, MassOfSlideToRestAgainstClosedForm) {
+  const double s0 = 1.0, mass = 2.0;
+  int checked = 0;
+  for (const Case& c : {Case{2, 0.3}, Case{2, -0.7}, Case{4, 0.3}, Case{4, -0.2}}) {
+    const double psi = c.a * kPi / c.d;
+    const Stop cf = closed_form(s0, psi, c.d);
+    const std::string at =
+        "d = " + std::to_string(c.d) + ", psi = " + std::to_string(c.a) + " pi/d";
+    const sim::Trajectory tr =
+        run(point(c.d), sliding(s0, psi), cf.t + 0.2, {"M[0][0]", "M[1][1]", "M[2][2]"});
+    ASSERT_TRUE(tr.ok()) << at << ": " << tr.message;
+    // (The zero gap's loss at the start names x0's z, vz only.)
+    for (size_t c = 0; c < 3; ++c) ASSERT_TRUE(tr.dx_final_exists[c]) << at;
+    ASSERT_EQ(tr.events.size(), 2u) << at;
+    const VectorXd dx = tr.dx_final.rowwise().sum();
+    Eigen::VectorXd dt(2);
+    for (size_t k = 0; k < 2; ++k) dt(static_cast<Eigen::Index>(k)) = tr.events[k].dt.sum();
+    EXPECT_NEAR(dx(0), cf.x / mass, kTol) << at << " dx*/dm";
+    EXPECT_NEAR(dx(1), cf.y / mass, kTol) << at << " dy*/dm";
+    for (int i : {2, 3, 4, 5}) EXPECT_NEAR(dx(i), 0.0, kTol) << at << " state " << i;
+    EXPECT_NEAR(dt(0), cf.t1 / mass, kTol) << at << " dt1/dm";
+    EXPECT_NEAR(dt(1), cf.t / mass, kTol) << at << " dt*/dm";
+    checked += 8;
+  }
+  EXPECT_EQ(checked, 32);
+}
+
+// A point (2 kg) dropped from z0 = 0.5 m (w = sqrt(2 g z0)) sliding at s0 =
+// 3 m/s along the cone's edge 1 (psi = pi/d: the slide's impulse is -mu P_N
+// along it, its velocity inside edge 1's region), restitution e = 0.5: it
+// lands at t1 = w/g, leaves at e w with s+ = s0 - mu (1 + e) w, lands again
+// at t2 = t1 + 2 e w/g with s++ = s+ - mu (1 + e) e w = s0 - mu w (1 +
+// e)^2, and at T in (t2, t3) it is in flight: along psi p(T) = s0 t1 + s+
+// (t2 - t1) + s++ (T - t2), z(T) = e^2 w (T - t2) - g (T - t2)^2 / 2. So
+// dt1/de = 0, dt2/de = 2 w/g, ds+/de = -mu w, ds++/de = -2 mu w (1 + e),
+// dp/de = -mu w (t2 - t1) + (s+ - s++) 2 w/g - 2 mu w (1 + e) (T - t2),
+// dz/de = 2 e w (T - t2) - e^2 w 2 w/g + 2 w (T - t2), dvz/de = 2 w (1 + e).
+// To 1e-12 (two impacts, each exact to rounding; no event has a small rate).
+TEST(SensitivityCone, BouncingLandingRestitutionAgainstClosedForm) {
+  const double z0 = 0.5, s0 = 3.0, e = 0.5, w = std::sqrt(2 * kG * z0), T = 0.72;
+  const double t1 = w / kG, t2 = t1 + 2 * e * w / kG, t3 = t2 + 2 * e * e * w / kG;
+  ASSERT_TRUE(t2 < T && T < t3);
+  const double sp = s0 - kMu * (1 + e) * w, spp = s0 - kMu * w * (1 + e) * (1 + e);
+  ASSERT_GT(spp, 0.5);  // sliding on after both impacts
+  const double dp =
+      -kMu * w * (t2 - t1) + (sp - spp) * 2 * w / kG - 2 * kMu * w * (1 + e) * (T - t2);
+  const double dz = 2 * e * w * (T - t2) - e * e * w * 2 * w / kG + 2 * w * (T - t2);
+  int checked = 0;
+  for (int d : {3, 4}) {
+    mech::Model m = point(d);
+    m.mechanical->restitution = VectorXd::Constant(1, e);
+    m = mech::model_of(*m.mechanical, "point3d");
+    const double psi = kPi / d;
+    VectorXd x0 = sliding(s0, psi);
+    x0(2) = z0;
+    const sim::Trajectory tr = run(m, x0, T, {"e[floor]"});
+    ASSERT_TRUE(tr.ok()) << tr.message;
+    ASSERT_TRUE(tr.sensitivity_losses.empty()) << tr.sensitivity_losses[0].reason;
+    ASSERT_EQ(tr.events.size(), 2u);
+    EXPECT_NEAR(tr.events[0].t, t1, 1e-12);
+    EXPECT_NEAR(tr.events[1].t, t2, 1e-12);
+    EXPECT_NEAR(tr.events[0].dt(0), 0.0, kTol);
+    EXPECT_NEAR(tr.events[1].dt(0), 2 * w / kG, kTol) << "dt2/de, d = " << d;
+    EXPECT_NEAR(tr.dx_final(0, 0), dp * std::cos(psi), kTol) << "dx/de, d = " << d;
+    EXPECT_NEAR(tr.dx_final(1, 0), dp * std::sin(psi), kTol) << "dy/de, d = " << d;
+    EXPECT_NEAR(tr.dx_final(2, 0), dz, kTol) << "dz/de, d = " << d;
+    const double dspp = -2 * kMu * w * (1 + e);
+    EXPECT_NEAR(tr.dx_final(3, 0), dspp * std::cos(psi), kTol) << "dvx/de, d = " << d;
+    EXPECT_NEAR(tr.dx_final(4, 0), dspp * std::sin(psi), kTol) << "dvy/de, d = " << d;
+    EXPECT_NEAR(tr.dx_final(5, 0), 2 * w * (1 + e), kTol) << "dvz/de, d = " << d;
+    checked += 8;
+  }
+  EXPECT_EQ(checked, 16);
+}
+
+// The plastic landing (e = 0: the floor is then held, any e > 0 bounces):
+// only a one-sided derivative in e exists, the column is lost at the
+// landing naming the floor (sensitivity.cpp's plastic_restitution); M's
+// columns are computed.
+TEST(SensitivityCone, PlasticLandingLosesRestitution) {
+  VectorXd x0 = sliding(3.0, 0.3 * kPi / 4);
+  x0(2) = 0.2;
+  const sim::Trajectory tr = run(point(4), x0, 0.5, {"e[floor]", "M[0][0]"});
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  ASSERT_EQ(tr.sensitivity_losses.size(), 1u);
+  const sim::SensitivityLoss& l = tr.sensitivity_losses.front();
+  EXPECT_EQ(l.contact, "floor");
+  EXPECT_EQ(l.t, tr.events.front().t);
+  EXPECT_EQ(l.columns, std::vector<int>{0});
+  EXPECT_NE(l.reason.find("plastic impact"), std::string::npos) << l.reason;
+  EXPECT_FALSE(tr.dx_final_exists[0]);
+  EXPECT_TRUE(tr.dx_final_exists[1]);
+}
+
+test_support::FdColumn mass_entry(int i, int j, double theta) {
+  return param("M[" + std::to_string(i) + "][" + std::to_string(j) + "]", theta,
+               [i, j](mech::MechanicalModel& mm, double d) {
+                 mm.M.coeffRef(i, j) += d;
+                 if (i != j) mm.M.coeffRef(j, i) += d;
+               });
+}
+
+// M[i][j] and e[c] against central differences: the point sliding to rest
+// with springs (phases: edge, face, stick), the landings of
+// LandingAgainstCentralDifferences with e = 0.5 at 3 m/s (bouncing: two
+// impacts, the slide after each on an edge's region or a face) and at 0.3
+// m/s (stuck at the first impact, leaving without sliding velocity) and the spring-pulled
+// point from rest (SpringPulledStickSlip...: stick -> slip, turns, stick;
+// the stick and slip forces moved by G).
+TEST(SensitivityCone, MassAndRestitutionAgainstCentralDifferences) {
+  int compared = 0;
+  for (const Case& c : {Case{2, 0.3}, Case{4, -0.35}}) {
+    mech::Model m = point(c.d, 0.4, -0.3);
+    m.mechanical->K = Eigen::Vector3d(1, 1, 0).asDiagonal().toDenseMatrix().sparseView();
+    m = mech::model_of(*m.mechanical, "point3d");
+    const VectorXd x0 = sliding(1.0, c.a * kPi / c.d);
+    compared += expect_fd(m, x0, 0.5,
+                          {mass_entry(0, 0, 2.0), mass_entry(1, 1, 2.0), mass_entry(2, 2, 2.0),
+                           mass_entry(0, 1, 0.0)});
+  }
+  for (int d : {2, 4})
+    for (const double s0 : {3.0, 0.3}) {
+      mech::Model m = point(d, 0.3, -0.2);
+      m.mechanical->restitution = VectorXd::Constant(1, 0.5);
+      m = mech::model_of(*m.mechanical, "point3d");
+      VectorXd x0 = sliding(s0, 0.3 * kPi / d);
+      x0(2) = 0.2;
+      compared += expect_fd(m, x0, 0.45,
+                            {mass_entry(0, 0, 2.0), mass_entry(2, 2, 2.0), mass_entry(0, 2, 0.0),
+                             param("e[floor]", 0.5, [](mech::MechanicalModel& mm, double dd) {
+                               mm.restitution(0) += dd;
+                             })});
+    }
+  for (int d : {2, 4})
+    compared += expect_fd(pulled(d), (VectorXd(10) << 0, 0, 0, 0, 0, 0, 0, 0, 3, 1).finished(), 1.0,
+                          {mass_entry(0, 0, 2.0), mass_entry(2, 2, 2.0), mass_entry(3, 3, 1.0),
+                           mass_entry(0, 3, 0.0)});
+  // 4 columns on 6 states and 2 events: the turn and the stop; the two
+  // landings (T = 0.45 s between the second and the third), four runs;
+  // pulled from rest, 10 states and 5 (d = 2) or 2 events.
+  EXPECT_EQ(compared, 2 * 4 * 8 + 4 * 4 * 8 + 4 * 15 + 4 * 12);
+}
+
+// A unit point at rest on the floor (mu = 0.4, N = 9.81 N, d edge pairs)
+// pushed along a face's normal n_0 (angle pi/(2d)) by a force input `push`.
+mech::Model pushed_point(int d, const std::string& input, double angle) {
+  char gain[96];
+  std::snprintf(gain, sizeof gain, "[%.17g, %.17g, 0]", std::cos(angle), std::sin(angle));
+  return io::parse_matrix_model(
+      "name: pushed_point\ninputs:\n  - " + input +
+          "\nmechanical:\n  M: [[1, 0, 0], [0, 1, 0], [0, 0, 1]]\n  E: [[0, 0, 1]]\n"
+          "  f: [0, 0, -9.81]\n  coordinates: [x, y, z]\n  constraints: [floor]\n"
+          "  force_inputs: [{input: push, gain: " +
+          gain + "}]\n  friction:\n    - {contact: floor, tangents: [[1, 0, 0], [0, 1, 0]], d: " +
+          std::to_string(d) + ", mu: 0.4}\ninitial: [0, 0, 0, 0, 0, 0]\nt_end: 1.8\n",
+      "pushed_point.yaml");
+}
+
+// An input's own parameters through 3-D phases (sensitivity_cone.cpp: the
+// force column of the free acceleration moves as f[i]'s, the exosystem's
+// rows as they are). The ramp P t / t1 (pwl points (0, 0), (t1, P), P = 6
+// N, t1 = 2 s) along the face normal n_0: the point sticks until the push
+// reaches the polygon's face, P t / t1 = mu c N (c = cos(pi/(2d))), ts = mu
+// c N t1 / P, then slides along n_0 (the face: its cross force zero) with
+// x'' = P s / t1 - mu c N, the planar block's closed form with mu c for mu
+// (test_sensitivity_friction_params.cpp): at T = 1.8 s along n_0 dp/dP =
+// (T^3/6 - T ts^2/2 + ts^3/3) / t1, dv/dP = (T^2 - ts^2) / (2 t1), dts/dP =
+// -ts/P, and d/dt1 = -(P / t1) d/dP. To 1e-12 (as there).
+TEST(SensitivityCone, InputParametersAgainstClosedForm) {
+  int checked = 0;
+  for (int d : {2, 4}) {
+    const double th = kPi / (2 * d), c = std::cos(th);
+    const mech::Model m = pushed_point(d, "{name: push, kind: pwl, points: [[0, 0], [2, 6]]}", th);
+    const double P = 6, t1 = 2, muN = 0.4 * 9.81 * c, ts = muN * t1 / P, T = 1.8;
+    const sim::Trajectory tr = run(m, VectorXd::Zero(6), T, {"pwl_v[push][1]", "pwl_t[push][1]"});
+    ASSERT_TRUE(tr.ok()) << tr.message;
+    ASSERT_TRUE(tr.dx_final_exists[0] && tr.dx_final_exists[1]);  // (the zero gap's loss: x0's)
+    ASSERT_EQ(tr.events.size(), 1u);                              // stick -> slip on the face
+    ASSERT_NEAR(tr.events[0].t, ts, 1e-12);
+    const double dp = (T * T * T / 6 - T * ts * ts / 2 + ts * ts * ts / 3) / t1;
+    const double dv = (T * T - ts * ts) / (2 * t1);
+    for (int col = 0; col < 2; ++col) {
+      const double k = col == 0 ? 1.0 : -P / t1;  // d/dt1 = -(P / t1) d/dP
+      EXPECT_NEAR(tr.dx_final(0, col), k * dp * std::cos(th), 1e-12) << d << " " << col;
+      EXPECT_NEAR(tr.dx_final(1, col), k * dp * std::sin(th), 1e-12) << d << " " << col;
+      EXPECT_NEAR(tr.dx_final(3, col), k * dv * std::cos(th), 1e-12) << d << " " << col;
+      EXPECT_NEAR(tr.dx_final(4, col), k * dv * std::sin(th), 1e-12) << d << " " << col;
+      EXPECT_NEAR(tr.events[0].dt(col), k * -ts / P, 1e-12) << d << " " << col;
+      EXPECT_NEAR(tr.dx_final(2, col), 0.0, 1e-12);
+      EXPECT_NEAR(tr.dx_final(5, col), 0.0, 1e-12);
+      checked += 7;
+    }
+  }
+  EXPECT_EQ(checked, 28);
+}
+
+// A damped sine push (amplitude 8 N, 0.4 Hz, damping 0.1 1/s, phase 0.3,
+// offset 0.5 N) at 0.3 rad from the first tangent, d = 4: stick -> slip,
+// turns through the cone's edges and faces as the push swings, stick again;
+// its parameters against central differences.
+TEST(SensitivityCone, InputParametersAgainstCentralDifferences) {
+  const mech::Model m = pushed_point(
+      4,
+      "{name: push, kind: damped_sine, amplitude: 8, frequency: 0.4, damping: 0.1, phase: 0.3, "
+      "offset: 0.5}",
+      0.3);
+  auto input = [](const char* column, double theta, double mech::Input::*field) {
+    return test_support::FdColumn{column, theta, [field](mech::Model& mm, VectorXd&, double dd) {
+                                    mm.mechanical->inputs[0].*field += dd;
+                                  }};
+  };
+  const int n = expect_fd(m, VectorXd::Zero(6), 3.0,
+                          {input("amplitude[push]", 8, &mech::Input::amplitude),
+                           input("frequency[push]", 0.4, &mech::Input::frequency),
+                           input("damping[push]", 0.1, &mech::Input::damping),
+                           input("phase[push]", 0.3, &mech::Input::phase),
+                           input("offset[push]", 0.5, &mech::Input::offset)});
+  // 5 columns on 6 states and 4 events (stick -> slip, turns, stick).
+  EXPECT_EQ(n, 5 * (6 + 4));
 }
 
 }  // namespace

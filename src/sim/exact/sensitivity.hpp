@@ -46,6 +46,12 @@ bool input_param_kind(char kind);
 // force's amplitude in the velocity rows, M^-1 gain): what a friction
 // phase's forces and closed loop move by (sensitivity_friction.cpp).
 MatrixXd input_param_dA(const mech::MechanicalModel& m, const lcs::Lcs& sys, const SensParam& p);
+// M[i][j]'s velocity rows of dAcl in a friction phase with held rows H,
+// force columns Gc, forces F (lu factors H M^-1 Gc'); sets dF
+// (sensitivity_friction.cpp, planar and 3-D).
+MatrixXd mass_phase_rows(const SensParam& sp, const MatrixXd& G, const MatrixXd& Av,
+                         const MatrixXd& H, const MatrixXd& Gc, const MatrixXd& F,
+                         const Eigen::FullPivLU<MatrixXd>& lu, MatrixXd& dF);
 // Parses amplitude[in], offset[in], ..., pwl_v[in][k], pwl_t[in][k]: "" or
 // the input error; false (untouched) when `s` is none of those names.
 bool parse_input_param(const mech::MechanicalModel& m, const std::string& s, SensParam& p,

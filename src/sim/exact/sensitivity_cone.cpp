@@ -8,7 +8,9 @@
 // forces are lambda = F x = -S^-1 H Av x, S = H M^-1 Gc', and for a
 // parameter of the free acceleration dF = -S^-1 H dAv, dAcl = dAv + M^-1
 // Gc' dF; for mu[c] of a sliding contact its column moves by dGc = the
-// column / mu (the planar derivation, sensitivity_friction.cpp). Its
+// column / mu; M[i][j] moves G = M^-1 (dG = -G dM G: S, Av and the loop);
+// an input's own parameter its dAv as f[i] (the planar derivations,
+// sensitivity_friction.cpp). Its
 // monitors (cone_phase.cpp's add_cone_monitors) move with dF: stick, the
 // polygon's face j: mu c u_N - cos(theta_j) u_T - sin(theta_j) u_T2; a
 // face's ends: mu s u_N -+ w (s = sin(pi/(2d)), w the cross row's
@@ -124,8 +126,8 @@ void Sensitivity::cone_mode_derivatives(const Phase& ph, double t) {
   if (nc > 0) friction_F_ = -lu.solve(H * Av);
   for (size_t p = 0; p < P; ++p) {
     const SensParam& sp = cols_.params[p];
-    if (std::string("fKDuge").find(sp.kind) == std::string::npos) {
-      // M[i][j], an input's: not derived here (never a silent zero).
+    if (std::string("fKDugeM").find(sp.kind) == std::string::npos && !input_param_kind(sp.kind)) {
+      // Not derived here (never a silent zero).
       lose(t, -1, "'" + sp.name + "' is not computed through 3-D friction",
            {nx0_ + static_cast<int>(p)});
       continue;
@@ -135,7 +137,14 @@ void Sensitivity::cone_mode_derivatives(const Phase& ph, double t) {
     if (sp.kind == 'K') dAv.col(sp.j) = -G_.col(sp.i);
     if (sp.kind == 'D') dAv.col(N_ + sp.j) = -G_.col(sp.i);
     MatrixXd dA = MatrixXd::Zero(n_, n_);
-    if (sp.kind == 'u') {
+    // An input's own parameter (a force input's): its exosystem rows as
+    // they are, its velocity rows dAv through the forces as f[i]'s.
+    if (input_param_kind(sp.kind)) dA = input_param_dA(m, sys_, sp), dAv = dA.middleRows(N_, N_);
+    if (sp.kind == 'M') {
+      // G = M^-1 moves S, the free acceleration and the closed loop (the
+      // planar derivation: sensitivity_friction.cpp's mass_phase_rows).
+      dA.middleRows(N_, N_) = mass_phase_rows(sp, G_, Av, H, Gc, friction_F_, lu, dF);
+    } else if (sp.kind == 'u') {
       // mu of a sliding contact: its normal's column moves by its unit
       // column; a sticking contact's mu enters its monitors only.
       const size_t f = static_cast<size_t>(sp.j);

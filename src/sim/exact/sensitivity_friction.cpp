@@ -264,14 +264,14 @@ namespace lcsim::sim::detail {
 // (mass_phase_rows). A gap offset g[c] and a restitution e[c] move no phase
 // (g[c]'s term is the gap monitor's, dh = 1). A singular S (a statically
 // indeterminate stick, whose split the phase chooses) loses the columns.
-namespace {
 
 // M[i][j] (dM the unit entries (i, j) and (j, i)) in a friction phase: G =
 // M^-1 moves by dG = -G dM G, so the free acceleration Av = G [-K -D f ...]
 // by dAv = -G dM Av, S = H G Gc' by dS = H dG Gc', the forces F = -S^-1 H
 // Av by dF = -S^-1 (dS F + H dAv), and Acl's velocity rows Av + G Gc' F by
 // dAv + dG Gc' F + G Gc' dF. Returns those rows (N x n); dF is set (rows of
-// F; none when every contact is open).
+// F; none when every contact is open). Shared with the 3-D phases
+// (sensitivity_cone.cpp), whose H and Gc are other rows of the same form.
 MatrixXd mass_phase_rows(const SensParam& sp, const MatrixXd& G, const MatrixXd& Av,
                          const MatrixXd& H, const MatrixXd& Gc, const MatrixXd& F,
                          const Eigen::FullPivLU<MatrixXd>& lu, MatrixXd& dF) {
@@ -286,8 +286,6 @@ MatrixXd mass_phase_rows(const SensParam& sp, const MatrixXd& G, const MatrixXd&
   dF = -lu.solve(H * dGGt * F + H * dAv);
   return dAv + dGGt * F + G * Gc.transpose() * dF;
 }
-
-}  // namespace
 
 void Sensitivity::friction_mode_derivatives(const Phase& ph, double t) {
   const mech::MechanicalModel& m = *model_.mechanical;

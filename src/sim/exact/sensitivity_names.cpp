@@ -304,8 +304,8 @@ std::string refuse_friction(const mech::Model& model, const Options& opt, std::s
       "Options::sensitivity: model '" + model.name + "' has mechanical.friction; ";
   if (method == "moreau-jean") return "";
   const mech::MechanicalModel& m = *model.mechanical;
-  // The exact method differentiates 3-D phases (sensitivity_cone.cpp) and
-  // reports 3-D impacts absent by name.
+  // The exact method differentiates 3-D phases and impacts
+  // (sensitivity_cone*.cpp); the other methods (but moreau-jean) do not.
   for (size_t f = 0; f < m.friction.size() && !used.event_search; ++f)
     if (m.friction[f].is_3d())
       return head + "mechanical.friction[" + std::to_string(f) +
@@ -329,19 +329,10 @@ std::string refuse_friction(const mech::Model& model, const Options& opt, std::s
              "' has mechanical.friction; through planar stick / slip x0, f[i], g[c], K[i][j], "
              "D[i][j], M[i][j], e[c], mu[c] and an input's own parameters are)";
   }
-  // Through 3-D stick / slip and 3-D impacts (sensitivity_cone*.cpp): x0,
-  // f, g, K, D and mu; the mass matrix, the restitutions and an input's own
-  // parameters move the cone impact's map in ways it does not differentiate.
-  const auto f3 = std::find_if(m.friction.begin(), m.friction.end(),
-                               [](const mech::FrictionalContact& c) { return c.is_3d(); });
-  if (f3 == m.friction.end()) return "";
-  for (const std::string& s : opt.sensitivity)
-    if (s != "x0" && s.rfind("mu[", 0) != 0 &&
-        !(s.size() > 1 && std::string("fgKD").find(s[0]) != std::string::npos && s[1] == '['))
-      return "Options::sensitivity '" + s + "': not computed through 3-D friction (model '" +
-             model.name + "' has a 3-D contact at mechanical.friction[" +
-             std::to_string(f3 - m.friction.begin()) +
-             "]; through 3-D stick / slip x0, f[i], g[c], K[i][j], D[i][j] and mu[c] are)";
+  // Through 3-D stick / slip and 3-D impacts (sensitivity_cone*.cpp) the
+  // same columns: M[i][j] and e[c] through the cone impact's map, an input's
+  // own parameters through the phases (a model with friction has no moving
+  // stop, so they do not enter an impact).
   return "";
 }
 
