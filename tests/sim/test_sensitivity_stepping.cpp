@@ -792,3 +792,34 @@ TEST(StepSensitivity, EulerAtTheConesEdgeReportsNoDerivative) {
 
 }  // namespace
 }  // namespace lcsim
+
+namespace lcsim {
+namespace {
+
+// The 3-D point (point_on_floor_3d) landing from 1 mm and sliding at the
+// heading 0.3 rad (the vertex D_4, then the face) and along the face's
+// bisector pi/8, to rest: euler's derivative against its own central
+// differences with the same modes and facets at every sample (the landing's
+// gap term in z0 and g[floor] included).
+TEST(StepSensitivity, Euler3dThroughVerticesFacesAndStickMatchesItsOwnDifferences) {
+  const mech::Model m = point_on_floor_3d();
+  const double pi = std::acos(-1.0);
+  for (const double psi : {0.3, pi / 8}) {
+    SCOPED_TRACE(psi);
+    VectorXd x0(6);
+    x0 << 0, 0, 1e-3, 2 * std::cos(psi), 2 * std::sin(psi), -0.07;
+    const sim::Trajectory plain = run("euler", m, x0, 0.8, 1e-2);
+    ASSERT_TRUE(plain.ok()) << plain.message;
+    const std::vector<std::string> fm = friction_modes(plain);
+    EXPECT_EQ(fm[10], psi == 0.3 ? "slip-edge-4 " : "slip-face-4 ");
+    EXPECT_EQ(fm.back(), "stick ");
+    expect_matches_own_fd(
+        "euler", m, x0, 0.8, 1e-2,
+        {state(0, 1e-6), state(1, 1e-6), state(2, 1e-7), state(3, 1e-6), state(4, 1e-6),
+         entry("f[0]", 'f', 0, 0, 1e-4), entry("f[2]", 'f', 2, 0, 1e-4),
+         entry("g[floor]", 'g', 0, 0, 1e-7), friction_mu("mu[floor]", 0, 1e-4)});
+  }
+}
+
+}  // namespace
+}  // namespace lcsim
