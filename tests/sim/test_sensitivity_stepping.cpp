@@ -555,3 +555,271 @@ TEST(StepSensitivity, MoreauJean3dThroughVerticesFacesAndStickMatchesItsOwnDiffe
 
 }  // namespace
 }  // namespace lcsim
+
+namespace lcsim {
+namespace {
+
+// Backward Euler through friction (docs/sensitivities.md, "The time-stepping
+// derivative"): Moreau–Jean's step map at theta = 1 with the normal rows on
+// the gap, E v+ = -(E q + g) / h on an active row, so that row's right-hand
+// side moves with dq and dg.
+//
+// The unit block on the floor (robots/block_on_floor_friction.yaml, mu =
+// 0.4, from y = 0 at v0 = 2 m/s) to T = N h = 0.4 s before its stop. Each
+// step of euler: v_free = v + h f, the floor's row vy+ = -(y + g_c) / h
+// (g_c the floor's offset, 0), so the normal impulse is lambda_N = h |f1| -
+// (y + g_c) / h - vy and the block slides with vx+ = vx + h f0 / M00 - mu
+// lambda_N / M00. From y = vy = 0: vx_k = v0 + k h a, a = (f0 + mu f1) / M00,
+// and x_N = x0 + h sum_k vx_k = x0 + T v0 + a h^2 N (N + 1) / 2, so with
+// P = h^2 N (N + 1) / 2 = T (T + h) / 2:
+//   dx/dx0 = 1, dx/dvx0 = T, dx/df0 = P, dx/df1 = mu P, dx/dM00 = -a P,
+//   dx/dmu = f1 P = -g P; dvx/df1 = mu T, dvx/dmu = -g T;
+// and the gap term: y0 and g_c change the first step's lambda_N by -1/h
+// (the row puts the block back on the shifted floor within that step: y1 =
+// -g_c) and the second's by +1/h (the velocity -(y0 + g_c)/h it left is
+// stopped), so vx is shifted by mu / h over one step only: dy/dy0 = 0,
+// dy/dg = -1, dvx/dy0 = dvx/dg = 0, dx/dy0 = dx/dg = mu; vy0 changes the
+// first step's lambda_N alone (by -1), so dy/dvy0 = 0, dvx/dvy0 = mu,
+// dx/dvy0 = mu T. To 1e-12 (40 steps of rounding on numbers below 1).
+TEST(StepSensitivity, EulerSlidingBlockIsTheClosedForm) {
+  const mech::Model m = load("block_on_floor_friction.yaml");
+  const double T = 0.4, h = 1e-2, mu = 0.4, g = 9.81, a = -mu * g, P = T * (T + h) / 2;
+  const sim::Trajectory tr =
+      run("euler", m, m.initial, T, h, {"x0", "f[0]", "f[1]", "M[0][0]", "mu[floor]", "g[floor]"});
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  ASSERT_TRUE(tr.sensitivity_losses.empty()) << tr.sensitivity_losses.front().reason;
+  EXPECT_NEAR(tr.final_state(0), 2.0 * T + a * P, 1e-12);
+  // rows x, y, vx, vy; columns x0 (4), f0, f1, M00, mu, g
+  const MatrixXd& dx = tr.dx_final;
+  const double tol = 1e-12;
+  EXPECT_NEAR(dx(0, 0), 1.0, tol);
+  EXPECT_NEAR(dx(0, 1), mu, tol);
+  EXPECT_NEAR(dx(2, 1), 0.0, tol);
+  EXPECT_NEAR(dx(1, 1), 0.0, tol);
+  EXPECT_NEAR(dx(0, 2), T, tol);
+  EXPECT_NEAR(dx(2, 2), 1.0, tol);
+  EXPECT_NEAR(dx(0, 3), mu * T, tol);
+  EXPECT_NEAR(dx(2, 3), mu, tol);
+  EXPECT_NEAR(dx(1, 3), 0.0, tol);
+  EXPECT_NEAR(dx(0, 4), P, tol);
+  EXPECT_NEAR(dx(0, 5), mu * P, tol);
+  EXPECT_NEAR(dx(2, 5), mu * T, tol);
+  EXPECT_NEAR(dx(1, 5), 0.0, tol);
+  EXPECT_NEAR(dx(0, 6), -a * P, tol);
+  EXPECT_NEAR(dx(2, 6), -a * T, tol);
+  EXPECT_NEAR(dx(0, 7), -g * P, tol);
+  EXPECT_NEAR(dx(2, 7), -g * T, tol);
+  EXPECT_NEAR(dx(0, 8), mu, tol);
+  EXPECT_NEAR(dx(2, 8), 0.0, tol);
+  EXPECT_NEAR(dx(1, 8), -1.0, tol);
+  EXPECT_NEAR(dx(3, 8), 0.0, tol);
+}
+
+// The point on the 3-D floor (point_on_floor_3d: d = 4, edges at pi i / 4)
+// sliding from the floor at 2 m/s along psi = pi/8, the bisector of the face
+// between the edges D_4 and D_5: the friction impulse sits mid-face, its
+// component along the heading n = (cos psi, sin psi) is -mu lambda_N c (c =
+// cos(pi/8), the face's distance), and the face's row holds the velocity
+// along n. So the speed falls by h mu g c per step and, as for the planar
+// block with P = T (T + h) / 2: dx/dmu = -g c^2 P, dy/dmu = -g c s P (s =
+// sin psi), dx/df2 = mu c^2 P; a change of the start velocity keeps only
+// its component along n (the face's row projects it out in the first step):
+// dv/dvx0 = n c, dx/dvx0 = c^2 T, dy/dvx0 = c s T; and the gap term dz/dz0 =
+// 0. On the vertex D_4 = -x (psi = 0): dy/dvy0 = T, dvx/dvy0 = 0 (the
+// polyhedral cone does not brake sideways), dx/dmu = -g P. To 1e-12.
+TEST(StepSensitivity, Euler3dSlidingIsTheClosedForm) {
+  const mech::Model m = point_on_floor_3d();
+  const double T = 0.4, h = 1e-2, mu = 0.4, g = 9.81, P = T * (T + h) / 2, tol = 1e-12;
+  const double pi = std::acos(-1.0), c = std::cos(pi / 8), s = std::sin(pi / 8);
+  VectorXd x0(6);
+  x0 << 0, 0, 0, 2 * c, 2 * s, 0;
+  const std::vector<std::string> cols = {"x0", "f[2]", "mu[floor]"};
+  const sim::Trajectory face = run("euler", m, x0, T, h, cols);
+  ASSERT_TRUE(face.ok()) << face.message;
+  ASSERT_TRUE(face.sensitivity_losses.empty()) << face.sensitivity_losses.front().reason;
+  EXPECT_EQ(friction_modes(face).back(), "slip-face-4 ");
+  const MatrixXd& d = face.dx_final;  // rows x y z vx vy vz; columns x0 (6), f2, mu
+  EXPECT_NEAR(d(0, 7), -g * c * c * P, tol);
+  EXPECT_NEAR(d(1, 7), -g * c * s * P, tol);
+  EXPECT_NEAR(d(0, 6), mu * c * c * P, tol);
+  EXPECT_NEAR(d(3, 3), c * c, tol);
+  EXPECT_NEAR(d(4, 3), c * s, tol);
+  EXPECT_NEAR(d(0, 3), c * c * T, tol);
+  EXPECT_NEAR(d(1, 3), c * s * T, tol);
+  EXPECT_NEAR(d(2, 2), 0.0, tol);
+  x0 << 0, 0, 0, 2, 0, 0;
+  const sim::Trajectory edge = run("euler", m, x0, T, h, cols);
+  ASSERT_TRUE(edge.ok()) << edge.message;
+  ASSERT_TRUE(edge.sensitivity_losses.empty()) << edge.sensitivity_losses.front().reason;
+  EXPECT_EQ(friction_modes(edge).back(), "slip-edge-4 ");
+  const MatrixXd& e = edge.dx_final;
+  EXPECT_NEAR(e(1, 4), T, tol);
+  EXPECT_NEAR(e(4, 4), 1.0, tol);
+  EXPECT_NEAR(e(3, 4), 0.0, tol);
+  EXPECT_NEAR(e(0, 7), -g * P, tol);
+}
+
+// The number of stick / slip changes between consecutive samples of a run
+// (a contact opening or closing counts too).
+int mode_changes(const sim::Trajectory& tr) {
+  const std::vector<std::string> fm = friction_modes(tr);
+  int n = 0;
+  for (size_t k = 1; k < fm.size(); ++k) n += fm[k] != fm[k - 1];
+  return n;
+}
+
+// Backward Euler against its own central differences through stick / slip
+// changes on the shipped friction files (every perturbed run with the same
+// modes at every step), h = 1e-2. The mode changes between samples are
+// counted and asserted, so that each run does cross stick / slip (measured,
+// printed; the first is the first step closing the contact):
+//   incline (landing from 1 mm at 0.07 m/s): open, slip- at 0.01 s, stick
+//     at 0.82 s (2);
+//   belt (at rest on the belt moving at 0.2 m/s): open, slip- at 0.01 s,
+//     stick at 0.22 s, slip- at 1.33 s as the spring pulls it back (3);
+//   mass on a spring (from x = 1): open, slip- at 0.01 s, slip+ at 1.58 s
+//     (it turns), stick at 3.15 s (3).
+TEST(StepSensitivity, EulerThroughStickAndSlipMatchesItsOwnDifferences) {
+  struct Case {
+    std::string file;
+    VectorXd x0;
+    double T;
+    int changes;
+  };
+  const Eigen::Vector4d land(0.0, 1e-3, -1.5, -0.07);
+  const std::vector<Case> cases = {
+      {"incline_friction.yaml", land, 2.0, 2},
+      {"belt_friction.yaml", load("belt_friction.yaml").initial, 3.0, 3},
+      {"mass_spring_friction.yaml", load("mass_spring_friction.yaml").initial, 5.0, 3}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.file);
+    const mech::Model m = load(c.file);
+    const sim::Trajectory plain = run("euler", m, c.x0, c.T, 1e-2);
+    ASSERT_TRUE(plain.ok()) << plain.message;
+    std::cout << c.file << " euler mode changes " << mode_changes(plain) << ":";
+    {
+      const std::vector<std::string> fm = friction_modes(plain);
+      for (size_t k = 0; k < fm.size(); ++k)
+        if (k == 0 || fm[k] != fm[k - 1]) std::cout << " t=" << plain.samples[k].t << " " << fm[k];
+      std::cout << "\n";
+    }
+    EXPECT_EQ(mode_changes(plain), c.changes);
+    std::vector<Perturbation> ps = {
+        state(0, 1e-6),
+        state(2, 1e-6),
+        state(3, 1e-7),
+        entry("f[0]", 'f', 0, 0, 1e-4),
+        entry("f[1]", 'f', 1, 0, 1e-4),
+        entry("M[0][0]", 'M', 0, 0, 1e-4),
+        friction_mu("mu[" + m.mechanical->constraints[0] + "]", 0, 1e-6)};
+    if (m.mechanical->K.nonZeros() > 0) ps.push_back(entry("K[0][0]", 'K', 0, 0, 1e-4));
+    // Landing: the gap term's dq and dg (from a zero gap a perturbation of
+    // either makes the start infeasible, which the run refuses).
+    if (c.x0(1) > 0.0) {
+      ps.push_back(state(1, 1e-7));
+      ps.push_back(entry("g[" + m.mechanical->constraints[0] + "]", 'g', 0, 0, 1e-7));
+    }
+    expect_matches_own_fd("euler", m, c.x0, c.T, 1e-2, ps);
+  }
+}
+
+// Backward Euler's derivative converges to the exact method's at first
+// order on the sliding block (from the floor, to T = 0.4 s before its
+// stop): by the closed forms above euler's dx/df0, dx/df1, dx/dM00 and
+// dx/dmu are the exact method's times (T + h) / T and its velocity rows
+// are exact, so the error is g T h / 2 (dx/dmu) and halves exactly with h:
+// the ratio is 2 to the exact method's rounding (1e-12 of an error of
+// 5e-3 at the finest h), asserted within 1e-6. The y and vy columns are
+// left out: the gap term makes euler's dx/dy0 = mu N grow as 1 / h (the
+// first step lifts or presses the block back within one step, an impulse
+// the exact method spreads over a fall or an impact).
+TEST(StepSensitivity, EulerThroughFrictionConvergesToTheExactDerivative) {
+  const mech::Model m = load("block_on_floor_friction.yaml");
+  const double T = 0.4;
+  const std::vector<std::string> cols = {"x0", "f[0]", "f[1]", "M[0][0]", "mu[floor]"};
+  sim::Options opt;
+  opt.t_end = T;
+  opt.sensitivity = cols;
+  const sim::Trajectory exact = sim::simulate(m, m.initial, opt, "event");
+  ASSERT_TRUE(exact.ok()) << exact.message;
+  // (The exact method reports x0's y and vy columns absent: a zero gap at
+  // the start; those used here exist.)
+  double prev = 0.0;
+  for (const double h : {1e-2, 5e-3, 2.5e-3}) {
+    const sim::Trajectory tr = run("euler", m, m.initial, T, h, cols);
+    ASSERT_TRUE(tr.ok()) << tr.message;
+    double err = 0.0;
+    for (const int c : {0, 2, 4, 5, 6, 7})  // x0, vx0, f0, f1, M00, mu
+      for (const int r : {0, 2}) {
+        EXPECT_TRUE(tr.dx_final_exists[static_cast<size_t>(c)]);
+        EXPECT_TRUE(exact.dx_final_exists[static_cast<size_t>(c)]);
+        err = std::max(err, std::abs(tr.dx_final(r, c) - exact.dx_final(r, c)));
+      }
+    std::cout << "sliding block euler h " << h << " err " << err
+              << (prev > 0 ? " ratio " + std::to_string(prev / err) : "") << "\n";
+    EXPECT_NEAR(err, 9.81 * T * h / 2, 1e-9);
+    if (prev > 0) {
+      EXPECT_NEAR(prev / err, 2.0, 1e-6);
+    }
+    prev = err;
+  }
+}
+
+}  // namespace
+}  // namespace lcsim
+
+namespace lcsim {
+namespace {
+
+// As Moreau–Jean's (MoreauJeanAtTheConesEdgeReportsNoDerivative): pushed
+// from rest on the floor exactly at the friction limit f0 = mu |f1|, euler's
+// first step sticks with |lambda_T| = mu lambda_N (lambda_N = h |f1|, W = M):
+// the loss at t = 0 at `floor`, named for euler, and no number.
+TEST(StepSensitivity, EulerAtTheConesEdgeReportsNoDerivative) {
+  mech::Model m = load("block_on_floor_friction.yaml");
+  m.mechanical->f(0) = 0.4 * 9.81;
+  const sim::Trajectory tr = run("euler", m, Eigen::Vector4d::Zero(), 0.1, 1e-2, {"x0", "f[0]"});
+  ASSERT_TRUE(tr.ok()) << tr.message;
+  ASSERT_EQ(tr.sensitivity_losses.size(), 1u);
+  EXPECT_EQ(tr.sensitivity_losses.front().t, 0.0);
+  EXPECT_EQ(tr.sensitivity_losses.front().contact, "floor");
+  EXPECT_NE(tr.sensitivity_losses.front().reason.find("a step (euler) that sticks on its cone's "
+                                                      "boundary"),
+            std::string::npos)
+      << tr.sensitivity_losses.front().reason;
+  for (char e : tr.dx_final_exists) EXPECT_FALSE(e);
+}
+
+}  // namespace
+}  // namespace lcsim
+
+namespace lcsim {
+namespace {
+
+// The 3-D point (point_on_floor_3d) landing from 1 mm and sliding at the
+// heading 0.3 rad (the vertex D_4, then the face) and along the face's
+// bisector pi/8, to rest: euler's derivative against its own central
+// differences with the same modes and facets at every sample (the landing's
+// gap term in z0 and g[floor] included).
+TEST(StepSensitivity, Euler3dThroughVerticesFacesAndStickMatchesItsOwnDifferences) {
+  const mech::Model m = point_on_floor_3d();
+  const double pi = std::acos(-1.0);
+  for (const double psi : {0.3, pi / 8}) {
+    SCOPED_TRACE(psi);
+    VectorXd x0(6);
+    x0 << 0, 0, 1e-3, 2 * std::cos(psi), 2 * std::sin(psi), -0.07;
+    const sim::Trajectory plain = run("euler", m, x0, 0.8, 1e-2);
+    ASSERT_TRUE(plain.ok()) << plain.message;
+    const std::vector<std::string> fm = friction_modes(plain);
+    EXPECT_EQ(fm[10], psi == 0.3 ? "slip-edge-4 " : "slip-face-4 ");
+    EXPECT_EQ(fm.back(), "stick ");
+    expect_matches_own_fd(
+        "euler", m, x0, 0.8, 1e-2,
+        {state(0, 1e-6), state(1, 1e-6), state(2, 1e-7), state(3, 1e-6), state(4, 1e-6),
+         entry("f[0]", 'f', 0, 0, 1e-4), entry("f[2]", 'f', 2, 0, 1e-4),
+         entry("g[floor]", 'g', 0, 0, 1e-7), friction_mu("mu[floor]", 0, 1e-4)});
+  }
+}
+
+}  // namespace
+}  // namespace lcsim

@@ -277,8 +277,8 @@ namespace {
 // any other kind is refused by name, never taken as a zero column.
 std::string refuse_for_scheme(const detail::SensColumns& c, std::string_view method) {
   for (const detail::SensParam& p : c.params) {
-    if (std::string_view(method == "moreau-jean" ? "fKDMgeau" : "fKDMgea").find(p.kind) ==
-        std::string_view::npos)
+    if (std::string_view(method == "moreau-jean" || method == "euler" ? "fKDMgeau" : "fKDMgea")
+            .find(p.kind) == std::string_view::npos)
       return "Options::sensitivity '" + p.name + "': method '" + std::string(method) +
              "' does not compute it (the method 'event' does)";
     if (method == "moreau-jean" && p.kind == 'g')
@@ -294,15 +294,19 @@ std::string refuse_for_scheme(const detail::SensColumns& c, std::string_view met
   return "";
 }
 
-// Friction: Moreau–Jean's step map at its stick / slip outcome, planar or
-// 3-D (step_sensitivity.cpp, the columns the scheme knows); the exact
+// Friction: Moreau–Jean's and backward Euler's step maps at their stick /
+// slip outcome, planar or 3-D (step_sensitivity.cpp, the columns the scheme
+// knows); the exact
 // method through planar stick / slip, x0 and the parameters that leave the
 // friction's columns as they are; "" or why not.
 std::string refuse_friction(const mech::Model& model, const Options& opt, std::string_view method,
                             const OptionsUsed& used) {
   const std::string head =
       "Options::sensitivity: model '" + model.name + "' has mechanical.friction; ";
-  if (method == "moreau-jean") return "";
+  // Backward Euler's step with friction is Moreau–Jean's at theta = 1 with
+  // the normal rows on the gap (step_sensitivity.hpp's euler_gap): the same
+  // pieces, planar and 3-D.
+  if (method == "moreau-jean" || method == "euler") return "";
   const mech::MechanicalModel& m = *model.mechanical;
   // The exact method differentiates 3-D phases and impacts
   // (sensitivity_cone*.cpp); the other methods (but moreau-jean) do not.
@@ -314,8 +318,8 @@ std::string refuse_friction(const mech::Model& model, const Options& opt, std::s
              std::string(method) + "' (moreau-jean's step map is)";
   if (!used.event_search)
     return head + "method '" + std::string(method) +
-           "' does not compute sensitivities through stick / slip (methods 'event' and "
-           "'moreau-jean' do)";
+           "' does not compute sensitivities through stick / slip (methods 'event', "
+           "'moreau-jean' and 'euler' do)";
   // The free acceleration's parameters, the gap offsets, the mass matrix and
   // the restitutions: f, K, D, g, M, e, and a force input's own parameters
   // (sensitivity_friction.cpp; a model with friction has no moving stop).

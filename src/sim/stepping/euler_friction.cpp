@@ -38,6 +38,7 @@
 #include "sim/stepping/friction_labels.hpp"
 #include "sim/stepping/mj_friction.hpp"
 #include "sim/stepping/step_kernels.hpp"
+#include "sim/stepping/step_sensitivity.hpp"
 #include "sim/stepping/time_stepping_detail.hpp"
 
 namespace lcsim::sim::detail {
@@ -57,6 +58,7 @@ class EulerFrictionRun {
  public:
   EulerFrictionRun(const mech::Model& model, const VectorXd& x0, const Options& opt)
       : opt_(opt),
+        model_(model),
         m_(*model.mechanical),
         N_(m_.dofs()),
         k_(m_.num_constraints()),
@@ -119,6 +121,9 @@ class EulerFrictionRun {
     gaps();
     rhs_.resize(N_);
     dv_.resize(N_);
+    if (!opt_.sensitivity.empty())  // Moreau–Jean's at theta = 1 with the gap rows
+      sens_ = std::make_unique<MjStepSensitivity>(
+          model_, parse_sensitivity(model_, opt_.sensitivity), kTheta, true);
     record(0.0);
   }
 
@@ -135,6 +140,7 @@ class EulerFrictionRun {
     tr_.final_state.resize(2 * N_);
     tr_.final_state << q_, v_;
     tr_.energy_final = ops_.energy(q_, v_);
+    if (sens_) sens_->finish(tr_);
     return std::move(tr_);  // only ever returned from the run: no copy of the samples
   }
 
@@ -165,6 +171,7 @@ class EulerFrictionRun {
     v_next_ = v_ + h * dv_;  // v_free
     v_free_size_ = v_next_.size() > 0 ? v_next_.lpNorm<Eigen::Infinity>() : 0.0;
     if (k_ > 0 && !contact_step(f, h, t0)) return false;
+    if (sens_) sensitivity_step(t0, h);
     q_next_ = q_ + h * v_next_;  // q+ = q + h v+
     if (std::string why = guard_.check(last ? *opt_.t_end : j * grid_.h, q_next_, v_next_, last);
         !why.empty()) {
@@ -178,6 +185,17 @@ class EulerFrictionRun {
     const double t = last ? *opt_.t_end : j * grid_.h;
     if (sampler_.want(t, grid_.h, last)) record(t);
     return true;
+  }
+
+  // The step map's derivative (step_sensitivity.hpp): the step's active
+  // set, normal and friction impulses, and label_modes' velocity scale.
+  void sensitivity_step(double t0, double h) {
+    MjStepSensitivity::Friction fr;
+    fr.t = &lambda_T_;
+    fr.t2 = u_t2_.size() > 0 ? &friction_->lambda_T2() : nullptr;
+    fr.V = std::max(v_free_size_, v_next_.size() > 0 ? v_next_.lpNorm<Eigen::Infinity>() : 0.0);
+    static const IndexSet kNone;
+    sens_->step(t0, h, q_, v_, v_next_, k_ > 0 ? A_ : kNone, lamA_, &fr);
   }
 
   // The step LCP (MjFriction::step with the normal rows at the position
@@ -301,10 +319,12 @@ class EulerFrictionRun {
     s.friction_mode = fmode_;
     s.u_t2 = u_t2_;
     s.friction_facet = facet_;
+    if (sens_) sens_->fill(s.dx, s.dx_exists);
     tr_.record_sample(std::move(s), opt_);
   }
 
   const Options& opt_;
+  const mech::Model& model_;
   const mech::MechanicalModel& m_;
   const int N_, k_;
   const Eigen::Index nf_;
@@ -334,6 +354,7 @@ class EulerFrictionRun {
   double v_free_size_ = 0.0;  // |v_free|_inf of the last step (m/s): label_modes' scale
   lcp::Result failed_;
   std::string warning_;
+  std::unique_ptr<MjStepSensitivity> sens_;  // Options::sensitivity asked, else null
 };
 
 }  // namespace

@@ -120,8 +120,8 @@ int StepSensitivity::classify(const VectorXd& z, const VectorXd& w, const Vector
 // ---- Moreau–Jean ----
 
 MjStepSensitivity::MjStepSensitivity(const mech::Model& model, const SensColumns& cols,
-                                     double theta)
-    : StepSensitivity(model, cols), theta_(theta) {
+                                     double theta, bool euler_gap)
+    : StepSensitivity(model, cols), theta_(theta), euler_gap_(euler_gap) {
   const mech::MechanicalModel& m = *model.mechanical;
   N_ = m.dofs();
   M_ = dense(m.M);
@@ -185,28 +185,53 @@ void MjStepSensitivity::step(double t0, double h, const VectorXd& q, const Vecto
                h * h * theta_ * theta_ * K_ * dV;
   parameter_terms(t0, h, q, v, v_next, R);
   MatrixXd dVn = W.solve(R);
-  if (!A.empty() && !impulse_terms(t0, W, v, v_next, A, z, friction, dVn)) return;
+  if (!A.empty() && !impulse_terms(t0, h, W, q, v, v_next, A, z, friction, dVn)) return;
   const MatrixXd dQn = dQ + h * ((1.0 - theta_) * dV + theta_ * dVn);
   S_.topRows(N_) = dQn;
   S_.bottomRows(N_) = dVn;
 }
 
-bool MjStepSensitivity::impulse_terms(double t0, const Eigen::LLT<MatrixXd>& W, const VectorXd& v,
-                                      const VectorXd& v_next, const IndexSet& A, const VectorXd& z,
+Eigen::RowVectorXd MjStepSensitivity::normal_rhs(int r, double h, double rate,
+                                                 const MatrixXd& dVn) const {
+  Eigen::RowVectorXd out;
+  if (euler_gap_) {  // E_r dv+ = -(E_r dq + dg_r) / h
+    out = -(E_.row(r) * S_.topRows(N_)) / h - E_.row(r) * dVn;
+    for (size_t p = 0; p < cols_.params.size(); ++p)
+      if (cols_.params[p].kind == 'g' && cols_.params[p].i == r)
+        out(nx0_ + static_cast<int>(p)) -= 1.0 / h;
+    return out;
+  }
+  // E_S dv+ = -e_S (E_S dv) - de_S (E_S v)
+  out = -e_(r) * (E_.row(r) * S_.bottomRows(N_)) - E_.row(r) * dVn;
+  for (size_t p = 0; p < cols_.params.size(); ++p)
+    if (cols_.params[p].kind == 'e' && cols_.params[p].i == r)
+      out(nx0_ + static_cast<int>(p)) -= rate;
+  return out;
+}
+
+bool MjStepSensitivity::impulse_terms(double t0, double h, const Eigen::LLT<MatrixXd>& W,
+                                      const VectorXd& q, const VectorXd& v, const VectorXd& v_next,
+                                      const IndexSet& A, const VectorXd& z,
                                       const Friction* friction, MatrixXd& dVn) {
   const int na = static_cast<int>(A.size());
   MatrixXd EA(na, N_);
   for (int a = 0; a < na; ++a) EA.row(a) = E_.row(A[static_cast<size_t>(a)]);
   const VectorXd Gd = (EA * W.solve(EA.transpose())).diagonal();
-  const VectorXd Ev = EA * v, Evn = EA * v_next;
+  // The rows' rates: E v (Moreau–Jean's, times e) or euler's (E q + g) / h.
+  VectorXd Ev = EA * v;
+  if (euler_gap_)
+    for (int a = 0; a < na; ++a)
+      Ev(a) = (EA.row(a).dot(q) + model_.mechanical->g(A[static_cast<size_t>(a)])) / h;
+  const VectorXd Evn = EA * v_next;
   VectorXd w(na);
-  for (int a = 0; a < na; ++a) w(a) = Evn(a) + e_(A[static_cast<size_t>(a)]) * Ev(a);
+  for (int a = 0; a < na; ++a)
+    w(a) = Evn(a) + (euler_gap_ ? 1.0 : e_(A[static_cast<size_t>(a)])) * Ev(a);
   const double scale = std::max({Ev.cwiseAbs().maxCoeff(), Evn.cwiseAbs().maxCoeff(),
                                  (Gd.cwiseProduct(z)).cwiseAbs().maxCoeff()});
   std::vector<int> act;
   if (const int bad = classify(z, w, Gd, scale, act); bad >= 0) {
     lose_all(t0, A[static_cast<size_t>(bad)],
-             "degenerate step LCP (moreau-jean): zero impulse and zero velocity");
+             std::string("degenerate step LCP (") + scheme() + "): zero impulse and zero velocity");
     return false;
   }
   const int ns = static_cast<int>(act.size());
@@ -224,16 +249,11 @@ bool MjStepSensitivity::impulse_terms(double t0, const Eigen::LLT<MatrixXd>& W, 
   // Unknowns: the normal impulses of S, then the pieces' (stuck tangents,
   // faces); X the rows held, B the impulses' columns.
   MatrixXd X(nu, N_), B(N_, nu), rhs(nu, m_);
-  const auto dV = S_.bottomRows(N_);
   for (int a = 0; a < ns; ++a) {
     const int r = rows[static_cast<size_t>(a)];
     X.row(a) = E_.row(r);
     B.col(a) = E_.row(r).transpose();
-    // E_S dv+ = -e_S (E_S dv) - de_S (E_S v)
-    rhs.row(a) = -e_(r) * (E_.row(r) * dV) - E_.row(r) * dVn;
-    for (size_t p = 0; p < cols_.params.size(); ++p)
-      if (cols_.params[p].kind == 'e' && cols_.params[p].i == r)
-        rhs(a, nx0_ + static_cast<int>(p)) -= Ev(act[a]);
+    rhs.row(a) = normal_rhs(r, h, Ev(act[a]), dVn);
   }
   for (const auto& [a, col] : pc.normal) B.col(a) += col;
   for (size_t k = 0; k < pc.cols.size(); ++k) {
@@ -246,7 +266,8 @@ bool MjStepSensitivity::impulse_terms(double t0, const Eigen::LLT<MatrixXd>& W, 
   const Eigen::FullPivLU<MatrixXd> lu(X * WB);
   if (!lu.isInvertible()) {
     lose_all(t0, rows.front(),
-             "a step LCP (moreau-jean) whose linear map at its active set is singular");
+             std::string("a step LCP (") + scheme() +
+                 ") whose linear map at its active set is singular");
     return false;
   }
   dVn += WB * lu.solve(rhs);
@@ -305,7 +326,7 @@ bool MjStepSensitivity::contact_piece(double t0, const mech::FrictionalContact& 
   const bool inside = strictly_inside_cone(p1, flat ? 0.0 : p2, mu_pn, flat ? 1 : d);
   const bool still = std::max(std::abs(s), std::abs(s2)) <= stick_band(fc, V);
   auto lose = [&](const char* why) {
-    lose_all(t0, fc.contact, std::string("a step (moreau-jean) ") + why);
+    lose_all(t0, fc.contact, std::string("a step (") + scheme() + ") " + why);
     return false;
   };
   if (!inside && still)

@@ -60,9 +60,14 @@ class StepSensitivity {
 // q+ = q + h ((1 - theta) v + theta v+), E_S v+ + e_S . E_S v = 0 on the
 // strictly active rows S. Columns x0, f, K, D, M, e (g is refused: the map
 // depends on it only through the active set).
+// With `euler_gap` (backward Euler with friction, euler_friction.cpp: this
+// step at theta = 1 with the normal rows at the position level) the active
+// rows hold E_S v+ = -(E_S q + g_S) / h instead, so they move with dq and
+// dg (columns g[c]; e is refused for euler).
 class MjStepSensitivity : public StepSensitivity {
  public:
-  MjStepSensitivity(const mech::Model& model, const SensColumns& cols, double theta);
+  MjStepSensitivity(const mech::Model& model, const SensColumns& cols, double theta,
+                    bool euler_gap = false);
   // A step's friction: the tangential impulses per constraint along t and
   // t2 (N s; t2 null for a planar model) and the step's velocity scale V
   // (m/s; friction_labels.hpp's stick band).
@@ -95,9 +100,16 @@ class MjStepSensitivity : public StepSensitivity {
   // The impulses' part of dv+ (added to dVn): the strictly active normal
   // rows S as equalities with the friction's pieces; false when the step
   // map has no derivative (a loss recorded).
-  bool impulse_terms(double t0, const Eigen::LLT<MatrixXd>& W, const VectorXd& v,
-                     const VectorXd& v_next, const IndexSet& A, const VectorXd& z,
-                     const Friction* friction, MatrixXd& dVn);
+  bool impulse_terms(double t0, double h, const Eigen::LLT<MatrixXd>& W, const VectorXd& q,
+                     const VectorXd& v, const VectorXd& v_next, const IndexSet& A,
+                     const VectorXd& z, const Friction* friction, MatrixXd& dVn);
+  // The active row r's right-hand side for its impulse's change: E_r dv+
+  // (Moreau–Jean's -e_r E_r dv - de_r E_r v, or euler's -(E_r dq + dg_r) /
+  // h) less E_r dVn, the change without it; `rate` is E_r v or (E_r q +
+  // g_r) / h.
+  Eigen::RowVectorXd normal_rhs(int r, double h, double rate, const MatrixXd& dVn) const;
+  // "moreau-jean" or "euler": the losses' messages.
+  const char* scheme() const { return euler_gap_ ? "euler" : "moreau-jean"; }
   // The pieces of the frictional contacts on S (`rows`, constraint indices,
   // normal impulses lambda_N); false (a loss recorded) where two outcomes
   // meet or the impulse is not Coulomb's at the velocity.
@@ -116,6 +128,7 @@ class MjStepSensitivity : public StepSensitivity {
                        const VectorXd& v_next, MatrixXd& R) const;
 
   double theta_;
+  bool euler_gap_ = false;
   int N_ = 0;
   MatrixXd M_, D_, K_, E_;
   VectorXd e_;
