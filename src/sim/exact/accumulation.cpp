@@ -139,8 +139,8 @@ void EventDriven::project_onto(const std::vector<int>& rows, VectorXd& xa, bool 
     const VectorXd own = positions ? stop_offset(xa) : stop_rate(xa);
     for (size_t i = 0; i < rows.size(); ++i) r(static_cast<Eigen::Index>(i)) += own(rows[i]);
   }
-  const Eigen::LLT<MatrixXd> llt(m.M);
-  const MatrixXd MinvEt = llt.solve(EJ.transpose());
+  if (!M_llt_) M_llt_.emplace(m.M);  // M is the run's: factorised once
+  const MatrixXd MinvEt = M_llt_->solve(EJ.transpose());
   const VectorXd lambda = (EJ * MinvEt).completeOrthogonalDecomposition().solve(r);
   if (positions)
     xa.head(N_) -= MinvEt * lambda;

@@ -661,6 +661,9 @@ class EventDriven {
   };
   mutable std::optional<PhaseMemo> phase_memo_;
   mutable Phase failed_phase_;  // make_phase's result when it fails
+  // The Cholesky factor of the mechanical model's M (project_onto), built
+  // at its first use: M is the same throughout a run.
+  mutable std::optional<Eigen::LLT<MatrixXd>> M_llt_;
   // monitor_start(ph, xa ./ ph.D, t, 1.0) for a selection's checks (its m0
   // and d0): kept with the memo when ph is the memo's phase at its state, so
   // the checks of one chosen phase (consistent, lifting_normals) start its
