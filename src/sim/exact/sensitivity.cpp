@@ -680,6 +680,18 @@ void Sensitivity::moving_stop_columns(const std::vector<int>& A, const MatrixXd&
   J.block(N_, 2 * N_ + 1, N_, ne) = G_ * EA.transpose() * Tc * rateA;
 }
 
+ImpactActive impact_active(const EventResult::ImpactRound& rd, const MatrixXd& E) {
+  ImpactActive a;
+  const VectorXd& v = rd.v_before;
+  for (int r : rd.closed) {
+    a.pmax = std::max(a.pmax, std::abs(rd.impulse(r)));
+    a.amax = std::max(a.amax, std::abs(E.row(r).dot(v)));
+  }
+  for (int r : rd.closed)
+    if (rd.impulse(r) > kSqrtEps * a.pmax) a.A.push_back(r);
+  return a;
+}
+
 // One round of the impact law at its fixed active set A (the closed
 // contacts with a positive impulse): v+ = v + G E_A' mu with
 // mu = -W^{-1} (1 + e) E_A v (moreau-restitution: E_A v+ = -e E_A v) or
@@ -694,14 +706,9 @@ bool Sensitivity::impact_map(double t, const EventResult::ImpactRound& rd, Matri
   const MatrixXd E = dense(m.E);
   const VectorXd e = law_ == 'i' ? VectorXd::Zero(rd.restitution.size()) : rd.restitution;
   const VectorXd& v = rd.v_before;
-  double pmax = 0.0, amax = 0.0;
-  for (int r : rd.closed) {
-    pmax = std::max(pmax, std::abs(rd.impulse(r)));
-    amax = std::max(amax, std::abs(E.row(r).dot(v)));
-  }
-  std::vector<int> A;
-  for (int r : rd.closed)
-    if (rd.impulse(r) > kSqrtEps * pmax) A.push_back(r);
+  const ImpactActive act = impact_active(rd, E);
+  const std::vector<int>& A = act.A;
+  const double amax = act.amax;
   const int a = static_cast<int>(A.size());
   MatrixXd EA(a, N_);
   VectorXd eA(a);

@@ -66,6 +66,15 @@ struct SensColumns {
 };
 SensColumns parse_sensitivity(const mech::Model& model, const std::vector<std::string>& asked);
 
+// The rows of an impact round's closed set that carry an impulse (above
+// sqrt(eps) of the largest), and the largest impulse and approach rate
+// |E_r v-| over the closed set (the scales of the maps' degeneracy tests).
+struct ImpactActive {
+  std::vector<int> A;
+  double pmax = 0.0, amax = 0.0;
+};
+ImpactActive impact_active(const EventResult::ImpactRound& rd, const MatrixXd& E);
+
 // The sensitivity S = dx/dtheta (augmented state x n columns) of one run,
 // carried along beside the state by EventDriven's stages.
 class Sensitivity {

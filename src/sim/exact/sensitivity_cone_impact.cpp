@@ -284,14 +284,9 @@ bool Sensitivity::cone_impact_map(double t, const EventResult::ImpactRound& rd, 
   const MatrixXd E = MatrixXd(m.E);
   const VectorXd& v = rd.v_before;
   const VectorXd e = law_ == 'i' ? VectorXd::Zero(rd.restitution.size()) : rd.restitution;
-  double pmax = 0.0, amax = 0.0;
-  for (int r : rd.closed) {
-    pmax = std::max(pmax, std::abs(rd.impulse(r)));
-    amax = std::max(amax, std::abs(E.row(r).dot(v)));
-  }
-  std::vector<int> A;
-  for (int r : rd.closed)
-    if (rd.impulse(r) > kSqrtEps * pmax) A.push_back(r);
+  const ImpactActive act = impact_active(rd, E);
+  const std::vector<int>& A = act.A;
+  const double pmax = act.pmax, amax = act.amax;
   VectorXd R1(static_cast<Eigen::Index>(A.size()));
   VectorXd erate = VectorXd::Zero(static_cast<Eigen::Index>(A.size()));  // e[c]'s a_c
   for (size_t i = 0; i < A.size(); ++i) {

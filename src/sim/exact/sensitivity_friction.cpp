@@ -127,14 +127,9 @@ bool Sensitivity::friction_impact_map(double t, const EventResult::ImpactRound& 
   const MatrixXd E = MatrixXd(m.E);
   const VectorXd& v = rd.v_before;
   const VectorXd e = law_ == 'i' ? VectorXd::Zero(rd.restitution.size()) : rd.restitution;
-  double pmax = 0.0, amax = 0.0;
-  for (int r : rd.closed) {
-    pmax = std::max(pmax, std::abs(rd.impulse(r)));
-    amax = std::max(amax, std::abs(E.row(r).dot(v)));
-  }
-  std::vector<int> A;
-  for (int r : rd.closed)
-    if (rd.impulse(r) > kSqrtEps * pmax) A.push_back(r);
+  const ImpactActive act = impact_active(rd, E);
+  const std::vector<int>& A = act.A;
+  const double amax = act.amax;
   const int a = static_cast<int>(A.size());
   FrictionImpactRows s;
   for (size_t f = 0; f < m.friction.size(); ++f) {
