@@ -98,7 +98,9 @@ struct Inequalities {
     const Eigen::Index r = F.rows();
     F.conservativeResize(r + 1, s.P.cols());
     h.conservativeResize(r + 1);
-    F.row(r) = a_u * WP + a_l * s.P;
+    // A mode with no unknowns (every contact open) has rows of no entries:
+    // Eigen's row of a 0-column matrix offsets a null pointer.
+    if (F.cols() > 0) F.row(r) = a_u * WP + a_l * s.P;
     h(r) = (a_u * b)(0);
     on_rates.push_back(rate);
   }
