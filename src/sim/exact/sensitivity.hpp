@@ -52,6 +52,14 @@ MatrixXd input_param_dA(const mech::MechanicalModel& m, const lcs::Lcs& sys, con
 MatrixXd mass_phase_rows(const SensParam& sp, const MatrixXd& G, const MatrixXd& Av,
                          const MatrixXd& H, const MatrixXd& Gc, const MatrixXd& F,
                          const Eigen::FullPivLU<MatrixXd>& lu, MatrixXd& dF);
+// M[i][j] and e[c] of an impact map at a fixed outcome, v+ = v + G B lambda
+// with X G B lambda = c - R v, planar or cone (sensitivity_friction.cpp):
+// into dR's velocity rows of their columns.
+void mass_restitution_impact_columns(const std::vector<SensParam>& params, int nx0,
+                                     const MatrixXd& G, const MatrixXd& GB, const MatrixXd& X,
+                                     const Eigen::FullPivLU<MatrixXd>& W, const VectorXd& lambda,
+                                     const std::vector<int>& A, const VectorXd& erate,
+                                     MatrixXd& dR);
 // Parses amplitude[in], offset[in], ..., pwl_v[in][k], pwl_t[in][k]: "" or
 // the input error; false (untouched) when `s` is none of those names.
 bool parse_input_param(const mech::MechanicalModel& m, const std::string& s, SensParam& p,

@@ -230,41 +230,6 @@ void cone_impact_mu(const mech::MechanicalModel& m, const std::vector<int>& d,
   }
 }
 
-// M[i][j] and e[c] through the round at its outcome (the planar map's
-// terms, sensitivity_friction.cpp's mass_restitution_impact_columns): X, R,
-// B and c do not depend on M, G = M^-1 does (dG = -G dM G, dM the unit
-// entries (i, j), (j, i)), so dlambda = -(X G B)^-1 X dG B lambda and dv+ =
-// dG B lambda + G B dlambda. e[c] of a contact on A whose restitution is on
-// (approaching, erate(i) = a_c = E_c v < 0; 0 elsewhere and for the law
-// `inelastic`) moves R's row by E_c: dlambda = -(X G B)^-1 unit_i a_c, dv+ =
-// G B dlambda. A plastic impact after which the contact is held loses its
-// e column (Sensitivity::plastic_restitution). Into dR's velocity rows.
-void cone_impact_mass_restitution(const std::vector<SensParam>& params, int nx0, const MatrixXd& G,
-                                  const std::vector<int>& A, const VectorXd& erate,
-                                  const ConeImpactSolution& sol, MatrixXd& dR) {
-  const Eigen::Index N = G.rows(), na = sol.s.B.cols();
-  for (size_t p = 0; p < params.size(); ++p) {
-    const SensParam& sp = params[p];
-    VectorXd dv;
-    if (sp.kind == 'M') {
-      MatrixXd dM = MatrixXd::Zero(N, N);
-      dM(sp.i, sp.j) = dM(sp.j, sp.i) = 1.0;
-      const VectorXd dGBl = -G * (dM * (sol.GB * sol.lambda));
-      dv = dGBl;
-      if (na > 0) dv += sol.GB * VectorXd(-sol.W.solve(sol.s.X * dGBl));
-    } else if (sp.kind == 'e') {
-      const auto i = std::find(A.begin(), A.end(), sp.i) - A.begin();
-      if (i == static_cast<long>(A.size()) || erate(i) == 0.0) continue;
-      VectorXd unit = VectorXd::Zero(na);
-      unit(i) = erate(i);
-      dv = sol.GB * VectorXd(-sol.W.solve(unit));
-    } else {
-      continue;
-    }
-    dR.block(N, nx0 + static_cast<Eigen::Index>(p), N, 1) = dv;
-  }
-}
-
 }  // namespace
 
 bool Sensitivity::cone_impact_map(double t, const EventResult::ImpactRound& rd, MatrixXd& J,
@@ -338,7 +303,10 @@ bool Sensitivity::cone_impact_map(double t, const EventResult::ImpactRound& rd, 
     J.block(N_, 2 * N_, N_, 1) = sol.GB * sol.W.solve(sol.s.c);
   }
   cone_impact_mu(m, cone_d_, cols_.params, nx0_, G_, es, sol, dR);
-  cone_impact_mass_restitution(cols_.params, nx0_, G_, A, erate, sol, dR);
+  // M[i][j] and e[c]: the planar map's terms (X, R, B and c do not depend
+  // on M; e moves R's row of an approaching contact).
+  mass_restitution_impact_columns(cols_.params, nx0_, G_, sol.GB, sol.s.X, sol.W, sol.lambda, A,
+                                  erate, dR);
   return true;
 }
 

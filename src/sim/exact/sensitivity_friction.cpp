@@ -76,6 +76,8 @@ void mu_impact_columns(const mech::MechanicalModel& m, const std::vector<SensPar
   }
 }
 
+}  // namespace
+
 // M[i][j] and e[c] through one impact round at its outcome (the map's
 // rows X, R, B, c do not depend on either; G = M^-1 does). M[i][j] (dM the
 // unit entries (i, j), (j, i)): dG = -G dM G, so dlambda = -(X G B)^-1 X dG
@@ -86,27 +88,25 @@ void mu_impact_columns(const mech::MechanicalModel& m, const std::vector<SensPar
 // velocity rows of the column. (At e_c = 0 the column is lost where the
 // contact is then held: Sensitivity::plastic_restitution.)
 void mass_restitution_impact_columns(const std::vector<SensParam>& params, int nx0,
-                                     const MatrixXd& G, const std::vector<int>& A,
-                                     const VectorXd& erate, const FrictionImpactRows& s,
+                                     const MatrixXd& G, const MatrixXd& GB, const MatrixXd& X,
                                      const Eigen::FullPivLU<MatrixXd>& W, const VectorXd& lambda,
+                                     const std::vector<int>& A, const VectorXd& erate,
                                      MatrixXd& dR) {
-  const Eigen::Index N = G.rows(), na = s.B.cols();
+  const Eigen::Index N = G.rows(), na = GB.cols();
   for (size_t p = 0; p < params.size(); ++p) {
     const SensParam& sp = params[p];
     VectorXd dv;
     if (sp.kind == 'M') {
       MatrixXd dM = MatrixXd::Zero(N, N);
       dM(sp.i, sp.j) = dM(sp.j, sp.i) = 1.0;
-      const MatrixXd dG = -G * dM * G;
-      const VectorXd dGBl = dG * (s.B * lambda);
-      const VectorXd dlambda = na > 0 ? VectorXd(-W.solve(s.X * dGBl)) : VectorXd();
-      dv = na > 0 ? VectorXd(dGBl + G * (s.B * dlambda)) : VectorXd::Zero(N);
+      dv = -G * (dM * (GB * lambda));  // dG B lambda
+      if (na > 0) dv += GB * VectorXd(-W.solve(X * dv));
     } else if (sp.kind == 'e') {
       const auto i = std::find(A.begin(), A.end(), sp.i) - A.begin();
       if (i == static_cast<long>(A.size()) || erate(i) == 0.0) continue;
       VectorXd unit = VectorXd::Zero(na);
       unit(i) = erate(i);
-      dv = G * (s.B * VectorXd(-W.solve(unit)));
+      dv = GB * VectorXd(-W.solve(unit));
     } else {
       continue;
     }
@@ -114,7 +114,7 @@ void mass_restitution_impact_columns(const std::vector<SensParam>& params, int n
   }
 }
 
-}  // namespace
+namespace {}  // namespace
 
 bool Sensitivity::friction_impact_map(double t, const EventResult::ImpactRound& rd, MatrixXd& J,
                                       MatrixXd& dR) {
@@ -184,7 +184,7 @@ bool Sensitivity::friction_impact_map(double t, const EventResult::ImpactRound& 
     J.block(N_, 2 * N_, N_, 1) = GB * W.solve(s.c);
   }
   mu_impact_columns(m, cols_.params, nx0_, G_, A, s, W, lambda, dR);
-  mass_restitution_impact_columns(cols_.params, nx0_, G_, A, erate, s, W, lambda, dR);
+  mass_restitution_impact_columns(cols_.params, nx0_, G_, GB, s.X, W, lambda, A, erate, dR);
   return true;
 }
 
