@@ -116,7 +116,7 @@ PainleveVerdict decide_painleve_by_modes(const MatrixXd& Wg, const VectorXd& b, 
 // first_t[f]; normal_of[f] its normal. Per contact open, stick, slip on edge
 // i (2d), slip on face k (2d) (d = 1: open, stick, edges 0 and 1; no
 // friction: open, closed), each a square system; a singular one is judged
-// by velocity uniqueness (painleve_cone.cpp, solve_cone_mode). Above
+// by velocity uniqueness (solve_mode_system, painleve_modes.cpp). Above
 // kConePainleveModeBound combinations (18^4 = 104976 for four contacts at
 // d = 4), not enumerated.
 constexpr long kConePainleveModeBound = 200000;
