@@ -1,6 +1,7 @@
 // Internal helpers shared by the impact rules (not part of the public face).
 #pragma once
 
+#include <functional>
 #include <lcsim/impact/impact.hpp>
 #include <optional>
 #include <string>
@@ -90,12 +91,13 @@ bool no_painleve_after_solve(const MatrixXd& Wf, Eigen::Index nj,
 // the normal of frictional row f; per frictional contact open, stick,
 // slip+, slip-, per frictionless one open or closed: 4 or 2 square systems
 // per contact, each solution kept when the mode's inequalities hold to 1e-9
-// of their terms). unique: exactly one motion (Wg lambda, equal to 1e-8 of
-// its terms), that of lambda_law (the LCP's solution in the same
-// coordinates), and every mode's system regular; else `message` says why
-// (two motions and the modes of both, a singular mode system, which may
-// hold a continuum, naming its modes, or more than kPainleveModeBound
-// combinations: not enumerated). labels: each normal's name in messages.
+// of their terms; a singular system judged by solve_singular_mode, as the
+// cone's). unique: exactly one motion (Wg lambda, equal to 1e-8 of its
+// terms), that of lambda_law (the LCP's solution in the same coordinates);
+// else `message` says why (two motions and the modes of both, a singular
+// mode system that leaves the velocity free or is not decided, naming its
+// modes, or more than kPainleveModeBound combinations: not enumerated).
+// labels: each normal's name in messages.
 constexpr long kPainleveModeBound = 4096;
 struct PainleveVerdict {
   bool unique = false;
@@ -114,7 +116,7 @@ PainleveVerdict decide_painleve_by_modes(const MatrixXd& Wg, const VectorXd& b, 
 // first_t[f]; normal_of[f] its normal. Per contact open, stick, slip on edge
 // i (2d), slip on face k (2d) (d = 1: open, stick, edges 0 and 1; no
 // friction: open, closed), each a square system; a singular one is judged
-// by velocity uniqueness (painleve_cone.cpp, solve_cone_mode). Above
+// by velocity uniqueness (solve_mode_system, painleve_modes.cpp). Above
 // kConePainleveModeBound combinations (18^4 = 104976 for four contacts at
 // d = 4), not enumerated.
 constexpr long kConePainleveModeBound = 200000;
@@ -128,6 +130,55 @@ struct ConeModesProblem {
 };
 PainleveVerdict decide_cone_painleve_by_modes(const ConeModesProblem& p, const VectorXd& lambda_law,
                                               const std::vector<std::string>& labels);
+// What both enumerations share (painleve_modes.cpp). A mode's square
+// system: the impulses lambda = P x over its unknowns x, the equations
+// A x = rhs (A = R Wg P, rhs = -R b: the rates R u that the mode holds at
+// zero), its inequalities F x + h >= 0, each row's tolerance 1e-9 of the
+// terms of u (a rate row, on_rates) or of lambda (an impulse row).
+struct ModeInequalities {
+  MatrixXd F;
+  VectorXd h;
+  std::vector<bool> on_rates;
+  // The row a_u u + a_l lambda >= 0 (a_u, a_l: 1 x n), u = WP x + b.
+  void add(const MatrixXd& a_u, const MatrixXd& a_l, const MatrixXd& P, const MatrixXd& WP,
+           const VectorXd& b, bool rate);
+};
+struct ModeOutcome {
+  enum Kind { kNone, kMotion, kContinuum, kUndecided } kind = kNone;
+  VectorXd lambda;  // a motion's impulse (Wg lambda + b: the rates after)
+};
+// One mode's motion, its system solved with pivots below 1e-12 of the
+// largest taken as rounding. A regular system: its solution when the
+// inequalities hold. A singular one (dependent rows: a box's four coplanar
+// corners leave the normal block of rank 3) is judged by velocity, not
+// impulse, uniqueness: an inconsistent system is no motion; a consistent
+// one's impulses are x0 + K y (K its kernel) over the polyhedron of y where
+// the inequalities hold (see the .cpp): the law's motion when Wg P K = 0
+// and its velocity is the law's; no motion when the polyhedron is empty;
+// one motion when every vertex gives one velocity and no ray moves it;
+// else a continuum (kContinuum). A kernel above 3 or an inequality matrix
+// of lower rank: kUndecided.
+ModeOutcome solve_mode_system(const MatrixXd& Wg, const VectorXd& b, const MatrixXd& P,
+                              const MatrixXd& A, const VectorXd& rhs, const ModeInequalities& q,
+                              const VectorXd& lambda_law);
+// Equal motions: Wg (a - c) zero to 1e-8 of its terms (Wg = G M^-1 G' is
+// positive semidefinite, so Wg d = 0 is G' d = 0: the same velocity after).
+bool same_velocity(const MatrixXd& Wg, const VectorXd& b, const VectorXd& a, const VectorXd& c);
+// The motions an enumeration found, distinct by velocity, with the text of
+// each one's modes, and the verdict they give.
+struct MotionTally {
+  const MatrixXd& Wg;
+  const VectorXd& b;
+  std::vector<VectorXd> motions;
+  std::vector<std::string> modes;
+  // Takes a mode's outcome; false (message set, naming the modes by
+  // modes_text(), called only for a new motion or a refusal) when it ends
+  // the enumeration: a continuum, or a singular system not decided.
+  bool add(const ModeOutcome& o, const std::function<std::string()>& modes_text,
+           PainleveVerdict& out);
+  // unique when the one motion found is lambda_law's; else the message.
+  void decide(const VectorXd& lambda_law, PainleveVerdict& out) const;
+};
 // The message of a friction impact whose LCP no solver solved (`tried`: the
 // solvers, in the order tried).
 std::string friction_lcp_failure(const std::string& tried, const lcp::Result& res);

@@ -40,9 +40,36 @@ struct Problem {
   const VectorXd& mu;
 };
 
-// The impulse of `modes`, or nullopt when its inequalities fail; `singular`
-// set when its system is singular (not solved).
-std::optional<VectorXd> solve_modes(const Problem& p, const Modes& modes, bool& singular) {
+// The mode's inequalities as rows F x + h >= 0 (detail::ModeInequalities)
+// for a singular system: per normal open u_N >= 0; else lambda_N >= 0 and,
+// sticking, mu lambda_N -+ lambda_T >= 0, slipping, sign u_T >= 0 (the
+// tests of a regular system's solution in solve_modes, as rows).
+ModeInequalities mode_rows(const Problem& p, const Modes& modes, const MatrixXd& P,
+                           const MatrixXd& WP) {
+  const Eigen::Index n = p.Wg.rows();
+  ModeInequalities q{MatrixXd(0, P.cols()), VectorXd(0), {}};
+  const MatrixXd zero = MatrixXd::Zero(1, n);
+  for (Eigen::Index j = 0; j < p.nj; ++j) {
+    const int mj = modes[static_cast<size_t>(j)], f = p.friction_of[static_cast<size_t>(j)];
+    MatrixXd a = zero;
+    a(0, j) = 1.0;
+    q.add(mj == 0 ? a : zero, mj == 0 ? zero : a, P, WP, p.b, mj == 0);
+    if (mj == 0 || f < 0) continue;
+    for (const double sign : {1.0, -1.0}) {
+      if (mj >= 2 && sign != (mj == 2 ? 1.0 : -1.0)) continue;
+      MatrixXd r = zero;
+      r(0, p.nj + f) = mj == 1 ? -sign : sign;
+      if (mj == 1) r(0, j) = p.mu(f);
+      q.add(mj == 1 ? zero : r, mj == 1 ? r : zero, P, WP, p.b, mj >= 2);
+    }
+  }
+  return q;
+}
+
+// The motion of `modes`: a regular system's solution when its inequalities
+// hold; a singular one (dependent rows: a box's four coplanar corners)
+// judged by detail::solve_mode_system, as the cone's.
+ModeOutcome solve_modes(const Problem& p, const Modes& modes, const VectorXd& lambda_law) {
   const Eigen::Index n = p.Wg.rows();
   MatrixXd P = MatrixXd::Zero(n, n);  // lambda = P x
   std::vector<Eigen::Index> rows;     // the equations u_row = 0
@@ -61,7 +88,6 @@ std::optional<VectorXd> solve_modes(const Problem& p, const Modes& modes, bool& 
     rows.push_back(p.nj + f);
   }
   const auto nx = static_cast<Eigen::Index>(rows.size());
-  singular = false;
   VectorXd x = VectorXd::Zero(nx);
   if (nx > 0) {
     const MatrixXd WP = p.Wg * P.leftCols(nx);
@@ -73,12 +99,15 @@ std::optional<VectorXd> solve_modes(const Problem& p, const Modes& modes, bool& 
     }
     const Eigen::FullPivLU<MatrixXd> lu(A);
     if (!lu.isInvertible()) {
-      singular = true;
-      return std::nullopt;
+      const MatrixXd Px = P.leftCols(nx);
+      return solve_mode_system(p.Wg, p.b, Px, A, rhs, mode_rows(p, modes, Px, WP), lambda_law);
     }
     x = lu.solve(rhs);
   }
-  const VectorXd lambda = P.leftCols(nx) * x, u = p.Wg * lambda + p.b;
+  ModeOutcome out;
+  out.lambda = P.leftCols(nx) * x;
+  const VectorXd& lambda = out.lambda;
+  const VectorXd u = p.Wg * lambda + p.b;
   // The mode's inequalities to 1e-9 of their terms (the impact's acceptance
   // of rates and impulses, detail::finish).
   const double tol_u =
@@ -94,17 +123,10 @@ std::optional<VectorXd> solve_modes(const Problem& p, const Modes& modes, bool& 
            (f < 0 || std::abs(lambda(p.nj + f)) <= p.mu(f) * lambda(j) + tol_l);
     else
       ok = lambda(j) >= -tol_l && (mj == 2 ? 1.0 : -1.0) * u(p.nj + f) >= -tol_u;
-    if (!ok) return std::nullopt;
+    if (!ok) return {};
   }
-  return lambda;
-}
-
-// Equal motions: Wg (a - b) zero to 1e-8 of its terms. Wg = G M^-1 G' is
-// positive semidefinite, so Wg d = 0 is G' d = 0: the same velocity after.
-bool same_motion(const Problem& p, const VectorXd& a, const VectorXd& c) {
-  return (p.Wg * (a - c)).cwiseAbs().maxCoeff() <=
-         1e-8 * (1.0 + p.b.cwiseAbs().maxCoeff() +
-                 (p.Wg.cwiseAbs() * (a.cwiseAbs() + c.cwiseAbs())).maxCoeff());
+  out.kind = ModeOutcome::kMotion;
+  return out;
 }
 
 std::string modes_text(const Problem& p, const Modes& modes,
@@ -137,8 +159,7 @@ PainleveVerdict decide_painleve_by_modes(const MatrixXd& Wg, const VectorXd& b, 
     return out;
   }
   out.enumerated = true;
-  std::vector<VectorXd> motions;
-  std::vector<Modes> modes_of;
+  MotionTally tally{Wg, b, {}, {}};
   Modes modes(static_cast<size_t>(nj));
   for (long code = 0; code < total; ++code) {
     long c = code;
@@ -147,34 +168,10 @@ PainleveVerdict decide_painleve_by_modes(const MatrixXd& Wg, const VectorXd& b, 
       modes[static_cast<size_t>(j)] = static_cast<int>(c % base);
       c /= base;
     }
-    bool singular = false;
-    const std::optional<VectorXd> lambda = solve_modes(p, modes, singular);
-    if (singular) {
-      out.message = text("the system of the modes ", modes_text(p, modes, labels),
-                         " is singular (it may hold a continuum of motions)");
-      return out;
-    }
-    if (!lambda) continue;
-    bool seen = false;
-    for (const VectorXd& o : motions) seen = seen || same_motion(p, *lambda, o);
-    if (seen) continue;
-    motions.push_back(*lambda);
-    modes_of.push_back(modes);
+    const auto text_of = [&] { return modes_text(p, modes, labels); };
+    if (!tally.add(solve_modes(p, modes, lambda_law), text_of, out)) return out;
   }
-  if (motions.size() == 1 && same_motion(p, motions[0], lambda_law)) {
-    out.unique = true;
-    return out;
-  }
-  if (motions.empty()) {
-    out.message = "the contacts' modes' enumeration finds no motion (the solution fits none)";
-  } else if (motions.size() == 1) {
-    out.message = text("the impact has two motions: the modes ", modes_text(p, modes_of[0], labels),
-                       " and the LCP's solution");
-  } else {
-    out.message = text("the impact has ", motions.size(), " motions: the modes ",
-                       modes_text(p, modes_of[0], labels), " and the modes ",
-                       modes_text(p, modes_of[1], labels));
-  }
+  tally.decide(lambda_law, out);
   return out;
 }
 

@@ -159,26 +159,40 @@ TEST(FrictionImpact, PainleveCaseIsDiagnosedByName) {
   EXPECT_FALSE(ok.painleve);
 }
 
-// The modes' enumeration refuses what it cannot decide (issue 27). Two
-// copies of the skew contact (the same rows: W_g singular) at the velocity
-// with one motion alone: the enumeration meets the modes (stick, stick),
-// whose system has two equal pairs of rows, singular (the copies may share
-// the impulse in a continuum of ways), and names them. One skew contact and
-// 11 frictionless ones (4 x 2^11 = 8192 combinations, above 4096): not
-// enumerated, the sufficient condition's refusal ("not resolved").
+// The modes' enumeration refuses what it cannot decide (issue 27). The
+// skew contact c1 beside a frictionless copy c2 of its normal row (the same
+// row: W_g singular) at v- = (-1, 3): the modes (slip+, closed) have the
+// impulses n (l1 + l2) - 2.5 t l1, v+ = (-1 + l2 - 0.25 l1, 3 - 2.5 l1),
+// u_N = 0 on the line l2 = 1 + 0.25 l1, where the velocity moves with l1:
+// every l1 in [0, 1.2] (l1, l2 >= 0, u_T = 3 - 2.5 l1 >= 0) is a motion
+// (checked below at l1 = 0 and 1), a continuum, refused naming the
+// modes. (Two copies of the skew contact, refused here before as a
+// singular system, are one motion: painleve_singular_test.cpp.) One skew
+// contact and 11 frictionless ones (4 x 2^11 = 8192 combinations, above
+// 4096): not enumerated, the sufficient condition's refusal ("not
+// resolved").
 TEST(FrictionImpact, PainleveModesSingularOrAboveTheBoundAreRefusedByName) {
   {
     mech::MechanicalModel m = testing::make_model(Eigen::Matrix2d::Identity(),
                                                   (Eigen::MatrixXd(2, 2) << 1, 0, 1, 0).finished());
     m.restitution = vec({0, 0});
     m.friction.push_back({0, vec({0.5, 1}), 2.5});
-    m.friction.push_back({1, vec({0.5, 1}), 2.5});
-    const ImpactInput in = testing::input(m, vec({-1, 3}), {0, 1}, m.restitution);
+    const Eigen::VectorXd v = vec({-1, 3});
+    // Two motions of the continuum, from their impulses (Coulomb's law and
+    // the impact's complementarity, exact in binary fractions).
+    for (const double l1 : {0.0, 1.0}) {
+      const double l2 = 1 + 0.25 * l1;
+      const Eigen::VectorXd vp = v + vec({1, 0}) * (l1 + l2) + vec({0.5, 1}) * (-2.5 * l1);
+      EXPECT_EQ(vp(0), 0.0) << l1;                // u_N1 = u_N2 = 0
+      EXPECT_EQ(vp(1), 3 - 2.5 * l1) << l1;       // the velocity moves with l1
+      EXPECT_GT(0.5 * vp(0) + vp(1), 0.0) << l1;  // slip+: friction -mu P_N1
+    }
+    const ImpactInput in = testing::input(m, v, {0, 1}, m.restitution);
     const ImpactResult r = make_impact_law("moreau")->apply(in, *lcp::make_solver("lemke"));
     EXPECT_FALSE(r.ok());
     EXPECT_TRUE(r.painleve);
-    EXPECT_NE(r.message.find("the system of the modes 0 ('c1') (stick) 1 ('c2') (stick) is "
-                             "singular"),
+    EXPECT_NE(r.message.find("the system of the modes 0 ('c1') (slip+) 1 ('c2') (closed) is "
+                             "singular and leaves the velocity free (a continuum of motions)"),
               std::string::npos)
         << r.message;
   }
