@@ -107,5 +107,32 @@ contacts: [{link: a, plane: floor, name: toe}]
   EXPECT_EQ(ranges[0].range, 1.0);  // the limit's distance, exact
 }
 
+// bullet3's a1.urdf is <robot name="a1_description">: a user writing the
+// floating base's height as `a1.z` read "no joint 'a1.z' in a1.urdf", which
+// does not say what the base's coordinates are called. The message now
+// names them.
+TEST_F(RobotSurvey, AWrongBaseCoordinateNameSaysWhatTheBaseIsCalled) {
+  const std::string urdf = std::string("<robot name=\"a1_description\"><link name=\"trunk\">") +
+                           kInertial + "</link></robot>";
+  write("r.urdf", urdf);
+  const std::string message = error("", R"(urdf: r.urdf
+base: floating
+initial: {q: {a1.z: 0.3}}
+)");
+  EXPECT_NE(message.find("s.yaml: initial.q.a1.z: no joint 'a1.z' in "), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("r.urdf (the floating base's coordinates are a1_description.x ... "
+                         "a1_description.rz: base.name, by default the URDF's <robot name>)"),
+            std::string::npos)
+      << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;  // one line
+  // A joint's name (no base coordinate's suffix) keeps the plain message.
+  const std::string plain = error("", R"(urdf: r.urdf
+base: floating
+initial: {q: {knee: 0.3}}
+)");
+  EXPECT_EQ(plain.find("floating base"), std::string::npos) << plain;
+}
+
 }  // namespace
 }  // namespace lcsim
