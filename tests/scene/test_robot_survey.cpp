@@ -5,8 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <lcsim/mech/mech.hpp>
 #include <lcsim/scene/linearisation.hpp>
 #include <lcsim/scene/scene.hpp>
+#include <lcsim/sim/sim.hpp>
 #include <string>
 
 #include "scene_files.hpp"
@@ -132,6 +134,53 @@ base: floating
 initial: {q: {knee: 0.3}}
 )");
   EXPECT_EQ(plain.find("floating base"), std::string::npos) << plain;
+}
+
+// bullet3's cube_small.urdf: a 5 cm cube of 0.1 kg whose <inertia> is 1 kg
+// m^2 about each axis (Bullet's inertia_scaling hack), so its four bottom
+// corners act almost as one point (the Delassus matrix's rotational part
+// is r^2 / I = 1.25e-3 of its translational 1/m). Dropped flat from 1 cm
+// while sliding at (1, 0.3) m/s onto a floor with mu = 0.5 (d = 4),
+// Moreau–Jean "completed" at h = 1e-4, 5e-4 and 2e-3 with the slide
+// reversed (v_x = -1.49 m/s after landing at h = 1e-4) and the energy risen
+// from 0.0888 J to 0.159 J in the landing step: the dense cone LCP's last
+// fallback had accepted lambda_N = 0 beside edge impulses 0.28 N s. With
+// e = 0 and no input nothing may raise the energy, and Coulomb friction
+// can slow the slide along x or stop it but never reverse it. Whatever the
+// outcome, every recorded sample must keep both; a run that stops is a
+// numerical failure, never an input error. Tolerances: free flight under
+// gravity is exact in the theta = 1/2 step (constant force), so the energy
+// moves by rounding only, 1e-12 J against 0.09 J; a stuck corner's
+// velocity is 0 to rounding of 1 m/s, 1e-12.
+TEST_F(RobotSurvey, AFlatCubeWithAHugeInertiaNeverGainsEnergyInMoreauJean) {
+  write("r.urdf", R"(<robot name="cube"><link name="baseLink"><inertial><mass value="0.1"/>
+      <inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+      <collision><geometry><box size="0.05 0.05 0.05"/></geometry></collision></link></robot>)");
+  const auto loaded = scene::load_model_and_scene(write("s.yaml", R"(urdf: r.urdf
+base: {type: floating, pose: {xyz: [0, 0, 0.025]}}
+planes: [{name: floor, normal: [0, 0, 1]}]
+contacts: [{link: baseLink, plane: floor, friction: 0.5, d: 4}]
+contact_options: {max_distance: 0.01}
+initial: {q: {cube.z: 0.035}, v: {cube.x: 1, cube.y: 0.3}}
+)"));
+  const mech::MechanicalModel& m = *loaded.model.mechanical;
+  const Eigen::Index n = m.dofs();
+  const double e0 =
+      mech::total_energy(m, loaded.model.initial.head(n), loaded.model.initial.tail(n));
+  for (const double h : {1e-4, 5e-4, 2e-3}) {
+    sim::Options o;
+    o.t_end = 0.1;  // it lands at t = 0.045 s
+    o.h = h;
+    const sim::Trajectory tr =
+        sim::make_integrator("moreau-jean")->run(loaded.model, loaded.model.initial, o);
+    const std::string at = "h = " + std::to_string(h) + ": " + tr.message;
+    EXPECT_NE(tr.status, Status::kInvalidInput) << at;
+    ASSERT_FALSE(tr.samples.empty()) << at;
+    for (const sim::Sample& s : tr.samples) {
+      EXPECT_LE(mech::total_energy(m, s.x.head(n), s.x.tail(n)), e0 + 1e-12) << at << " t " << s.t;
+      EXPECT_GE(s.x(n), -1e-12) << at << " t " << s.t;  // v_x
+    }
+  }
 }
 
 }  // namespace
