@@ -4,6 +4,7 @@
 // robots' files.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <lcsim/mech/mech.hpp>
 #include <lcsim/scene/linearisation.hpp>
@@ -181,6 +182,37 @@ initial: {q: {cube.z: 0.035}, v: {cube.x: 1, cube.y: 0.3}}
       EXPECT_GE(s.x(n), -1e-12) << at << " t " << s.t;  // v_x
     }
   }
+}
+
+// bullet3's robots give <inertial> frames turned from their link's (the
+// A1's hips: rpy = (pi, 0, 0); Laikago's and Aliengo's links): the tensor
+// is written in the inertial frame, which lcsim must turn into the link's.
+// One link on a revolute joint about y at the origin, its centre of mass at
+// c = (0.3, 0.1, 0.2) m in a frame turned by rpy = (0.4, -0.3, 0.7), its
+// principal moments (0.01, 0.02, 0.025) kg m^2 along that frame's axes,
+// m = 2 kg. Independently: M = (R I R')_yy + m (cx^2 + cz^2) (parallel
+// axes), R = Rz(0.7) Ry(-0.3) Rx(0.4) (URDF's rpy); gravity (0, 0, -9.81)
+// gives the torque (c x m g)_y = m 9.81 cx at q0 = 0. Tolerance: rounding
+// of sums of a few products of numbers below 1, 1e-14.
+TEST_F(RobotSurvey, AnInertialFrameTurnedByRpyEntersTheMassMatrix) {
+  write("r.urdf", R"(<robot name="pendulum"><link name="base"/>
+    <link name="arm"><inertial><origin xyz="0.3 0.1 0.2" rpy="0.4 -0.3 0.7"/><mass value="2"/>
+      <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.025"/></inertial></link>
+    <joint name="j" type="continuous"><parent link="base"/><child link="arm"/>
+      <axis xyz="0 1 0"/></joint></robot>)");
+  const auto loaded = scene::load_model_and_scene(write("s.yaml", "urdf: r.urdf\njoints: [j]\n"));
+  const mech::MechanicalModel& m = *loaded.model.mechanical;
+  const Eigen::Matrix3d R = (Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()) *
+                             Eigen::AngleAxisd(-0.3, Eigen::Vector3d::UnitY()) *
+                             Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitX()))
+                                .toRotationMatrix();
+  const Eigen::Matrix3d I = R * Eigen::Vector3d(0.01, 0.02, 0.025).asDiagonal() * R.transpose();
+  const double mass = 2.0, cx = 0.3, cz = 0.2;
+  ASSERT_EQ(m.dofs(), 1);
+  EXPECT_NEAR(Eigen::MatrixXd(m.M)(0, 0), I(1, 1) + mass * (cx * cx + cz * cz), 1e-14);
+  EXPECT_NEAR(m.f(0), mass * 9.81 * cx, 1e-14);
+  // The turn matters: the unturned tensor's I_yy (0.02) differs by far more.
+  EXPECT_GT(std::abs(I(1, 1) - 0.02), 1e-3);
 }
 
 }  // namespace
