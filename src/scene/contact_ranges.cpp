@@ -101,18 +101,20 @@ struct Extent {
   double distance = std::numeric_limits<double>::infinity();
   std::string end = "search";
 };
-// A coordinate that does not move the point (`moves` false) is not
-// evaluated: its |p(q) - p(q0)| is exactly 0 at every step, so it never
-// exceeds, and its extent is the search's end, as the scan finds it.
+// Only a coordinate that moves the point is scanned (contact_ranges skips
+// the others: they never end a range). A way it cannot move at all (q0 at
+// its limit on that side: an extent of 0) is not scanned either: it would
+// report 0 as the range although nothing was measured; a coordinate locked
+// both ways keeps an infinite distance and is no candidate.
 Extent reach_along(const Bodies& dyn, const ContactFrame& c, const std::vector<Plane>& planes,
-                   const VectorXd& q0, Eigen::Index i, const Axis& a, double threshold,
-                   bool moves) {
+                   const VectorXd& q0, Eigen::Index i, const Axis& a, double threshold) {
   Extent r;
   const Plane* plane = plane_of(c, planes);
   const Eigen::Vector3d p0 = probe(dyn, c, plane, q0).seen;
   for (const double dir : {-1.0, 1.0}) {
+    const double extent = dir < 0 ? a.lower : a.upper;
+    if (!(extent > 0.0)) continue;
     const auto exceeds = [&](double step) {
-      if (!moves) return false;
       VectorXd q = q0;
       q(i) += dir * step;
       const Probe at = probe(dyn, c, plane, q);
@@ -121,7 +123,7 @@ Extent reach_along(const Bodies& dyn, const ContactFrame& c, const std::vector<P
       const double linear = c.normal_row(i) * dir * step;
       return moved > 0.0 && std::abs(exact - linear) > threshold * moved;
     };
-    const Reach got = first_crossing(exceeds, dir < 0 ? a.lower : a.upper);
+    const Reach got = first_crossing(exceeds, extent);
     if (got.ok < r.distance) {
       r.distance = got.ok;
       const bool limit = dir < 0 ? a.limit_lower : a.limit_upper;
@@ -152,18 +154,31 @@ std::vector<ContactRange> contact_ranges(const Scene& s, double threshold) {
     r.closed = mech::gap_is_zero(r.gap, scale(c.row));
     r.range = std::numeric_limits<double>::infinity();
     const std::vector<bool> moves = moving_coordinates(dyn, c);
-    for (std::size_t i = 0; i < s.lin.joints.size(); ++i) {
-      const auto ii = static_cast<Eigen::Index>(i);
-      const Axis a = axis_of(dyn, i, q0(ii));
-      if (any_rad && a.unit != "rad") continue;  // rotations bend the gap; report theirs
-      const Extent got = reach_along(dyn, c, s.planes, q0, ii, a, threshold, moves[i]);
-      if (got.distance < r.range || r.coordinate.empty()) {
-        r.coordinate = s.lin.joints[i];
-        r.unit = a.unit;
-        r.range = got.distance;
-        r.end = got.end;
+    // The rotations that move the point; if none does (a point moved by
+    // translations alone), the translations that move it (they never
+    // cross: the gap is affine along them).
+    for (const bool rotations_only : {true, false}) {
+      for (std::size_t i = 0; i < s.lin.joints.size(); ++i) {
+        const auto ii = static_cast<Eigen::Index>(i);
+        const Axis a = axis_of(dyn, i, q0(ii));
+        if (!moves[i] || (rotations_only && any_rad && a.unit != "rad")) continue;
+        const Extent got = reach_along(dyn, c, s.planes, q0, ii, a, threshold);
+        if (std::isfinite(got.distance) && (got.distance < r.range || r.coordinate.empty())) {
+          r.coordinate = s.lin.joints[i];
+          r.unit = a.unit;
+          r.range = got.distance;
+          r.end = got.end;
+        }
       }
+      if (!r.coordinate.empty()) break;
     }
+    for (std::size_t i = 0; r.coordinate.empty() && i < s.lin.joints.size(); ++i)
+      if (moves[i]) {  // every coordinate moving it is locked at its limits: it cannot move
+        r.coordinate = s.lin.joints[i];
+        r.unit = axis_of(dyn, i, q0(static_cast<Eigen::Index>(i))).unit;
+        r.range = 0.0;
+        r.end = "limit";
+      }
     out.push_back(r);
   }
   return out;

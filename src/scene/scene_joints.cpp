@@ -91,10 +91,29 @@ VectorXd SceneJoints::vector_of(const std::map<std::string, double>& values) con
   return v;
 }
 
+namespace {
+
+// For a name written as a floating base's coordinate (`<name>.z`) that is
+// none: the base's coordinates, as the user is likely to have guessed the
+// base's name (bullet3's a1.urdf is <robot name="a1_description">).
+std::string base_hint(const SceneJoints& joints, const std::string& n) {
+  const auto dot = n.rfind('.');
+  if (joints.base == 0 || dot == std::string::npos) return "";
+  const std::string tail = n.substr(dot + 1);
+  for (const char* c : {"x", "y", "z", "rx", "ry", "rz"})
+    if (tail == c)
+      return " (the floating base's coordinates are " + joints.names.front() + " ... " +
+             joints.names[joints.base - 1] + ": base.name, by default the URDF's <robot name>)";
+  return "";
+}
+
+}  // namespace
+
 NameCheck simulated(const SceneJoints& joints, const SceneUrdf& urdf) {
   return [&](const std::string& n) -> std::string {
     if (static_cast<std::size_t>(joints.coord(n)) < joints.base) return "";  // a floating base's
-    if (!urdf.model->getJoint(n)) return "no joint '" + n + "' in " + urdf.path;
+    if (!urdf.model->getJoint(n))
+      return "no joint '" + n + "' in " + urdf.path + base_hint(joints, n);
     if (joints.mimics.count(n))
       return "joint '" + n + "' mimics '" + joints.mimics.at(n).leader +
              "' (it follows its leader and is not a coordinate)";

@@ -187,6 +187,41 @@ void MjFriction::assemble_cone() {
   Wb_.noalias() = P * (Wg_ * P.transpose());
 }
 
+namespace {
+
+// Slack of edges_in_cone, relative to the step's largest normal or edge
+// impulse: a solution on a slipping contact has mu lambda_N - sum beta = 0
+// to the LCP's rounding (1e-12 of the problem; on an open contact beside
+// others, edge impulses of 8e-15 with lambda_N = 0 where they reach 0.3:
+// the DeepMimic humanoid's feet in euler).
+constexpr double kConeSlack = 1e-9;
+
+// Whether the cone LCP's z keeps each contact's edge impulses in its cone,
+// sum_i beta_i <= mu lambda_N (to kConeSlack). The dense path's last
+// fallback accepts z on a residual relative to |z|_inf, which a diverging
+// sliding-speed multiplier inflates: on a 0.1 kg cube whose URDF gives it
+// 1 kg m^2 (bullet3's cube_small.urdf: its four corners act almost as one
+// point) landing at 0.44 m/s, xi = 5.7e11 let through lambda_N = 0 with
+// sum beta = 0.28 N s, and the step reversed the cube's 1 m/s slide,
+// gaining energy. Such a z is no solution: the sweeps decide instead.
+bool edges_in_cone(const VectorXd& z, long na, const std::vector<int>& normal_of,
+                   const std::vector<int>& first, const std::vector<int>& d, const VectorXd& mu) {
+  if (mu.size() == 0) return true;
+  long ne = 0;
+  for (const int dj : d) ne += 2 * dj;
+  const double slack = kConeSlack * z.head(na + ne).cwiseAbs().maxCoeff();  // xi left out
+  for (Eigen::Index j = 0; j < mu.size(); ++j) {
+    const std::size_t js = static_cast<std::size_t>(j);
+    double sum = 0.0;
+    for (int i = 0; i < 2 * d[js]; ++i) sum += z(na + first[js] + i);
+    const double cap = mu(j) * z(normal_of[js]);
+    if (!(sum - cap <= slack)) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 // The step's cone LCP (mj_friction.hpp); lam_ gets (lambda_N, the impulses
 // along t, along t2) from the edge impulses.
 bool MjFriction::solve_cone(const lcp::Solver& solver, long& solves, lcp::Result& failed) {
@@ -208,7 +243,14 @@ bool MjFriction::solve_cone(const lcp::Solver& solver, long& solves, lcp::Result
   // of dependent rows: four corners of one face), the sweeps, whose local
   // 3 x 3 blocks stay positive definite; wherever the dense path solves,
   // its numbers stand.
-  if (!solve_kept(true, solver, solves, failed)) {
+  bool dense_ok = solve_kept(true, solver, solves, failed);
+  if (dense_ok && !edges_in_cone(zprev_, na_, normal_of_, first_, d_, mu_)) {
+    dense_ok = false;
+    zprev_version_ = -1;  // not a basis to start the next step from
+    failed.status = lcp::Status::kNumericalFailure;
+    failed.message = "friction cone LCP: its solution leaves the friction cone";
+  }
+  if (!dense_ok) {
     lcp::Result dense = failed;
     if (solve_cone_sparse(solves, failed)) return true;
     failed.message = dense.message + "; then " + failed.message;
