@@ -8,6 +8,7 @@
 #include <iostream>
 #include <lcsim/bullet/bullet.hpp>
 #include <lcsim/io/io.hpp>
+#include <string>
 
 #include "cli/command.hpp"
 
@@ -61,6 +62,20 @@ int report(lcsim::Status status, const char* what) {
   return exit_code(status);
 }
 
+// A first word that is no command (`lcsim check model.yaml`): one line
+// naming it and the commands, where CLI11 would say only "A subcommand is
+// required". Empty when argv[1] is an option or a known command.
+std::string unknown_command(const CLI::App& app, int argc, char** argv) {
+  if (argc < 2 || argv[1][0] == '-') return "";
+  std::string names;
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
+    if (sub->check_name(argv[1])) return "";
+    names += (names.empty() ? "" : ", ") + sub->get_name();
+  }
+  return "unknown command '" + std::string(argv[1]) + "' (the commands are " + names +
+         "; lcsim --help)";
+}
+
 }  // namespace
 }  // namespace lcsim::cli
 
@@ -71,6 +86,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "lcsim 0.1.0");
   for (auto& setup : lcsim::cli::command_registry()) setup(app);
+  if (const std::string why = lcsim::cli::unknown_command(app, argc, argv); !why.empty())
+    return lcsim::cli::report(Status::kInvalidInput, why.c_str());
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

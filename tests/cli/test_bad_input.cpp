@@ -362,4 +362,13 @@ TEST(BadInput, PlotsAreRenamedIntoPlace) {
   EXPECT_TRUE(fs::is_regular_file(odd));
 }
 
+// A first word that is no command (a new user's `lcsim check model.yaml`):
+// one line naming the word and the commands, exit 2, not CLI11's "A
+// subcommand is required".
+TEST(BadInput, UnknownCommandIsNamed) {
+  const fs::path dir = fresh_dir();
+  const CliRun r = lcsim(dir, "check " + quote(kTwoCarts));
+  expect_rejected(dir, r, {"unknown command 'check'", "simulate", "analyze"});
+}
+
 }  // namespace
