@@ -4,6 +4,7 @@
 // changes end it (EventDriven::make_phase).
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "sim/exact/event_driven_detail.hpp"
@@ -68,10 +69,27 @@ VectorXd balancing(const MatrixXd& A) {
 }  // namespace
 
 // The rows that start a path of k edges, for k = 1, 2, ..., until none is
-// left (true) or the set stops shrinking (a cycle: false). O(len n^2), no
+// left (true) or the set stops shrinking (a cycle: false); up to 64 rows as
+// bit masks (O(n^2) once, O(n) per length), else O(n^2) per length. No
 // products.
 bool no_path_of(const MatrixXd& A, int len) {
   const Eigen::Index n = A.rows();
+  if (n <= 64) {
+    std::vector<std::uint64_t> reads(static_cast<size_t>(n), 0);  // row i's nonzero columns
+    for (Eigen::Index j = 0; j < n; ++j)
+      for (Eigen::Index i = 0; i < n; ++i)
+        if (A(i, j) != 0.0) reads[static_cast<size_t>(i)] |= std::uint64_t{1} << j;
+    std::uint64_t starts = n == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << n) - 1;
+    for (int k = 1; k <= len; ++k) {
+      std::uint64_t next = 0;
+      for (Eigen::Index i = 0; i < n; ++i)
+        if (reads[static_cast<size_t>(i)] & starts) next |= std::uint64_t{1} << i;
+      if (next == 0) return true;
+      if (next == starts) return false;
+      starts = next;
+    }
+    return false;
+  }
   std::vector<char> starts(static_cast<size_t>(n), 1), next(static_cast<size_t>(n));
   Eigen::Index count = n;
   for (int k = 1; k <= len; ++k) {
@@ -144,8 +162,11 @@ const Phase& EventDriven::make_phase(const lcs::IndexSet& mode,
   // The state compared exactly (NaN never matches): a phase's monitors are
   // scaled by it, so only the very same state gives the very same phase.
   const PhaseMemo* m = phase_memo_ ? &*phase_memo_ : nullptr;
-  if (m && m->mode == mode && m->friction == friction && m->undetermined == undetermined &&
-      m->xa.size() == xa.size() && (m->xa.array() == xa.array()).all())
+  // A memo whose phase the run has taken (adopt_phase, event_driven.cpp)
+  // has none left (an empty D): built again.
+  if (m && m->phase.D.size() == xa.size() && m->mode == mode && m->friction == friction &&
+      m->undetermined == undetermined && m->xa.size() == xa.size() &&
+      (m->xa.array() == xa.array()).all())
     return m->phase;
   Phase ph = build_phase(mode, friction, undetermined, xa, err);
   if (!err.empty()) {
