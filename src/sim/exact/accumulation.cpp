@@ -128,20 +128,25 @@ void EventDriven::record_impacts(const std::vector<int>& contacts, const VectorX
 void EventDriven::project_onto(const std::vector<int>& rows, VectorXd& xa, bool positions) const {
   if (rows.empty()) return;
   const mech::MechanicalModel& m = *model_.mechanical;
-  MatrixXd EJ(rows.size(), N_);
   VectorXd r(rows.size());
-  for (size_t i = 0; i < rows.size(); ++i) {
-    EJ.row(i) = m.E.row(rows[i]);
+  for (size_t i = 0; i < rows.size(); ++i)
     r(i) = positions ? m.E.row(rows[i]).dot(xa.head(N_)) + m.g(rows[i])
                      : m.E.row(rows[i]).dot(xa.segment(N_, N_));
-  }
   if (moving_stops()) {  // the stops' own position or rate (schedule.cpp)
     const VectorXd own = positions ? stop_offset(xa) : stop_rate(xa);
     for (size_t i = 0; i < rows.size(); ++i) r(static_cast<Eigen::Index>(i)) += own(rows[i]);
   }
-  if (!M_llt_) M_llt_.emplace(m.M);  // M is the run's: factorised once
-  const MatrixXd MinvEt = M_llt_->solve(EJ.transpose());
-  const VectorXd lambda = (EJ * MinvEt).completeOrthogonalDecomposition().solve(r);
+  if (!projection_ || projection_->rows != rows) {  // E_J's factors, once per set J
+    MatrixXd EJ(rows.size(), N_);
+    for (size_t i = 0; i < rows.size(); ++i) EJ.row(i) = m.E.row(rows[i]);
+    if (!M_llt_) M_llt_.emplace(m.M);  // M is the run's: factorised once
+    MatrixXd MinvEt = M_llt_->solve(EJ.transpose());
+    Eigen::CompleteOrthogonalDecomposition<MatrixXd> cod =
+        (EJ * MinvEt).completeOrthogonalDecomposition();
+    projection_ = ProjectionFactors{rows, std::move(MinvEt), std::move(cod)};
+  }
+  const MatrixXd& MinvEt = projection_->MinvEt;
+  const VectorXd lambda = projection_->cod.solve(r);
   if (positions)
     xa.head(N_) -= MinvEt * lambda;
   else

@@ -78,6 +78,20 @@ void count_event(Trajectory& tr, const EventResult& ev) {
   for (const auto& w : ev.warnings) tr.warn(w.kind, w.first_t, w.message);
 }
 
+// The run's next phase from make_phase's result: moved out of the memo when
+// it is the memo's (no copy of its matrices and monitors). The memo keeps its
+// arguments and monitors' start, which march_start reads, and no phase (an
+// empty one: make_phase builds again if asked for the same).
+template <class Memo>
+void adopt_phase(std::optional<Memo>& memo, const Phase& built, Phase& phase) {
+  if (memo && &memo->phase == &built) {
+    phase = std::move(memo->phase);
+    memo->phase = Phase{};
+  } else {
+    phase = built;
+  }
+}
+
 }  // namespace
 
 void EventDriven::check_feasible(double t, const VectorXd& xa, const VectorXd& y) const {
@@ -163,8 +177,11 @@ bool EventDriven::start_run(RunState& r, const VectorXd& x0_user) {
     fail(tr, ev.message);
   } else {
     std::string err;
-    r.phase = make_phase(ev.mode, ev.friction, ldcp_undetermined_, ev.x_plus, err);
-    if (!err.empty()) fail(tr, err);
+    const Phase& built = make_phase(ev.mode, ev.friction, ldcp_undetermined_, ev.x_plus, err);
+    if (!err.empty())
+      fail(tr, err);
+    else
+      adopt_phase(phase_memo_, built, r.phase);
   }
   if (tr.status != RunStatus::kCompleted) {
     tr.final_state = x0_user;
@@ -351,11 +368,12 @@ bool EventDriven::reinitialise(RunState& r, const VectorXd& x_minus, EventResult
     return false;
   }
   std::string err;
-  r.phase = make_phase(ev.mode, ev.friction, ldcp_undetermined_, ev.x_plus, err);
+  const Phase& built = make_phase(ev.mode, ev.friction, ldcp_undetermined_, ev.x_plus, err);
   if (!err.empty()) {
     fail(r.tr, err);
     return false;
   }
+  adopt_phase(phase_memo_, built, r.phase);
   r.xa = ev.x_plus;
   if (ev.accumulation && ev.t_star > r.t) {
     // Continue from the accumulation time in the limit mode; the bounces

@@ -73,6 +73,10 @@ std::string friction_mode_name(FrictionMode m, int d);
 // An upper bound on the spectral radius, ||B^16||^(1/16) ||A|| with
 // B = A/||A|| (Gelfand's formula; 4 squarings, no eigen-decomposition).
 double spectral_radius_bound(const MatrixXd& A);
+// Whether A's nonzero pattern (an edge i -> j where A(i, j) != 0, NaN
+// included) has no path of `len` edges: then every product of `len`
+// factors A, formed in any order, is exactly zero (phase.cpp).
+bool no_path_of(const MatrixXd& A, int len);
 
 struct Monitor {
   RowVectorXd w;            // phi(t) = w x(t)
@@ -664,6 +668,41 @@ class EventDriven {
   // The Cholesky factor of the mechanical model's M (project_onto), built
   // at its first use: M is the same throughout a run.
   mutable std::optional<Eigen::LLT<MatrixXd>> M_llt_;
+  // project_onto's factors for the last row set J it projected on (the
+  // closed gaps, then the resting rates: at an event of a body resting on
+  // its contacts the same set, event after event): M^-1 E_J' and the
+  // decomposition of E_J M^-1 E_J', functions of J alone, so a projection
+  // on the same set solves with the very same numbers.
+  struct ProjectionFactors {
+    std::vector<int> rows;
+    MatrixXd MinvEt;
+    Eigen::CompleteOrthogonalDecomposition<MatrixXd> cod;
+  };
+  mutable std::optional<ProjectionFactors> projection_;
+  // The regular-only LDCP at an event (select_regular_mode) reads the state
+  // only through the free response C A^m x and its scales |C| |A|^m |x|
+  // (src/lcs/ldcp.cpp, FreeResponse): a selection whose free response equals
+  // the last one's, order by order (ldcp_free_response), is the last one's.
+  // Kept only while the free dynamics' |A| is nilpotent (no_path_of: then
+  // the response ends, and the LDCP's retry in scaled time returns its first
+  // result), for the configuration it was made in (reinitialisation.cpp).
+  struct LdcpMemo {
+    int config = -1;
+    std::vector<VectorXd> response;  // C A^m x, |C| |A|^m |x| for m = 0, 1, ...
+    lcs::ModeSelection sel;
+  };
+  std::optional<LdcpMemo> ldcp_memo_;
+  lcs::ModeSelection ldcp_scratch_;  // a selection not kept in the memo
+  int ldcp_nilpotent_config_ = -1;   // the configuration ldcp_nilpotent_ was found for
+  bool ldcp_nilpotent_ = false;
+  // lcs::select_mode(sys_, xa, ldcp_ regular only), or the memo's; its
+  // callers read mode, undetermined, status, message and lcp_solves (a
+  // repeated selection counts its solves again, so a run's lcp_solves read
+  // as before).
+  const lcs::ModeSelection& select_regular_ldcp(const VectorXd& xa);
+  // The free response the LDCP would read at xa (every order up to the last
+  // nonzero one; false when it does not end by order n or is not finite).
+  bool ldcp_free_response(const VectorXd& xa, std::vector<VectorXd>& response) const;
   // monitor_start(ph, xa ./ ph.D, t, 1.0) for a selection's checks (its m0
   // and d0): kept with the memo when ph is the memo's phase at its state, so
   // the checks of one chosen phase (consistent, lifting_normals) start its

@@ -4,6 +4,7 @@
 // changes end it (EventDriven::make_phase).
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "sim/exact/event_driven_detail.hpp"
@@ -67,9 +68,57 @@ VectorXd balancing(const MatrixXd& A) {
 
 }  // namespace
 
+// The rows that start a path of k edges, for k = 1, 2, ..., until none is
+// left (true) or the set stops shrinking (a cycle: false); up to 64 rows as
+// bit masks (O(n^2) once, O(n) per length), else O(n^2) per length. No
+// products.
+bool no_path_of(const MatrixXd& A, int len) {
+  const Eigen::Index n = A.rows();
+  if (n <= 64) {
+    std::vector<std::uint64_t> reads(static_cast<size_t>(n), 0);  // row i's nonzero columns
+    for (Eigen::Index j = 0; j < n; ++j)
+      for (Eigen::Index i = 0; i < n; ++i)
+        if (A(i, j) != 0.0) reads[static_cast<size_t>(i)] |= std::uint64_t{1} << j;
+    std::uint64_t starts = n == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << n) - 1;
+    for (int k = 1; k <= len; ++k) {
+      std::uint64_t next = 0;
+      for (Eigen::Index i = 0; i < n; ++i)
+        if (reads[static_cast<size_t>(i)] & starts) next |= std::uint64_t{1} << i;
+      if (next == 0) return true;
+      if (next == starts) return false;
+      starts = next;
+    }
+    return false;
+  }
+  std::vector<char> starts(static_cast<size_t>(n), 1), next(static_cast<size_t>(n));
+  Eigen::Index count = n;
+  for (int k = 1; k <= len; ++k) {
+    Eigen::Index c = 0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      char s = 0;
+      for (Eigen::Index j = 0; j < n && !s; ++j)
+        s = starts[static_cast<size_t>(j)] && A(i, j) != 0.0;
+      next[static_cast<size_t>(i)] = s;
+      c += s;
+    }
+    if (c == 0) return true;
+    if (c == count) return false;
+    starts.swap(next);
+    count = c;
+  }
+  return false;
+}
+
 double spectral_radius_bound(const MatrixXd& A) {
   const double a = A.cwiseAbs().rowwise().sum().maxCoeff();
   if (a == 0.0) return 0.0;
+  // A pattern without a path of 16 edges (the free dynamics and the sliding
+  // phases of a body without springs: x' = v, v' = const) has B^16 exactly
+  // zero below: each entry of a computed power is a sum of products along
+  // paths, every one with a factor exactly zero (B's entries are finite and
+  // at most 1 in size, so no product is NaN), so the bound is 0 * a = 0, as
+  // the squarings would return, without them.
+  if (std::isfinite(a) && no_path_of(A, 16)) return 0.0;
   MatrixXd B = A / a;
   for (int i = 0; i < 4; ++i) B = (B * B).eval();
   return std::pow(B.cwiseAbs().rowwise().sum().maxCoeff(), 1.0 / 16.0) * a;
@@ -113,8 +162,11 @@ const Phase& EventDriven::make_phase(const lcs::IndexSet& mode,
   // The state compared exactly (NaN never matches): a phase's monitors are
   // scaled by it, so only the very same state gives the very same phase.
   const PhaseMemo* m = phase_memo_ ? &*phase_memo_ : nullptr;
-  if (m && m->mode == mode && m->friction == friction && m->undetermined == undetermined &&
-      m->xa.size() == xa.size() && (m->xa.array() == xa.array()).all())
+  // A memo whose phase the run has taken (adopt_phase, event_driven.cpp)
+  // has none left (an empty D): built again.
+  if (m && m->phase.D.size() == xa.size() && m->mode == mode && m->friction == friction &&
+      m->undetermined == undetermined && m->xa.size() == xa.size() &&
+      (m->xa.array() == xa.array()).all())
     return m->phase;
   Phase ph = build_phase(mode, friction, undetermined, xa, err);
   if (!err.empty()) {

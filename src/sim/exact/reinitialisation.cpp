@@ -129,9 +129,7 @@ bool EventDriven::select_regular_mode(double t, const ContactScan& scan, const l
   // up to the state's rounding, and mode selection must see them so.
   project_onto(scan.in.closed, xa, true);
   project_onto(scan.resting, xa, false);
-  lcs::LdcpOptions o = ldcp_;
-  o.regular_only = true;  // the state is now regular: contact forces and higher
-  const lcs::ModeSelection sel = lcs::select_mode(sys_, xa, o);
+  const lcs::ModeSelection& sel = select_regular_ldcp(xa);
   out.lcp_solves += sel.lcp_solves;
   if (!sel.ok()) {
     out.message = "mode selection at t = " + std::to_string(t) + ": " + sel.message;
@@ -148,6 +146,60 @@ bool EventDriven::select_regular_mode(double t, const ContactScan& scan, const l
   }
   ldcp_undetermined_ = undetermined;
   return true;
+}
+
+bool EventDriven::ldcp_free_response(const VectorXd& xa, std::vector<VectorXd>& response) const {
+  // The products of the LDCP's FreeResponse::reach, in its order, so that
+  // equal responses here are equal responses there.
+  const MatrixXd Aabs = sys_.A.cwiseAbs(), Cabs = sys_.C.cwiseAbs();
+  VectorXd Amx = xa, Amx_abs = xa.cwiseAbs();
+  response.clear();
+  for (int m = 0; m <= n_; ++m) {
+    if (Amx.isZero(0.0) && Amx_abs.isZero(0.0)) return true;
+    response.push_back(sys_.C * Amx);
+    response.push_back(Cabs * Amx_abs);
+    if (!response[response.size() - 2].allFinite() || !response.back().allFinite()) return false;
+    Amx = sys_.A * Amx;
+    Amx_abs = Aabs * Amx_abs;
+  }
+  return false;
+}
+
+// The LDCP reads x only through C A^m x and |C| |A|^m |x| (their values: a
+// zero of either sign enters a level's coefficient as +0 + (+-0) = +0) and
+// whether A^m x and |A|^m |x| are zero vectors; the response here ends at the
+// first order where both are (every later order is then zero too), so its
+// length says where. With |A| nilpotent (no path of n edges in A's pattern:
+// the free dynamics of bodies without springs, x' = v, v' = const) the
+// response ends by order n, and the retry in scaled time never changes the
+// first result (its growth per order, log2_growth, is -inf). So a state whose
+// response equals the memo's, order by order, gets the memo's selection: the
+// very computation it would repeat. At the events of a box sliding on a floor
+// (only the sliding direction changes) it is the same, event after event.
+const lcs::ModeSelection& EventDriven::select_regular_ldcp(const VectorXd& xa) {
+  lcs::LdcpOptions o = ldcp_;
+  o.regular_only = true;  // the state is now regular: contact forces and higher
+  if (ldcp_nilpotent_config_ != config_) {
+    ldcp_nilpotent_config_ = config_;
+    ldcp_nilpotent_ = no_path_of(sys_.A, n_);
+    ldcp_memo_.reset();
+  }
+  std::vector<VectorXd> response;
+  const bool ends = ldcp_nilpotent_ && ldcp_free_response(xa, response);
+  if (ends && ldcp_memo_ && ldcp_memo_->config == config_ &&
+      ldcp_memo_->response.size() == response.size() &&
+      std::equal(response.begin(), response.end(), ldcp_memo_->response.begin(),
+                 [](const VectorXd& a, const VectorXd& b) {
+                   return a.size() == b.size() && (a.array() == b.array()).all();
+                 }))
+    return ldcp_memo_->sel;
+  lcs::ModeSelection sel = lcs::select_mode(sys_, xa, o);
+  if (!ends) {
+    ldcp_memo_.reset();
+    return ldcp_scratch_ = std::move(sel);
+  }
+  ldcp_memo_ = LdcpMemo{config_, std::move(response), std::move(sel)};
+  return ldcp_memo_->sel;
 }
 
 EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0,
