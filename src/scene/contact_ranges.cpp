@@ -39,31 +39,6 @@ Axis axis_of(const Bodies& b, std::size_t i, double q0) {
   return a;
 }
 
-// Contact c at q: its point seen from what it touches (in the world for a
-// plane, in the frame of the other body's link for a body's shape, so the
-// shape's own motion counts as the point's, relative to it) and its exact
-// gap (signed_distance). On a plane (`plane` set) both come from one pose
-// of the link.
-struct Probe {
-  Eigen::Vector3d seen;
-  double gap = 0.0;  // m
-};
-Probe probe(const Bodies& dyn, const ContactFrame& c, const Plane* plane, const VectorXd& q) {
-  const Eigen::Vector3d w = dyn.link_pose(c.point.body, c.point.link, q) * c.point.local;
-  if (plane) return {w, plane_distance(*plane, w, c.point.radius)};
-  return {dyn.link_pose(c.against->body, c.against->link, q).inverse() * w,
-          signed_distance(dyn, c.point, *c.against, q)};
-}
-
-// The plane contact c touches (nullptr for a body's shape); InputError as
-// signed_distance's when the scene has no plane of its name.
-const Plane* plane_of(const ContactFrame& c, const std::vector<Plane>& planes) {
-  if (c.against) return nullptr;
-  for (const Plane& p : planes)
-    if (p.name == c.plane) return &p;
-  throw InputError("contact '" + c.point.name + "': no plane '" + c.plane + "'");
-}
-
 // Marks the scene's coordinates that move link `link` of body b: the body's
 // floating base, and each simulated joint on the link's path from the root,
 // itself or as the leader of a mimic on it. No other coordinate enters the
@@ -110,14 +85,14 @@ Extent reach_along(const Bodies& dyn, const ContactFrame& c, const std::vector<P
                    const VectorXd& q0, Eigen::Index i, const Axis& a, double threshold) {
   Extent r;
   const Plane* plane = plane_of(c, planes);
-  const Eigen::Vector3d p0 = probe(dyn, c, plane, q0).seen;
+  const Eigen::Vector3d p0 = probe_contact(dyn, c, plane, q0).seen;
   for (const double dir : {-1.0, 1.0}) {
     const double extent = dir < 0 ? a.lower : a.upper;
     if (!(extent > 0.0)) continue;
     const auto exceeds = [&](double step) {
       VectorXd q = q0;
       q(i) += dir * step;
-      const Probe at = probe(dyn, c, plane, q);
+      const ContactProbe at = probe_contact(dyn, c, plane, q);
       const double moved = (at.seen - p0).norm();
       const double exact = at.gap - c.gap;
       const double linear = c.normal_row(i) * dir * step;
@@ -134,6 +109,21 @@ Extent reach_along(const Bodies& dyn, const ContactFrame& c, const std::vector<P
 }
 
 }  // namespace
+
+ContactProbe probe_contact(const Bodies& dyn, const ContactFrame& c, const Plane* plane,
+                           const VectorXd& q) {
+  const Eigen::Vector3d w = dyn.link_pose(c.point.body, c.point.link, q) * c.point.local;
+  if (plane) return {w, plane_distance(*plane, w, c.point.radius)};
+  return {dyn.link_pose(c.against->body, c.against->link, q).inverse() * w,
+          signed_distance(dyn, c.point, *c.against, q)};
+}
+
+const Plane* plane_of(const ContactFrame& c, const std::vector<Plane>& planes) {
+  if (c.against) return nullptr;
+  for (const Plane& p : planes)
+    if (p.name == c.plane) return &p;
+  throw InputError("contact '" + c.point.name + "': no plane '" + c.plane + "'");
+}
 
 std::vector<ContactRange> contact_ranges(const Scene& s, double threshold) {
   check_linearisation_threshold(threshold);

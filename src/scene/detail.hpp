@@ -261,6 +261,22 @@ std::vector<ContactFrame> against_frames(const std::vector<ContactBody>& bodies,
 // that has the point's centre already (the contact ranges).
 double plane_distance(const Plane& plane, const Eigen::Vector3d& centre, double radius);
 
+// Contact c at q (contact_ranges.cpp; the contact ranges and the run's
+// linearisation check): its point seen from what it touches (in the world
+// for a plane, in the frame of the other body's link for a body's shape, so
+// the shape's own motion counts as the point's) and its exact gap phi(q)
+// (signed_distance, m). On a plane (`plane` set) both come from one pose of
+// the link.
+struct ContactProbe {
+  Eigen::Vector3d seen;
+  double gap = 0.0;  // m
+};
+ContactProbe probe_contact(const Bodies& dyn, const ContactFrame& c, const Plane* plane,
+                           const VectorXd& q);
+// The plane contact c touches (nullptr for a body's shape); InputError as
+// signed_distance's when the scene has no plane of its name.
+const Plane* plane_of(const ContactFrame& c, const std::vector<Plane>& planes);
+
 // A scene of several URDFs (`bodies:`, scene_bodies.cpp): read_scene's
 // counterpart when the file has that key instead of `urdf:`.
 Scene read_bodies_scene(const YAML::Node& root, const std::string& source);

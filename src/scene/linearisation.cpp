@@ -11,6 +11,7 @@
 #include <lcsim/io/json.hpp>
 #include <lcsim/io/text.hpp>
 #include <lcsim/scene/linearisation.hpp>
+#include <limits>
 #include <stdexcept>
 
 #include "scene/detail.hpp"
@@ -23,11 +24,27 @@ using io::to_json;
 
 namespace {
 
-// e_M and e_F at q for the linear model (M0, f, K) and the exact dynamics.
+// e_M, e_F and e_C at q for the linear model (M0, f, K, the contacts' rows)
+// and the exact dynamics and geometry.
 struct Errors {
-  double mass = 0.0, force = 0.0;
-  double max() const { return std::max(mass, force); }
+  double mass = 0.0, force = 0.0, contact = 0.0;
+  std::size_t worst_contact = 0;  // where e_C is largest
+  double max() const { return std::max({mass, force, contact}); }
 };
+
+// Each contact's plane (nullptr against a body) and point at q0, for e_C.
+struct ContactsAtStart {
+  std::vector<const Plane*> planes;
+  std::vector<Eigen::Vector3d> seen;
+};
+ContactsAtStart contacts_at_start(const Scene& s, const Bodies& dyn, const VectorXd& q0) {
+  ContactsAtStart c;
+  for (const ContactFrame& f : s.contacts) {
+    c.planes.push_back(plane_of(f, s.planes));
+    c.seen.push_back(probe_contact(dyn, f, c.planes.back(), q0).seen);
+  }
+  return c;
+}
 
 struct Evaluator {
   const Scene& scene;
@@ -41,7 +58,10 @@ struct Evaluator {
         M0(s.model.mechanical->M.toDense()),
         K(s.model.mechanical->K.toDense()),
         f(s.model.mechanical->f),
-        q0(dyn.reference()) {}
+        q0(dyn.reference()),
+        start(contacts_at_start(s, dyn, q0)) {}
+
+  ContactsAtStart start;
 
   Errors at(const VectorXd& q) const {
     Errors e;
@@ -50,7 +70,28 @@ struct Evaluator {
     const VectorXd d = dyn.gravity_force(q) - scene.lin.tau_g + scene.lin.K_g * (q - q0);
     const double scale = std::max({(L + d).norm(), L.norm(), (K * (q - q0)).norm()});
     e.force = scale > 0.0 ? d.norm() / scale : 0.0;
+    contact_errors(q, e);
     return e;
+  }
+
+  // e_C (linearisation.hpp): only where the gap's error is at least its
+  // distance from contact in one of the two models, and above the rounding
+  // of the positions it comes from (16 eps of their size: a state 1e-18 m
+  // from q0 moves the point by rounding, and the ratio of two roundings
+  // is no error of the model).
+  void contact_errors(const VectorXd& q, Errors& e) const {
+    constexpr double kRounding = 16.0 * std::numeric_limits<double>::epsilon();
+    for (std::size_t k = 0; k < scene.contacts.size(); ++k) {
+      const ContactFrame& c = scene.contacts[k];
+      const ContactProbe at = probe_contact(dyn, c, start.planes[k], q);
+      const double moved = (at.seen - start.seen[k]).norm();
+      const double linear = c.gap + c.normal_row.dot(q - q0);
+      const double off = std::abs(at.gap - linear);
+      const double size = at.seen.norm() + start.seen[k].norm() + std::abs(at.gap) +
+                          std::abs(c.gap) + std::abs(linear);
+      if (off <= kRounding * size || off < std::min(std::abs(at.gap), std::abs(linear))) continue;
+      if (off / moved > e.contact) e.contact = off / moved, e.worst_contact = k;
+    }
   }
 };
 
@@ -97,6 +138,10 @@ LinearisationCheck check_linearisation(const Scene& scene, const std::vector<Vec
     const Errors e = ev.at(x.head(n));
     c.mass_error = std::max(c.mass_error, e.mass);
     c.force_error = std::max(c.force_error, e.force);
+    if (e.contact > c.contact_error) {
+      c.contact_error = e.contact;
+      c.contact = scene.contacts[e.worst_contact].point.name;
+    }
     if (e.max() > c.error) {
       c.error = e.max();
       c.worst_q = x.head(n);
@@ -113,6 +158,9 @@ std::string linearisation_warning(const LinearisationCheck& check, double thresh
   const std::string q = number_list(check.worst_q, 3);
   return "the linear model is off by " + g3(100.0 * check.error) + " % (mass " +
          g3(100.0 * check.mass_error) + " %, forces " + g3(100.0 * check.force_error) +
+         (check.contact_error > threshold
+              ? " %, contact '" + check.contact + "' " + g3(100.0 * check.contact_error)
+              : std::string()) +
          " %) at q = (" + q + "), above the threshold " + g3(100.0 * threshold) +
          " %: the run left the region where the linearisation about q0 holds";
 }
@@ -168,6 +216,8 @@ nlohmann::json to_json(const LinearisationCheck& check) {
   return {{"error", check.error},
           {"mass_error", check.mass_error},
           {"force_error", check.force_error},
+          {"contact_error", check.contact_error},
+          {"contact", check.contact},
           {"worst_q", to_json(check.worst_q)},
           {"states", check.states}};
 }

@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <lcsim/io/text.hpp>
 #include <lcsim/mech/mech.hpp>
 #include <lcsim/scene/linearisation.hpp>
 #include <lcsim/scene/scene.hpp>
@@ -73,6 +74,36 @@ TEST_F(RobotSurvey, AJointThatDoesNotMoveTheContactNeverEndsItsRange) {
   EXPECT_EQ(ranges[0].unit, "rad");
   EXPECT_EQ(ranges[0].end, "threshold");
   EXPECT_NEAR(ranges[0].range, 2 * std::asin(0.01), 1e-12);
+}
+
+// bullet3's husky rolls its wheels through 1.2-1.4 rad in half a second:
+// the rim points the scene keeps (max_distance) turn away from the floor,
+// where the linear model holds them at the bottom, and neither the mass nor
+// the forces (a wheel is symmetric about its axle) showed it. The run's
+// linearisation check measures each contact's gap too: the toe's sphere
+// L = 0.4 m below its hip, turned by th, has the exact gap L (1 - cos th),
+// the linear one 0 (its row has no hip entry at the bottom), and moved
+// 2 L sin(th/2): e_C = sin(th/2) (to 1e-12: rounding of L (1 - cos th)
+// ~1e-16 m against ~1e-2 m). Lifted 1 m off the floor, the same turn changes
+// the gap by less than its distance in both models: not counted, e_C = 0.
+TEST_F(RobotSurvey, TheRunsLinearisationCheckMeasuresTheContactsGaps) {
+  const scene::Scene s = load(kLegScene, leg_and_gripper(-3.0, 0.0));
+  for (const double th : {0.05, 0.5, 1.2}) {
+    const scene::LinearisationCheck c =
+        scene::check_linearisation(s, {Eigen::Vector3d(0.0, th, 0.0)});
+    EXPECT_NEAR(c.contact_error, std::sin(th / 2), 1e-12) << th;
+    EXPECT_EQ(c.contact, "toe.sphere0") << th;
+    EXPECT_GE(c.error, c.contact_error) << th;
+  }
+  const scene::LinearisationCheck lifted =
+      scene::check_linearisation(s, {Eigen::Vector3d(1.0, 0.5, 0.0)});
+  EXPECT_EQ(lifted.contact_error, 0.0);
+  EXPECT_EQ(lifted.contact, "");
+  const std::string w = scene::linearisation_warning(
+      scene::check_linearisation(s, {Eigen::Vector3d(0.0, 1.2, 0.0)}), 0.01);
+  EXPECT_NE(w.find("contact 'toe.sphere0' " + io::format_number(100 * std::sin(0.6), 3) + " %"),
+            std::string::npos)
+      << w;
 }
 
 // The DeepMimic humanoid's knees have q0 = 0 at their upper limit: each

@@ -24,14 +24,25 @@ using Eigen::VectorXd;
 //                the last term of the scale, the linear model's change of force
 //                since q0, keeps rounding noise from counting where both forces
 //                vanish (a spring at its rest length, gravity along no joint)
-//   error        e(q) = max(e_M(q), e_F(q))
+//   contact error e_C(q) = max over the scene's contacts c of
+//                |phi_c(q) - gap_c(q)| / |p_c(q) - p_c(q0)|, the exact gap
+//                phi against the linear one gap = phi(q0) + (d phi/dq)(q0) (q - q0),
+//                relative to the contact point's displacement (the measure of
+//                the contact ranges below), counted where the difference could
+//                decide whether the contact is open: |phi - gap| >= min(|phi|,
+//                |gap|) (a rolling wheel's rim point the linear model keeps at
+//                the bottom, a foot swinging near the floor), not for a point
+//                far from its plane in both models
+//   error        e(q) = max(e_M(q), e_F(q), e_C(q))
 // For a pendulum about its hanging equilibrium, e_F = |theta - sin theta| / |theta| ~ theta^2/6.
 struct LinearisationCheck {
-  double error = 0.0;        // max over the states of e(q)
-  double mass_error = 0.0;   // max of e_M
-  double force_error = 0.0;  // max of e_F
-  VectorXd worst_q;          // the state where e(q) was largest
-  std::size_t states = 0;    // how many states were evaluated
+  double error = 0.0;          // max over the states of e(q)
+  double mass_error = 0.0;     // max of e_M
+  double force_error = 0.0;    // max of e_F
+  double contact_error = 0.0;  // max of e_C
+  std::string contact;         // the contact where e_C was largest ("" when e_C = 0)
+  VectorXd worst_q;            // the state where e(q) was largest
+  std::size_t states = 0;      // how many states were evaluated
 };
 constexpr std::size_t kLinearisationStates = 200;  // states evaluated at most
 constexpr double kLinearisationThreshold = 0.01;   // default warning threshold (1 %)
