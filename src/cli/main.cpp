@@ -91,9 +91,12 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    // --help and --version exit 0; a malformed command line is an input
-    // error like any other (exit 2), not CLI11's own codes (104, 105, ...).
-    return app.exit(e) == 0 ? 0 : lcsim::cli::exit_code(Status::kInvalidInput);
+    // --help and --version exit 0 (CLI11 prints them); a malformed command
+    // line is an input error like any other: one line "lcsim: error: ...",
+    // exit 2, not CLI11's own codes (104, 105, ...) nor its two lines.
+    if (e.get_exit_code() == 0) return app.exit(e);
+    const std::string what = std::string(e.what()) + " (lcsim --help lists the options)";
+    return lcsim::cli::report(Status::kInvalidInput, what.c_str());
   } catch (const lcsim::io::InputError& e) {
     return lcsim::cli::report(Status::kInvalidInput, e.what());
   } catch (const std::invalid_argument& e) {

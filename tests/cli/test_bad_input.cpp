@@ -287,6 +287,27 @@ TEST(BadInput, UnknownNames) {
   expect_every_command_rejects(d, f, {"mechanical.restitutoin", "unknown key"});
 }
 
+// A malformed command line (an unknown flag, a value that does not parse, a
+// flag without its value, a missing argument) is an input error like a bad
+// file: one line naming the flag or argument, exit 2, nothing written; before,
+// CLI11 printed its own two lines without "lcsim: error: ".
+TEST(BadInput, MalformedCommandLine) {
+  const fs::path d = fresh_dir();
+  const std::string out = " --out " + quote(d / "out" / "t.csv");
+  const std::string sim = "simulate " + quote(kTwoCarts);
+  expect_rejected(d, lcsim(d, sim + " --no-such-flag" + out), {"--no-such-flag", "--help"});
+  expect_rejected(d, lcsim(d, sim + " --h abc" + out), {"--h", "abc"});
+  expect_rejected(d, lcsim(d, sim + out + " --t-end"), {"--t-end"});
+  expect_rejected(d, lcsim(d, "sweep " + quote(kTwoCarts) + " --repeat x"), {"--repeat", "x"});
+  expect_rejected(d, lcsim(d, "lcp"), {"file"});
+  expect_rejected(d, lcsim(d, ""), {"subcommand"});
+  // --help still prints the usage and exits 0.
+  const CliRun help = lcsim(d, "simulate --help");
+  EXPECT_EQ(help.exit_code, 0) << help.err;
+  EXPECT_NE(help.out.find("Usage:"), std::string::npos) << help.out;
+  fs::remove_all(d);
+}
+
 TEST(BadInput, UnreadablePaths) {
   const fs::path d = fresh_dir();
   for (const char* c : {"simulate", "analyze", "impacts", "sweep", "compare", "lcp"}) {
