@@ -336,12 +336,10 @@ void refuse_type(const Reader& r, const Line& l, const std::string& name) {
     r.fail(l, name,
            "current-controlled switches are not supported (lcsim reads S, whose control is a "
            "voltage)");
-  // S is read too; the message predates it and existing tests assert it
-  // word for word (docs/circuits.md lists S).
   if (std::string("rclvidefghxs").find(type) == std::string::npos)
     r.fail(l, name,
            "unknown element type '" + std::string(1, name[0]) +
-               "' (lcsim reads R, C, L, V, I, E, F, G, H, D and X)");
+               "' (lcsim reads R, C, L, V, I, E, F, G, H, D, S and X)");
 }
 
 void read_element(Reader& r, const Scope& s, const Line& l) {

@@ -84,7 +84,8 @@ TEST(Netlist, RefusesBadInputOnOneLineNamingLineAndElement) {
     const char* message;
   } cases[] = {
       {"t\nV1 a 0 1\nQ1 a b c npn\nR1 a 0 1k\n",
-       "bad.cir:3: Q1: unknown element type 'Q' (lcsim reads R, C, L, V, I, E, F, G, H, D and X)"},
+       "bad.cir:3: Q1: unknown element type 'Q' (lcsim reads R, C, L, V, I, E, F, G, H, D, S and "
+       "X)"},
       {"t\nV1 a 0 1\nR1 a\n", "bad.cir:3: R1: missing node or value (expected `name n+ n- value`)"},
       {"t\nV1 a 0 1\nR1 a 0 abc\n", "bad.cir:3: R1: non-numeric value 'abc'"},
       {"t\nV1 a 0 1\nC1 a 0 1u\nR1 a 0 1k\n",

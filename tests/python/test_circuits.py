@@ -32,7 +32,7 @@ def test_bad_netlist_raises_input_error(tmp_path):
     with pytest.raises(lcsim.InputError) as e:
         lcsim.load(str(bad))
     assert str(e.value) == (f"{bad}:4: Q1: unknown element type 'Q' "
-                            "(lcsim reads R, C, L, V, I, E, F, G, H, D and X)")
+                            "(lcsim reads R, C, L, V, I, E, F, G, H, D, S and X)")
 
 
 def test_pwl_source_breakpoints_are_scheduled_events(tmp_path):
