@@ -12,6 +12,7 @@
 #include <lcsim/sim/sim.hpp>
 #include <memory>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -118,9 +119,16 @@ void print_summary(const SimulateArgs& a, const mech::Model& model, const sim::T
     std::printf("energy %.12g -> %.12g\n", tr.energy_initial, tr.energy_final);
   std::printf("max violation %.3g, LCP solves %ld, warnings %ld, wall time %.3g s\n",
               tr.max_violation, tr.lcp_solves, tr.warning_count(), tr.wall_time_s);
-  if (lin)
-    std::printf("linearisation error %.3g %% (mass %.3g %%, forces %.3g %%) over %zu states\n",
-                100.0 * lin->error, 100.0 * lin->mass_error, 100.0 * lin->force_error, lin->states);
+  if (lin) {
+    const std::string contact =
+        lin->contact.empty()
+            ? std::string()
+            : lcsim::text(", contact '", lin->contact, "' ",
+                          lcsim::format_number(100.0 * lin->contact_error, 3), " %");
+    std::printf("linearisation error %.3g %% (mass %.3g %%, forces %.3g %%%s) over %zu states\n",
+                100.0 * lin->error, 100.0 * lin->mass_error, 100.0 * lin->force_error,
+                contact.c_str(), lin->states);
+  }
   if (written) std::printf("trajectory written to %s\n", a.out.c_str());
 }
 

@@ -63,14 +63,16 @@ struct Evaluator {
 
   ContactsAtStart start;
 
-  Errors at(const VectorXd& q) const {
+  // e_M and e_F at q, and e_C when `contacts` (the run's check; the joints'
+  // linear ranges leave the contacts to their own ranges, contact_ranges).
+  Errors at(const VectorXd& q, bool contacts) const {
     Errors e;
     e.mass = (dyn.mass_matrix(q) - M0).norm() / M0.norm();
     const VectorXd L = f - K * q;
     const VectorXd d = dyn.gravity_force(q) - scene.lin.tau_g + scene.lin.K_g * (q - q0);
     const double scale = std::max({(L + d).norm(), L.norm(), (K * (q - q0)).norm()});
     e.force = scale > 0.0 ? d.norm() / scale : 0.0;
-    contact_errors(q, e);
+    if (contacts) contact_errors(q, e);
     return e;
   }
 
@@ -135,7 +137,7 @@ LinearisationCheck check_linearisation(const Scene& scene, const std::vector<Vec
       throw std::invalid_argument("scene::check_linearisation: state " + std::to_string(i) +
                                   " has " + std::to_string(x.size()) + " entries, the scene has " +
                                   std::to_string(n) + " coordinates");
-    const Errors e = ev.at(x.head(n));
+    const Errors e = ev.at(x.head(n), true);
     c.mass_error = std::max(c.mass_error, e.mass);
     c.force_error = std::max(c.force_error, e.force);
     if (e.contact > c.contact_error) {
@@ -196,7 +198,7 @@ std::vector<LinearRange> linear_ranges(const Scene& scene, double threshold) {
       const auto exceeds = [&](double s) {
         VectorXd q = ev.q0;
         q(ii) += dir * s;
-        return ev.at(q).max() > threshold;
+        return ev.at(q, false).max() > threshold;
       };
       const Reach got = first_crossing(exceeds, end);
       const double ok = got.ok;
