@@ -323,7 +323,8 @@ Plan plan_of(const mech::Model& model, const WorldSettings& s) {
     throw std::invalid_argument(
         "bullet: " + (model.source.empty() ? "model '" + model.name + "'" : model.source) +
         ": mechanical.friction on a model that is not a URDF contact scene: Bullet runs "
-        "friction at a scene's contacts only (methods 'event' and 'moreau-jean' simulate it)");
+        "friction at a scene's contacts only (methods 'event', 'moreau-jean' and 'euler' simulate "
+        "it)");
   if (!setup) {
     p.rb6_limits = limits_of(model, s.limit_range);
     return p;
