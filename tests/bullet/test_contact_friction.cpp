@@ -192,8 +192,8 @@ TEST(BulletFriction, MethodBulletRunsASceneWithFrictionAndRefusesMatrices) {
   EXPECT_EQ(refused.status, sim::RunStatus::kInvalidInput);
   EXPECT_EQ(refused.message,
             "bullet: model 'block': mechanical.friction on a model that is not a URDF contact "
-            "scene: Bullet runs friction at a scene's contacts only (methods 'event' and "
-            "'moreau-jean' simulate it)");
+            "scene: Bullet runs friction at a scene's contacts only (methods 'event', "
+            "'moreau-jean' and 'euler' simulate it)");
 }
 
 }  // namespace
