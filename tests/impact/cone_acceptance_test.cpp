@@ -29,9 +29,10 @@ const double kPi = std::acos(-1.0);
 // I)): contact point r (from the centre of mass) has the rows
 //   n  = (0, 0, 1, r_y, -r_x, 0)    (z of v + w x r)
 //   t1 = (1, 0, 0, 0, r_z, -r_y)    (x)
-//   t2 = (0, 1, 0, -r_z, 0, r_x)    (y)
+//   t2 = (0, -1, 0, r_z, 0, -r_x)   (-y)
 // t1, t2 are the rows of a world frame (world_frame: in generalised
-// coordinates they are not Euclidean-orthogonal).
+// coordinates they are not Euclidean-orthogonal); t2 = -y orders the edges
+// as the survey's scene does (its dumped LCP is this cube's, checked below).
 mech::MechanicalModel body_on_floor(double mass, const Eigen::Vector3d& inertia,
                                     const std::vector<Eigen::Vector3d>& points,
                                     const std::vector<double>& mu, const std::vector<int>& d) {
@@ -48,7 +49,7 @@ mech::MechanicalModel body_on_floor(double mass, const Eigen::Vector3d& inertia,
     const Eigen::Vector3d& r = points[static_cast<size_t>(i)];
     Eigen::VectorXd t1(6), t2(6);
     t1 << 1, 0, 0, 0, r.z(), -r.y();
-    t2 << 0, 1, 0, -r.z(), 0, r.x();
+    t2 << 0, -1, 0, r.z(), 0, -r.x();
     mech::FrictionalContact c(i, t1, mu[static_cast<size_t>(i)]);
     c.tangent2 = t2.sparseView();
     c.edges = d[static_cast<size_t>(i)];
@@ -269,6 +270,38 @@ TEST(ConeLcpAcceptance, TheCubesStepLcpsAreSolvedOrRefusedByName) {
         EXPECT_NE(r.message.find("friction cone"), std::string::npos) << r.message;
       }
     }
+}
+
+// The survey's step LCPs are this file's cube: the dumped M is CubeLcp's
+// Wb with its slack rows and columns (to rounding: entries near 10 formed
+// of a few products, and the scene's rotation terms of 1e-19; 7e-15
+// measured, 1e-13 allowed), so the step's rates are B v for one v (least
+// squares, residual 1e-12 of |q|: 6e-16 measured, the rates were formed
+// from the scene's rows). Through the impact law at that v: Coulomb's law on the result
+// and no energy gained, or a failure that names the contact.
+TEST(ConeLcpAcceptance, TheCubesStepThroughTheImpactLawObeysCoulombOrNamesTheContact) {
+  const DumpedLcp d = read_dump();
+  const CubeLcp c;
+  ASSERT_EQ(d.lcp.M.rows(), c.lcp.M.rows());
+  EXPECT_LE((d.lcp.M - c.lcp.M).cwiseAbs().maxCoeff(), 1e-13);
+  for (size_t h = 0; h < d.q.size(); ++h) {
+    SCOPED_TRACE("step " + std::to_string(h));
+    const Eigen::VectorXd rates = d.q[h].head(c.B.rows());
+    const Eigen::VectorXd v = c.B.colPivHouseholderQr().solve(rates);
+    EXPECT_LE((c.B * v - rates).cwiseAbs().maxCoeff(), 1e-12 * rates.cwiseAbs().maxCoeff());
+    for (const char* name : {"pivot", "lemke"}) {
+      SCOPED_TRACE(name);
+      const ImpactResult r = moreau_friction_cone(all_closed(c.m, v), *lcp::make_solver(name));
+      if (!r.ok()) {
+        EXPECT_NE(r.status, Status::kInvalidInput);
+        EXPECT_NE(r.message.find("at contact "), std::string::npos) << r.message;
+        continue;
+      }
+      const Violation cv = coulomb_violation(c.m, v, r);
+      EXPECT_LE(cv.worst, kCoulombTol) << cv.what;
+      EXPECT_LE(r.energy_after, r.energy_before * (1 + 1e-12));
+    }
+  }
 }
 
 // The cube's LCP solved directly, by each solver the impact laws take: the
