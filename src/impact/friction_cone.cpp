@@ -95,12 +95,17 @@ FrictionLcp friction_cone_lcp(const MatrixXd& Wb, const VectorXd& rate_N, const 
 
 // Solves the cone's LCP: impact::solve_friction_lcp, then Lemke's own z,
 // each accepted only when detail::check_cone_lcp finds it a solution on the
-// impulses and rates (the row-scaled test measures complementarity against
-// |z|_inf, which a diverging slack inflates: bullet3's cube_small.urdf gave
-// lambda_N = 0 beside 0.28 N s of edge impulses with xi = 5.7e11 m/s, and
-// the natural residual relative to |z|_inf, the former last fallback,
-// accepted it). Neither: the failure, its status the first solver's (or
-// Lemke's when that one claimed a solution), naming the worst row.
+// impulses and rates. Lemke's z is tried because the row-scaled test
+// measures a row against its own terms, and the row of an edge orthogonal
+// to the velocity (sticking with the velocity along an edge or a bisector)
+// is formed of products cos(pi/2) |D||v| ~ 1e-17: its rounding, 1e-16, is
+// then 30% of its terms although it is 1e-16 of the rates' scale, which is
+// what check_cone_lcp measures it against. It was accepted before on the
+// natural residual relative to |z|_inf, which a diverging slack inflates:
+// bullet3's cube_small.urdf gave lambda_N = 0 beside 0.28 N s of edge
+// impulses with xi = 5.7e11 m/s. Neither accepted: the failure, naming
+// the worst row of Lemke's z, its status the first solve's, or Lemke's own
+// (a ray termination, a limit) when the first was a numerical failure.
 lcp::Result solve_friction_cone_lcp(const FrictionLcp& p, const lcp::Solver& solver, int* solves,
                                     std::string* tried) {
   lcp::Result res = solve_friction_lcp(p, solver, solves, tried);  // checked there
