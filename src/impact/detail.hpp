@@ -179,6 +179,42 @@ struct MotionTally {
   // unique when the one motion found is lambda_law's; else the message.
   void decide(const VectorXd& lambda_law, PainleveVerdict& out) const;
 };
+// The acceptance of a solution z of friction_cone_lcp, or of the planar
+// friction_lcp (its impulses lambda_N, lambda_R; its cone row 2 mu lambda_N
+// - lambda_R), on the quantities that matter (friction_cone.cpp; applied by
+// solve_friction_lcp and solve_friction_cone_lcp to every z they accept),
+// in the form of lcp::scaled_residual,
+// |min(z_i / its scale, w_i / its scale)| per row, with a scale per unit:
+// an impulse (lambda_N, beta; N s) against P = the largest impulse and its
+// rate (m/s) against V = |q|_inf + max_i sum_j |M_ij| |z_j| over the
+// impulses' rows and columns (the rates before the impact and the change
+// the impulses make); a slack xi (a sliding speed, m/s) against V and its
+// cone row mu lambda_N - sum beta (N s) against P. So: impulses >= 0, rates
+// >= 0, every contact's edge impulses within mu lambda_N, complementarity
+// of the rates and of the slack, each to kConeLcpTolerance of its own unit
+// and none relative to the slack, which the physics leaves free (any xi
+// with zero impulses on an open contact). Tolerance: the solvers accept a
+// row at 1e-10 of its own terms (solve_friction_lcp's second pass); a
+// solution's cone row has terms <= 2 mu lambda_N <= 2 mu P and a rate row
+// terms <= V + xi <= 2 V (xi <= |u+| <= V), so 1e-8 holds what they
+// accept for mu up to 50; a violation that matters (the cube's: 1 of P)
+// is far above it.
+constexpr double kConeLcpTolerance = 1e-8;
+struct ConeLcpCheck {
+  double worst = 0.0;      // the worst row's measure (infinity: not finite, wrong size)
+  Eigen::Index row = -1;   // that row of the LCP
+  Eigen::Index cone = -1;  // its frictional contact (0 .. n_F - 1), -1 if none
+  double impulse_scale = 0.0, rate_scale = 0.0;  // P (N s), V (m/s)
+  std::string what;                              // the row's numbers
+  bool ok() const { return worst <= kConeLcpTolerance; }
+  std::string text() const;
+};
+// n_F of a friction_cone_lcp, read from its M: the largest trailing square
+// block of zeros (the slacks' columns and cone rows; an edge's or a
+// normal's diagonal entry, a Delassus diagonal, is positive). 0 for an LCP
+// of another form.
+Eigen::Index cone_slack_count(const MatrixXd& M);
+ConeLcpCheck check_cone_lcp(const FrictionLcp& p, const VectorXd& z);
 // The message of a friction impact whose LCP no solver solved (`tried`: the
 // solvers, in the order tried).
 std::string friction_lcp_failure(const std::string& tried, const lcp::Result& res);

@@ -70,10 +70,21 @@ lcp::Result solve_friction_lcp(const FrictionLcp& p, const lcp::Solver& solver, 
                                std::string* tried) {
   lcp::Options opt;
   lcp::Result res;
+  // A row-scaled pass is kept only when the impulses and rates obey the
+  // law (detail::check_cone_lcp: the row-scaled test judges complementarity
+  // against |z|_inf, which a diverging slack inflates).
+  const auto physical = [&](lcp::Result& r) {
+    const detail::ConeLcpCheck c = detail::check_cone_lcp(p, r.z);
+    if (c.ok()) return true;
+    r.status = lcp::Status::kNumericalFailure;
+    r.worst_row = static_cast<int>(c.row);
+    r.message = "its solution refused: " + c.text();
+    return false;
+  };
   for (const double tol : {1e-12, 1e-10}) {
     opt.tolerance = tol;
     res = lcp::solve_scaled(solver, p.M, p.q, opt, solves, tried);
-    if (res.ok()) return res;
+    if (res.ok() && physical(res)) return res;
   }
   for (const char* name : {"lemke", "enum"}) {
     if (std::string(name) == "enum" && p.q.size() > 12) continue;
@@ -86,7 +97,7 @@ lcp::Result solve_friction_lcp(const FrictionLcp& p, const lcp::Solver& solver, 
       if (std::abs(r.z(i)) <= 64 * std::numeric_limits<double>::epsilon() * zmax) r.z(i) = 0.0;
     lcp::Result chk = lcp::evaluate(p.M, p.q, r.z);
     chk.scaled_residual = lcp::scaled_residual(p.M, p.q, r.z, &chk.worst_row);
-    if (chk.scaled_residual <= opt.tolerance) {
+    if (chk.scaled_residual <= opt.tolerance && detail::check_cone_lcp(p, r.z).ok()) {
       chk.status = lcp::Status::kSolved;
       chk.pivots = r.pivots;
       return chk;

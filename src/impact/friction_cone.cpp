@@ -93,34 +93,113 @@ FrictionLcp friction_cone_lcp(const MatrixXd& Wb, const VectorXd& rate_N, const 
   return out;
 }
 
-// Solves the cone's LCP: impact::solve_friction_lcp, and where its row-scaled
-// acceptance refuses, Lemke's z accepted on the natural residual relative to
-// the whole problem: 0 <= z, w = M z + q >= -tol, |z_i w_i| <= tol |z|_inf
-// with tol = 1e-12 (|q|_inf + |M|_inf |z|_inf). The row-scaled test measures
-// a row against its own terms, and the row of an edge orthogonal to the
-// velocity (sticking with the velocity along an edge or a bisector) is
-// formed of products cos(pi/2) |D||v| ~ 1e-17: its rounding, 1e-16, is
-// then 30% of its terms although it is 1e-16 of the problem's.
+// Solves the cone's LCP: impact::solve_friction_lcp, then Lemke's own z,
+// each accepted only when detail::check_cone_lcp finds it a solution on the
+// impulses and rates. Lemke's z is tried because the row-scaled test
+// measures a row against its own terms, and the row of an edge orthogonal
+// to the velocity (sticking with the velocity along an edge or a bisector)
+// is formed of products cos(pi/2) |D||v| ~ 1e-17: its rounding, 1e-16, is
+// then 30% of its terms although it is 1e-16 of the rates' scale, which is
+// what check_cone_lcp measures it against. It was accepted before on the
+// natural residual relative to |z|_inf, which a diverging slack inflates:
+// bullet3's cube_small.urdf gave lambda_N = 0 beside 0.28 N s of edge
+// impulses with xi = 5.7e11 m/s. Neither accepted: the failure, naming
+// the worst row of Lemke's z, its status the first solve's, or Lemke's own
+// (a ray termination, a limit) when the first was a numerical failure.
 lcp::Result solve_friction_cone_lcp(const FrictionLcp& p, const lcp::Solver& solver, int* solves,
                                     std::string* tried) {
-  lcp::Result res = solve_friction_lcp(p, solver, solves, tried);
+  lcp::Result res = solve_friction_lcp(p, solver, solves, tried);  // checked there
   if (res.ok()) return res;
   lcp::Options opt;
   lcp::Result r = lcp::make_solver("lemke")->solve(p.M, p.q, opt);
   if (solves) ++*solves;
-  if (tried) *tried += ", lemke (natural residual)";
+  if (tried) *tried += ", lemke (impulses and rates)";
   if (r.z.size() != p.q.size() || !r.z.allFinite()) return res;
   r.z = r.z.cwiseMax(0.0);
-  const VectorXd w = p.M * r.z + p.q;
-  const double zmax = r.z.cwiseAbs().maxCoeff();
-  const double tol =
-      1e-12 * (p.q.cwiseAbs().maxCoeff() + p.M.cwiseAbs().rowwise().sum().maxCoeff() * zmax);
-  for (Eigen::Index i = 0; i < w.size(); ++i)
-    if (w(i) < -tol || std::abs(w(i) * r.z(i)) > tol * zmax) return res;
-  r.status = lcp::Status::kSolved;
-  r.message.clear();
-  return r;
+  const detail::ConeLcpCheck c = detail::check_cone_lcp(p, r.z);
+  if (c.ok()) {
+    r.status = lcp::Status::kSolved;
+    r.message.clear();
+    return r;
+  }
+  if (res.status == lcp::Status::kNumericalFailure && r.status != lcp::Status::kSolved)
+    res.status = r.status;  // a ray termination says more than a refused residual
+  res.worst_row = static_cast<int>(c.row);
+  res.message += std::string(res.message.empty() ? "" : "; ") + "lemke (" +
+                 std::string(lcp::to_string(r.status, "solved")) + "): " + c.text();
+  return res;
 }
+
+namespace detail {
+
+Eigen::Index cone_slack_count(const MatrixXd& M) {
+  const Eigen::Index n = M.rows();
+  if (M.cols() != n) return 0;
+  Eigen::Index k = 0;
+  for (; k < n; ++k) {  // grow the trailing zero block by row and column i
+    const Eigen::Index i = n - k - 1;
+    if (M(i, i) != 0.0 || (M.row(i).tail(k).array() != 0.0).any() ||
+        (M.col(i).tail(k).array() != 0.0).any())
+      break;
+  }
+  return k;
+}
+
+namespace {
+// x / s with 0 / 0 read as 0, as lcp::scaled_residual's.
+double ratio(double x, double s) { return s > 0.0 ? x / s : 0.0; }
+}  // namespace
+
+std::string ConeLcpCheck::text() const {
+  return lcsim::text(what, ": ", worst, " of its scale (impulses ", impulse_scale, " N s, rates ",
+                     rate_scale, " m/s) > ", kConeLcpTolerance);
+}
+
+ConeLcpCheck check_cone_lcp(const FrictionLcp& p, const VectorXd& z) {
+  ConeLcpCheck c;
+  const Eigen::Index n = p.q.size();
+  if (z.size() != n || p.M.rows() != n || p.M.cols() != n) {
+    c.worst = std::numeric_limits<double>::infinity();
+    c.what = "a solution of the wrong size";
+    return c;
+  }
+  const Eigen::Index nf = cone_slack_count(p.M), na = n - nf;
+  const VectorXd w = p.M * z + p.q;
+  // P: the largest impulse (N s); V: the rates' scale (m/s), the rates
+  // before the impact and what the impulses change, the slack left out.
+  c.impulse_scale = na ? z.head(na).cwiseAbs().maxCoeff() : 0.0;
+  c.rate_scale = na ? p.q.head(na).cwiseAbs().maxCoeff() +
+                          (p.M.topLeftCorner(na, na).cwiseAbs() * z.head(na).cwiseAbs()).maxCoeff()
+                    : 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const bool impulse = i < na;  // an impulse beside a rate, or a slack beside a cone row
+    const double zs = impulse ? c.impulse_scale : c.rate_scale;
+    const double ws = impulse ? c.rate_scale : c.impulse_scale;
+    double r = std::abs(std::min(ratio(z(i), zs), ratio(w(i), ws)));
+    if (std::isnan(r)) r = std::numeric_limits<double>::infinity();
+    if (r <= c.worst) continue;
+    c.worst = r;
+    c.row = i;
+  }
+  if (c.row < 0) return c;
+  const Eigen::Index i = c.row;
+  if (i >= na) {
+    c.cone = i - na;
+    c.what = text("friction cone ", c.cone, ": mu lambda_N - sum beta = ", w(i),
+                  " N s beside the sliding speed xi = ", z(i), " m/s");
+    return c;
+  }
+  for (Eigen::Index f = 0; f < nf; ++f)
+    if (p.M(i, na + f) != 0.0) c.cone = f;  // an edge row of cone f
+  for (Eigen::Index f = 0; c.cone < 0 && f < nf; ++f)
+    if (p.M(na + f, i) > 0.0) c.cone = f;  // the normal row of cone f
+  c.what = text(c.cone >= 0 && p.M(i, na + c.cone) != 0.0 ? "edge" : "normal", " impulse ", z(i),
+                " N s beside the rate ", w(i), " m/s");
+  if (c.cone >= 0) c.what += text(" (friction cone ", c.cone, ")");
+  return c;
+}
+
+}  // namespace detail
 
 namespace {
 
@@ -384,6 +463,21 @@ void set_cone_outcomes(const mech::MechanicalModel& m, const ImpactInput& in, co
   }
 }
 
+// The constraint (row of E) of row i of the cone's LCP (the normals, each
+// contact's edges, each contact's cone row), or -1 when i is none.
+int lcp_row_constraint(const mech::MechanicalModel& m, const IndexSet& closed, const ClosedCone& c,
+                       int i) {
+  const int nj = static_cast<int>(closed.size()), ne = static_cast<int>(c.edges());
+  if (i < 0) return -1;
+  if (i < nj) return closed[static_cast<size_t>(i)];
+  for (size_t f = 0; f < c.index.size(); ++f) {
+    const int e = i - nj - c.first[f];
+    if ((e >= 0 && e < 2 * c.d[f]) || i - nj - ne == static_cast<int>(f))
+      return m.friction[static_cast<size_t>(c.index[f])].contact;
+  }
+  return -1;
+}
+
 // The work of moving surfaces on the body (J): planar contacts' belts.
 double surface_work(const mech::MechanicalModel& m, const ClosedCone& c, const ImpactResult& out) {
   double w = 0.0;
@@ -428,6 +522,10 @@ ImpactResult moreau_friction_cone(const ImpactInput& in, const lcp::Solver& solv
   if (!res.ok()) {
     out.painleve = !alone.empty();
     out.message = out.painleve ? alone + kPainleveTail : detail::friction_lcp_failure(tried, res);
+    if (const int row = lcp_row_constraint(m, in.closed, c, res.worst_row);
+        !out.painleve && row >= 0)
+      out.message +=
+          text(" at contact ", row, " ('", m.constraints[static_cast<size_t>(row)], "')");
     return out;
   }
   const VectorXd lambda_N = res.z.head(nj), beta = res.z.segment(nj, ne);

@@ -178,13 +178,13 @@ struct FrictionLcp {
 FrictionLcp friction_lcp(const MatrixXd& Wg, const VectorXd& rate_N, const VectorXd& rate_T,
                          const std::vector<int>& normal_of, const VectorXd& mu);
 // Solves a friction_lcp: lcp::solve_scaled with `solver` and its fallbacks
-// (accepted at 1e-12, then 1e-10); where that fails, Lemke's and (size <= 12)
-// the enumeration's own z with its entries below rounding (64 eps |z|_inf)
-// set to zero, accepted by the same row-scaled test at 1e-10: at a closed
-// contact with no normal impulse the row 2 mu lambda_N - lambda_R is formed
-// of zeros, and a lambda_R of 1e-33 left by a pivot makes its row-scaled
-// residual 1 although the solution is exact to rounding. `solves` counts the
-// LCP solves, `tried` lists the solvers.
+// (1e-12, then 1e-10), then Lemke's and (size <= 12) the enumeration's z
+// with entries below rounding (64 eps |z|_inf) set to zero (a lambda_R of
+// 1e-33 left by a pivot where the cone row is formed of zeros) by the same
+// row-scaled test; each z kept only when its impulses and rates obey the
+// law to 1e-8 of their units, never relative to the slack xi, which a
+// failing pivot inflates (friction_cone.cpp, check_cone_lcp). `solves`
+// counts the LCP solves, `tried` lists the solvers.
 lcp::Result solve_friction_lcp(const FrictionLcp& p, const lcp::Solver& solver, int* solves,
                                std::string* tried);
 // The impulses (lambda_N, lambda_T) of a solution z of friction_lcp.
@@ -200,8 +200,8 @@ void friction_impulses(const VectorXd& z, int n_normal, const std::vector<int>& 
 FrictionLcp friction_cone_lcp(const MatrixXd& Wb, const VectorXd& rate_N, const VectorXd& rate_D,
                               const std::vector<int>& normal_of, const std::vector<int>& first,
                               const std::vector<int>& d, const VectorXd& mu);
-// Solves a friction_cone_lcp: solve_friction_lcp, then Lemke's z accepted
-// on the natural residual relative to the whole problem (friction_cone.cpp).
+// Solves a friction_cone_lcp: solve_friction_lcp, then Lemke's z, accepted
+// on its impulses and rates, never relative to the slack (friction_cone.cpp).
 lcp::Result solve_friction_cone_lcp(const FrictionLcp& p, const lcp::Solver& solver, int* solves,
                                     std::string* tried);
 

@@ -197,13 +197,16 @@ namespace {
 constexpr double kConeSlack = 1e-9;
 
 // Whether the cone LCP's z keeps each contact's edge impulses in its cone,
-// sum_i beta_i <= mu lambda_N (to kConeSlack). The dense path's last
-// fallback accepts z on a residual relative to |z|_inf, which a diverging
-// sliding-speed multiplier inflates: on a 0.1 kg cube whose URDF gives it
-// 1 kg m^2 (bullet3's cube_small.urdf: its four corners act almost as one
-// point) landing at 0.44 m/s, xi = 5.7e11 let through lambda_N = 0 with
-// sum beta = 0.28 N s, and the step reversed the cube's 1 m/s slide,
-// gaining energy. Such a z is no solution: the sweeps decide instead.
+// sum_i beta_i <= mu lambda_N (to kConeSlack). On a 0.1 kg cube whose URDF
+// gives it 1 kg m^2 (bullet3's cube_small.urdf: its four corners act almost
+// as one point) landing at 0.44 m/s, the cold solve's last fallback once
+// accepted lambda_N = 0 with sum beta = 0.28 N s (a residual relative to
+// |z|_inf, inflated by xi = 5.7e11), and the step reversed the cube's 1 m/s
+// slide, gaining energy. impact::solve_friction_cone_lcp now refuses such a
+// z itself (its acceptance on the impulses and rates; the cube's test
+// passes without this check); the check stays for the warm-started basis
+// (warm(): |w_J| within 1e-12 of a scale that xi inflates alike), which
+// does not go through it. Such a z is no solution: the sweeps decide.
 bool edges_in_cone(const VectorXd& z, long na, const std::vector<int>& normal_of,
                    const std::vector<int>& first, const std::vector<int>& d, const VectorXd& mu) {
   if (mu.size() == 0) return true;
