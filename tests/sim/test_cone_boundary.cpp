@@ -29,7 +29,10 @@
 // on the face, solves it), and the enumeration (17^4 = 83 521 combinations,
 // the first 4096 tried, contact 0 fastest) never reached a slip of contact
 // 3. The test asserts the run completes, that the event is the one slip at
-// t_s with both masses on the expected faces, and the closed form.
+// t_s with both masses on the expected faces, and the closed form. A second
+// test pushes the masses at a vertex of the polygon (two monitors at zero,
+// four modes keeping the force there, one consistent: the edge). Both were
+// refused before with the Vision 60's message.
 //
 // Tolerances. The stick phase is exact to rounding (the springs are at rest
 // length, the masses at rest to 1e-15); t_s is the root of a monitor that
@@ -56,6 +59,7 @@ using Eigen::VectorXd;
 
 constexpr double kG = 9.81, kMu = 0.5, kC0 = 10.0, kKa = 20.0, kK = 20.0;
 constexpr double kTheta = 1.5 * std::numbers::pi / 4;  // 67.5 deg: face 1's normal at d = 4
+constexpr double kEdge1 = std::numbers::pi / 4;        // 45 deg: edge 1 at d = 4
 
 // Coordinates (x_i, y_i, z_i) of mass i at 3i .. 3i + 2.
 int X(int i) { return 3 * i; }
@@ -71,7 +75,8 @@ void add_spring(MatrixXd& K, int i, int j, double k) {
   }
 }
 
-mech::Model four_masses() {
+// Pushed along theta (mass 1) and -theta (mass 3).
+mech::Model four_masses(double theta = kTheta) {
   mech::MechanicalModel m;
   m.M = MatrixXd::Identity(12, 12).sparseView();
   MatrixXd K = MatrixXd::Zero(12, 12);
@@ -101,10 +106,10 @@ mech::Model four_masses() {
   push.values = {0.0, 10.0 * kC0};
   m.inputs.push_back(push);
   VectorXd gain = VectorXd::Zero(12);
-  gain(X(1)) = std::cos(kTheta);
-  gain(Y(1)) = std::sin(kTheta);
-  gain(X(3)) = std::cos(kTheta);
-  gain(Y(3)) = -std::sin(kTheta);
+  gain(X(1)) = std::cos(theta);
+  gain(Y(1)) = std::sin(theta);
+  gain(X(3)) = std::cos(theta);
+  gain(Y(3)) = -std::sin(theta);
   m.force_inputs.push_back({0, gain});
   return mech::model_of(m, "four_masses");
 }
@@ -156,6 +161,62 @@ TEST(ConeBoundary, TwoStickForcesReachingTheirFacesTogetherSlideAsTheClosedForm)
     EXPECT_LE(err, 1e-12) << "t = " << s.t;
   }
   std::printf("[ boundary ] two faces reached together at t_s = %.12f: worst state error %.1e\n",
+              t_s, worst);
+}
+
+// The same masses pushed at a vertex of the polygon: along edge 1 (45 deg)
+// and its mirror, edge 7, so each stick force reaches the vertex between two
+// faces (two monitors at zero) at t_s = mu m g / c0 (the vertices are at
+// mu m g). Four modes keep the force there (stick, slip on either face, on
+// the edge); only the edge slip is consistent: the push grows along the
+// edge, so a face slip would need its face force beyond the face's end.
+// Closed form: on edge 1 the friction is -mu m g D_1, so with the springs
+// (k_a to the stuck mass 0 in x and y, 2k across in y) the coordinates
+// separate: m x'' + k_a x = c0 cos45 tau and m y'' + (k_a + 2k) y = c0 sin45
+// tau, each of the form of the first test; the velocity turns from 45 deg
+// towards 36 deg by the horizon, inside the edge's region (22.5 .. 67.5
+// deg), so there is no other event. Tolerances as in the first test.
+TEST(ConeBoundary, TwoStickForcesReachingAVertexTogetherSlideOnTheEdge) {
+  const double t_s = kMu * kG / kC0, T = t_s + 0.3;
+  const mech::Model model = four_masses(kEdge1);
+  sim::Options o;
+  o.t_end = T;
+  o.dt_out = 0.05;
+  const sim::Trajectory tr = sim::simulate(model, VectorXd::Zero(24), o, "event");
+  ASSERT_EQ(tr.status, Status::kCompleted) << tr.message;
+  ASSERT_EQ(tr.events.size(), 1u) << tr.events.back().note;
+  const sim::Event& ev = tr.events.front();
+  EXPECT_NEAR(ev.t, t_s, 1e-12);
+  // The force on edge 5 for mass 1 (its velocity along edge 1), 3 for mass 3.
+  EXPECT_NE(ev.note.find("'mass1': stick -> slip-edge-5"), std::string::npos) << ev.note;
+  EXPECT_NE(ev.note.find("'mass3': stick -> slip-edge-3"), std::string::npos) << ev.note;
+  EXPECT_EQ(ev.note.find("mass0"), std::string::npos) << ev.note;
+  EXPECT_EQ(ev.note.find("mass2"), std::string::npos) << ev.note;
+  const double push = kC0 * std::cos(kEdge1);  // per axis (cos 45 = sin 45)
+  const auto axis = [&](double k, double tau, double& pos, double& vel) {
+    const double w = std::sqrt(k);
+    pos = push / k * (tau - std::sin(w * tau) / w);
+    vel = push / k * (1.0 - std::cos(w * tau));
+  };
+  double worst = 0.0;
+  for (const sim::Sample& s : tr.samples) {
+    const double tau = std::max(0.0, s.t - t_s);
+    double x, vx, y, vy;
+    axis(kKa, tau, x, vx);
+    axis(kKa + 2 * kK, tau, y, vy);
+    VectorXd want = VectorXd::Zero(24);
+    for (const int i : {1, 3}) {
+      const double sy = i == 1 ? 1.0 : -1.0;
+      want(X(i)) = x;
+      want(Y(i)) = sy * y;
+      want(12 + X(i)) = vx;
+      want(12 + Y(i)) = sy * vy;
+    }
+    const double err = (s.x - want).cwiseAbs().maxCoeff();
+    worst = std::max(worst, err);
+    EXPECT_LE(err, 1e-12) << "t = " << s.t;
+  }
+  std::printf("[ boundary ] two vertices reached together at t_s = %.12f: worst state error %.1e\n",
               t_s, worst);
 }
 
