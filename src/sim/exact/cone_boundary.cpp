@@ -14,7 +14,8 @@
 // The boundary set B is read from the first candidate's phase: the contacts
 // with a friction monitor starting at zero (within its noise) with a nonzero
 // derivative, of either sign (one leaving upwards alone may leave downwards
-// once another contact of B slips). The other contacts keep their first
+// once another contact of B slips), or failing from a value beyond its noise
+// (a force a rounding outside its face). The other contacts keep their first
 // candidate: their monitors start strictly inside, and a change of mode of
 // B that keeps B's forces where they are (below) leaves every force
 // continuous at the event, so theirs stay inside. Each contact of B gets
@@ -79,7 +80,10 @@ std::string EventDriven::select_cone_boundary(double t, const lcs::IndexSet& mod
     const int f = ph.monitors[j].friction;
     if (f < 0) continue;
     auto& z = zero[static_cast<size_t>(f)];
-    z.push_back(st.m0[j] >= 1 ? 1 : 0);
+    // At zero with a nonzero derivative, or failing from a value beyond its
+    // noise (a stick force a rounding outside its face: the state 1e-13 s
+    // after another toe's slip, Vision 60 at d = 8).
+    z.push_back(st.m0[j] >= 1 || (st.m0[j] == 0 && !(st.d0[j] > 0.0)) ? 1 : 0);
     if (z.back()) in_b[static_cast<size_t>(f)] = 1;
   }
   std::vector<size_t> b;
