@@ -21,6 +21,8 @@
 //                         their monitors and forces
 //   cone_modes.cpp        mode selection at an event for models with such
 //                         contacts (candidates checked on the phase's monitors)
+//   cone_boundary.cpp     the same where stick forces reach their polygons
+//                         together (the modes that keep the forces there)
 #pragma once
 
 #include <Eigen/Dense>
