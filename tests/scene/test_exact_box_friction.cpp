@@ -409,8 +409,8 @@ TEST_F(ExactBoxFriction, QuadrupedLandingFasterReleasesTheFootItsSlipUnloads) {
 // were refused there ("none of the first 4096 of ... combinations ... is
 // consistent"); the cone LCP's guess (cone_guess.cpp) is now tried first.
 // Checked: the run reaches t_end, and the laws on every 1 ms sample
-// (expect_laws, as above). Five other variants (mu = 0.8, or d = 4 at 0.3
-// m/s) are still refused there: docs/friction.md, "Not done".
+// (expect_laws, as above). The seven variants the guess did not settle run
+// since cone_boundary.cpp: tests/scene/test_vision60_friction.cpp.
 TEST_F(ExactBoxFriction, Vision60LandingSidewaysTakesTheConeLcpGuess) {
   for (const auto& [d, vx, vy] : {std::tuple{2, 0.3, 0.1}, std::tuple{4, 1.0, 0.0}}) {
     const mech::Model model = scene::load_model(vision60(0.3, d, vx, vy));

@@ -17,7 +17,10 @@
 // selection itself. At an isolated contact exactly one candidate passes:
 // stick needs the stick force strictly inside the polygon, an edge the
 // sliding acceleration strictly inside its region, a face the acceleration
-// along n_j with the face force strictly inside the face.
+// along n_j with the face force strictly inside the face. Above 4096
+// combinations only the first are tried, after the cone LCP's guess
+// (cone_guess.cpp) and, when that fails, the combinations over the contacts
+// whose stick forces reach their polygons (cone_boundary.cpp).
 #include <algorithm>
 #include <cmath>
 #include <lcsim/impact/impact.hpp>
@@ -152,11 +155,20 @@ std::string EventDriven::select_cone_friction(double t, const lcs::IndexSet& und
     const Phase& ph = make_phase(out.mode, fm, undetermined, xa, err);
     if (!err.empty()) {
       if (painleve.empty() && err.find("Painlev") != std::string::npos) painleve = err;
-      continue;
-    }
-    if (consistent(ph, xa, t)) {
+    } else if (consistent(ph, xa, t)) {
       out.friction = fm;
       return "";
+    }
+    // Beyond the bound, before the enumeration goes on: the contacts whose
+    // stick forces reach their polygons (cone_boundary.cpp).
+    if (code == 0 && tries < total) {
+      bool found = false;
+      std::vector<FrictionMode> fb = fm;
+      if (std::string why = select_cone_boundary(t, out.mode, undetermined, cand, xa, fb, found);
+          !why.empty() || found) {
+        out.friction = fb;
+        return why;
+      }
     }
   }
   if (!painleve.empty()) return painleve;

@@ -21,6 +21,8 @@
 //                         their monitors and forces
 //   cone_modes.cpp        mode selection at an event for models with such
 //                         contacts (candidates checked on the phase's monitors)
+//   cone_boundary.cpp     the same where stick forces reach their polygons
+//                         together (the modes that keep the forces there)
 #pragma once
 
 #include <Eigen/Dense>
@@ -423,6 +425,15 @@ class EventDriven {
                                                          std::vector<double>& zero_target) const;
   void project_rows(const lcs::IndexSet& mode, const std::vector<RowVectorXd>& rows,
                     const std::vector<double>& target, VectorXd& xa) const;
+  // Stick forces reaching their polygons at an event (cone_boundary.cpp):
+  // fm (the first candidate, whose phase failed) with the contacts whose
+  // friction monitors start at zero given the modes that keep their forces
+  // where they are; found when exactly one combination of those is
+  // consistent; a message when several are; "" and not found otherwise.
+  std::string select_cone_boundary(double t, const lcs::IndexSet& mode,
+                                   const lcs::IndexSet& undetermined,
+                                   const std::vector<std::vector<FrictionMode>>& cand,
+                                   const VectorXd& xa, std::vector<FrictionMode>& fm, bool& found);
   // The acceleration-level cone LCP's guess moved to the front of each 3-D
   // contact's candidates (cone_guess.cpp).
   void cone_lcp_guess(const lcs::IndexSet& mode, const VectorXd& xa,
