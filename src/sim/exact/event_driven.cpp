@@ -30,7 +30,6 @@
 #include <lcsim/sim/sim.hpp>
 #include <limits>
 #include <sstream>
-#include <unsupported/Eigen/MatrixFunctions>
 
 #include "sim/exact/event_driven_detail.hpp"
 #include "sim/exact/sensitivity.hpp"
@@ -258,12 +257,14 @@ void EventDriven::march_phase(PhaseMarch& pm, double h_first, double h_max, doub
   while (ta < t_stop) {
     const double tb = std::min(ta + h, t_stop);
     VectorXd xa_b;
-    if (!pm.phase.dense_exp()) {
+    // A nilpotent phase's action (nil - 1 products with a vector) costs less
+    // than forming its exponential, even when the step repeats.
+    if (!pm.phase.dense_exp() || pm.phase.nil > 0) {
       xa_b = pm.phase.expv(tb - ta, xa_a);
     } else {
       if (tb - ta != h_phi) {
         h_phi = tb - ta;
-        Phi = (pm.phase.Ab * h_phi).exp();
+        Phi = pm.phase.expm(h_phi);
       }
       xa_b = Phi * xa_a;
     }

@@ -79,6 +79,10 @@ double spectral_radius_bound(const MatrixXd& A);
 // included) has no path of `len` edges: then every product of `len`
 // factors A, formed in any order, is exactly zero (phase.cpp).
 bool no_path_of(const MatrixXd& A, int len);
+// The smallest k such that A's nonzero pattern has no path of k edges (then
+// A^k = 0 exactly, and e^{A tau} is its finite series), or 0 when the
+// pattern has a cycle; at most n. No products (phase.cpp).
+int nilpotency_index(const MatrixXd& A);
 
 struct Monitor {
   RowVectorXd w;            // phi(t) = w x(t)
@@ -135,6 +139,11 @@ struct Phase {
     return use_sparse ? RowVectorXd(w * Ab_sparse) : RowVectorXd(w * Ab);
   }
   double rho = 0.0;  // spectral_radius_bound(Ab)
+  // nilpotency_index(Ab) when Ab is finite, else 0: with nil = k > 0
+  // (a body without springs: x' = v, v' = const, k = 3), e^{Ab tau} is the
+  // finite series sum_{j<k} (Ab tau)^j / j!, exactly (no truncation: each
+  // entry of (Ab tau)^k is a sum of products with a factor exactly zero).
+  int nil = 0;
 
   // Up to this many states e^{Ab tau} is formed (Padé with scaling and
   // squaring, O(n^3)) and, on a sampling grid, reused; above it only its
@@ -150,7 +159,14 @@ struct Phase {
   // ~20 terms); the error is that of the dense exponential's (both are
   // backward stable for ||Ab tau/s|| <= 1; Al-Mohy & Higham 2011 choose s
   // and the degree more finely).
+  // With nil > 0, at any size: the finite series by nil - 1 products with
+  // Ab (exact up to rounding, which is below Pade's with its scaling and
+  // squaring).
   VectorXd expv(double tau, const VectorXd& z) const;  // phase.cpp
+  // e^{Ab tau} formed: the finite series when nil > 0, else Pade with
+  // scaling and squaring (Eigen's MatrixExponential). The one way the
+  // exact method forms a phase's exponential (phase.cpp).
+  MatrixXd expm(double tau) const;
   VectorXd exp_apply(double tau, const VectorXd& x) const {
     return D.cwiseProduct(expv(tau, x.cwiseQuotient(D)));
   }

@@ -69,10 +69,10 @@ VectorXd balancing(const MatrixXd& A) {
 }  // namespace
 
 // The rows that start a path of k edges, for k = 1, 2, ..., until none is
-// left (true) or the set stops shrinking (a cycle: false); up to 64 rows as
-// bit masks (O(n^2) once, O(n) per length), else O(n^2) per length. No
-// products.
-bool no_path_of(const MatrixXd& A, int len) {
+// left (k is the index) or the set stops shrinking (a cycle: 0); the set
+// only shrinks, so at most n + 1 lengths. Up to 64 rows as bit masks (O(n^2)
+// once, O(n) per length), else O(n^2) per length. No products.
+int nilpotency_index(const MatrixXd& A) {
   const Eigen::Index n = A.rows();
   if (n <= 64) {
     std::vector<std::uint64_t> reads(static_cast<size_t>(n), 0);  // row i's nonzero columns
@@ -80,19 +80,18 @@ bool no_path_of(const MatrixXd& A, int len) {
       for (Eigen::Index i = 0; i < n; ++i)
         if (A(i, j) != 0.0) reads[static_cast<size_t>(i)] |= std::uint64_t{1} << j;
     std::uint64_t starts = n == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << n) - 1;
-    for (int k = 1; k <= len; ++k) {
+    for (int k = 1;; ++k) {
       std::uint64_t next = 0;
       for (Eigen::Index i = 0; i < n; ++i)
         if (reads[static_cast<size_t>(i)] & starts) next |= std::uint64_t{1} << i;
-      if (next == 0) return true;
-      if (next == starts) return false;
+      if (next == 0) return k;
+      if (next == starts) return 0;
       starts = next;
     }
-    return false;
   }
   std::vector<char> starts(static_cast<size_t>(n), 1), next(static_cast<size_t>(n));
   Eigen::Index count = n;
-  for (int k = 1; k <= len; ++k) {
+  for (int k = 1;; ++k) {
     Eigen::Index c = 0;
     for (Eigen::Index i = 0; i < n; ++i) {
       char s = 0;
@@ -101,12 +100,16 @@ bool no_path_of(const MatrixXd& A, int len) {
       next[static_cast<size_t>(i)] = s;
       c += s;
     }
-    if (c == 0) return true;
-    if (c == count) return false;
+    if (c == 0) return k;
+    if (c == count) return 0;
     starts.swap(next);
     count = c;
   }
-  return false;
+}
+
+bool no_path_of(const MatrixXd& A, int len) {
+  const int k = nilpotency_index(A);
+  return k != 0 && k <= len;
 }
 
 double spectral_radius_bound(const MatrixXd& A) {
@@ -124,7 +127,8 @@ double spectral_radius_bound(const MatrixXd& A) {
   return std::pow(B.cwiseAbs().rowwise().sum().maxCoeff(), 1.0 / 16.0) * a;
 }
 
-// e^{Ab tau} z in balanced coordinates. Above kDenseExpMax: the Taylor
+// e^{Ab tau} z in balanced coordinates. A nilpotent pattern (nil > 0): the
+// finite series, nil - 1 products with Ab. Above kDenseExpMax: the Taylor
 // series of the action in s = ceil(||Ab tau||_1) substeps, so each substep
 // has ||Ab tau/s||_1 <= 1 and its series, truncated once two consecutive
 // terms are below eps/4 of the partial sum, converges like 1/k! (at most
@@ -132,7 +136,16 @@ double spectral_radius_bound(const MatrixXd& A) {
 // backward stable for ||Ab tau/s|| <= 1; Al-Mohy & Higham 2011 choose s
 // and the degree more finely).
 VectorXd Phase::expv(double tau, const VectorXd& z) const {
-  if (dense_exp()) return (Ab * tau).exp() * z;
+  if (nil > 0) {
+    VectorXd sum = z, term = z;
+    for (int j = 1; j < nil; ++j) {
+      term = times(term);
+      term *= tau / static_cast<double>(j);
+      sum += term;
+    }
+    return sum;
+  }
+  if (dense_exp()) return expm(tau) * z;
   const double a = Ab_norm1 * std::abs(tau);
   const long steps = std::max(1L, static_cast<long>(std::ceil(a)));
   const double dt = tau / static_cast<double>(steps);
@@ -153,6 +166,21 @@ VectorXd Phase::expv(double tau, const VectorXd& z) const {
     y = sum;
   }
   return y;
+}
+
+MatrixXd Phase::expm(double tau) const {
+  if (nil == 0) return (Ab * tau).exp();
+  const Eigen::Index n = Ab.rows();
+  MatrixXd sum = MatrixXd::Identity(n, n);
+  if (nil == 1) return sum;
+  const MatrixXd X = Ab * tau;
+  MatrixXd term = X;
+  sum += term;
+  for (int j = 2; j < nil; ++j) {
+    term = (term * X) / static_cast<double>(j);
+    sum += term;
+  }
+  return sum;
 }
 
 const Phase& EventDriven::make_phase(const lcs::IndexSet& mode,
@@ -262,6 +290,9 @@ Phase EventDriven::build_phase(const lcs::IndexSet& mode, const std::vector<Fric
   ph.D = balancing(ph.Acl);
   ph.Ab = ph.D.cwiseInverse().asDiagonal() * ph.Acl * ph.D.asDiagonal();
   ph.Ab_norm1 = ph.Ab.cwiseAbs().colwise().sum().maxCoeff();
+  // A NaN or infinite entry times an exact zero is no zero: such a phase
+  // keeps Pade's exponential, whose result is not finite either.
+  ph.nil = ph.Ab.allFinite() ? nilpotency_index(ph.Ab) : 0;
   if (!ph.dense_exp()) {
     ph.Ab_sparse = ph.Ab.sparseView();
     ph.use_sparse = ph.Ab_sparse.nonZeros() * 10 <= ph.Ab.size();

@@ -3,7 +3,6 @@
 // StepExp in event_driven_detail.hpp).
 #include <algorithm>
 #include <cmath>
-#include <unsupported/Eigen/MatrixFunctions>
 
 #include "sim/exact/event_driven_detail.hpp"
 
@@ -12,17 +11,21 @@ namespace lcsim::sim::detail {
 namespace {
 
 // Estimated flops of e^{Ab dt} z by Phase::expv: ceil(||Ab dt||_1) substeps
-// of ~20 products with Ab (its non-zeros when sparse).
+// of ~20 products with Ab (its non-zeros when sparse); nil - 1 products for
+// a nilpotent phase's finite series.
 double action_flops(const Phase& ph, double dt) {
   const double n = static_cast<double>(ph.Ab.rows());
   const double nnz = ph.use_sparse ? static_cast<double>(ph.Ab_sparse.nonZeros()) : n * n;
+  if (ph.nil > 0) return std::max(1.0, ph.nil - 1.0) * 2.0 * nnz;
   return std::max(1.0, std::ceil(ph.Ab_norm1 * dt)) * 20.0 * 2.0 * nnz;
 }
 
 // Estimated flops of forming e^{Ab dt} (Padé 13 with scaling and squaring:
-// ~6 products for the approximant, a solve, and one per squaring).
+// ~6 products for the approximant, a solve, and one per squaring; nil - 2
+// products for a nilpotent phase's finite series).
 double dense_flops(const Phase& ph, double dt) {
   const double n = static_cast<double>(ph.Ab.rows());
+  if (ph.nil > 0) return std::max(1.0, ph.nil - 2.0) * 2.0 * n * n * n;
   const double squarings = std::max(0.0, std::ceil(std::log2(std::max(1.0, ph.Ab_norm1 * dt))));
   return (8.0 + squarings) * 2.0 * n * n * n;
 }
@@ -51,7 +54,7 @@ VectorXd GridSampler::step(const VectorXd& z) {
       step.action_flops += action;
       return ph_.expv(dt_, z);
     }
-    step.E = (ph_.Ab * dt_).exp();
+    step.E = ph_.expm(dt_);
   }
   return step.E * z;
 }
