@@ -463,5 +463,47 @@ TEST(EventFriction3d, AfterAnImpactSlidesToRestAsTheClosedForm) {
     }
 }
 
+// The same landing's impulses as the event reports them, along both
+// tangents (Event::friction_impulse2 was left empty by the exact method,
+// found on bullet3's r2d2, docs/contacts.md). Closed forms for the point
+// mass m = 2 landing at w = sqrt(2 g 0.05) while sliding at s0 = 2 m/s
+// along psi: P_N = m w; the law's friction impulse is the projection of
+// -m s onto the polygon mu P_N conv{D_i} (m s0 = 4 is far outside it,
+// mu P_N = 0.59): on an edge's region (psi = 0, and 0.3 pi/d, whose offset
+// from the vertex stays in its normal cone) the vertex -mu P_N D_0; on the
+// bisector psi = pi/(2d) the middle of face 0, -mu cos(pi/(2d)) P_N
+// (cos psi, sin psi). The velocity jump is P / m on each axis (M = m I,
+// t = x, t2 = y). Tolerance 1e-12: the law's LCP on 2d + 2 unknowns of
+// size O(1) rounds at ~1e-15; a missing or misattributed impulse is O(0.1).
+TEST(EventFriction3d, TheLandingsFrictionImpulseIsReportedAlongBothTangents) {
+  const double mass = 2.0, w = std::sqrt(2 * kG * 0.05), pn = mass * w;
+  for (int d : {2, 4})
+    for (double a : {0.0, 0.5, 0.3}) {
+      const double psi = a * kPi / d, s0 = 2.0;
+      const VectorXd x0 =
+          (VectorXd(6) << 0, 0, 0.05, s0 * std::cos(psi), s0 * std::sin(psi), 0).finished();
+      sim::Options o;
+      o.t_end = 0.2;
+      const sim::Trajectory tr = sim::simulate(block(d), x0, o, "event");
+      const std::string at = "d = " + std::to_string(d) + ", psi = " + std::to_string(psi);
+      ASSERT_EQ(tr.status, Status::kCompleted) << at << ": " << tr.message;
+      ASSERT_FALSE(tr.events.empty()) << at;
+      const sim::Event& hit = tr.events.front();
+      ASSERT_EQ(hit.type, EventType::kImpact) << at;
+      ASSERT_EQ(hit.impulse.size(), 1) << at;
+      ASSERT_EQ(hit.friction_impulse.size(), 1) << at;
+      ASSERT_EQ(hit.friction_impulse2.size(), 1) << at;
+      EXPECT_NEAR(hit.impulse(0), pn, 1e-12) << at;
+      const double reach = a == 0.5 ? kMu * std::cos(kPi / (2 * d)) * pn : kMu * pn;
+      const double want1 = a == 0.5 ? -reach * std::cos(psi) : -reach;
+      const double want2 = a == 0.5 ? -reach * std::sin(psi) : 0.0;
+      EXPECT_NEAR(hit.friction_impulse(0), want1, 1e-12) << at;
+      EXPECT_NEAR(hit.friction_impulse2(0), want2, 1e-12) << at;
+      const VectorXd dv = hit.state_after.tail(3) - hit.state_before.tail(3);
+      EXPECT_NEAR(mass * dv(0), hit.friction_impulse(0), 1e-12) << at;
+      EXPECT_NEAR(mass * dv(1), hit.friction_impulse2(0), 1e-12) << at;
+    }
+}
+
 }  // namespace
 }  // namespace lcsim

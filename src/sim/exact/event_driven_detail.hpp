@@ -240,6 +240,9 @@ struct EventResult : OutcomeStartingAs<Status::kNumericalFailure> {
   // Models with friction: the sum of the tangential impulses applied, per
   // entry of mechanical.friction (empty otherwise).
   VectorXd friction_impulse;
+  // Models with 3-D friction (has_cone_): the same along each entry's second
+  // tangent (empty otherwise; Event::friction_impulse2).
+  VectorXd friction_impulse2;
   bool jumped = false;
   bool accumulation = false;
   double t_star = 0.0;  // extrapolated accumulation time (accumulation only)

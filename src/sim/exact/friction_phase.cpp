@@ -265,6 +265,8 @@ void EventDriven::set_friction(Event& e, const EventResult& ev) const {
   e.friction_mode_after = ev.friction;
   e.friction_mode_after.resize(friction_contacts_.size(), FrictionMode::kOpen);
   if (has_cone_) {
+    e.friction_impulse2 =
+        ev.friction_impulse2.size() == nf ? ev.friction_impulse2 : VectorXd::Zero(nf);
     e.friction_facet_after.assign(friction_contacts_.size(), impact::ConeFacet{});
     for (size_t f = 0; f < e.friction_mode_after.size(); ++f)
       e.friction_facet_after[f] = force_facet(e.friction_mode_after[f], cone_d(f));

@@ -114,6 +114,11 @@ bool EventDriven::impact_round(double t, ContactScan& scan, bool limit_taken,
     for (size_t f = 0; f < friction_contacts_.size(); ++f)
       out.friction_impulse(static_cast<Eigen::Index>(f)) +=
           ir.friction_impulse(friction_contacts_[f]);
+  if (ir.friction_impulse2.size() == k_ &&
+      out.friction_impulse2.size() == out.friction_impulse.size())
+    for (size_t f = 0; f < friction_contacts_.size(); ++f)
+      out.friction_impulse2(static_cast<Eigen::Index>(f)) +=
+          ir.friction_impulse2(friction_contacts_[f]);
   out.jumped = true;
   if (sens_) out.rounds.push_back({in.closed, in.v, ir.impulse, in.restitution, ir.outcome});
   record_impacts(in.closed, ir.impulse, t, time_noise);
@@ -207,6 +212,7 @@ EventResult EventDriven::process_mechanical(double t, const VectorXd& xa0,
   EventResult out;
   out.impulse = VectorXd::Zero(k_);
   out.friction_impulse = VectorXd::Zero(static_cast<Eigen::Index>(friction_contacts_.size()));
+  if (has_cone_) out.friction_impulse2 = out.friction_impulse;
   VectorXd xa = xa0;
   ContactScan scan;
   VectorXd time_noise = VectorXd::Zero(k_);  // per approaching contact
