@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <lcsim/core/format.hpp>
 #include <lcsim/io/io.hpp>
 #include <lcsim/scene/scene.hpp>
 #include <random>
@@ -39,6 +40,28 @@ class SceneFiles : public ::testing::Test {
     }
     ADD_FAILURE() << "no error for:\n" << scene;
     return "";
+  }
+  // robots/vision60_drop_scene.yaml (and its URDF) with friction mu, d on
+  // its four toes and a horizontal velocity (vx, vy) m/s: the scene path.
+  std::string vision60_friction(double mu, int d, double vx, double vy) {
+    const std::string robots = std::string(LCSIM_SOURCE_DIR) + "/robots/";
+    write("vision60.urdf", io::read_file(robots + "vision60.urdf"));
+    std::string t = io::read_file(robots + "vision60_drop_scene.yaml");
+    for (int k = 0; k < 4; ++k) {
+      const std::string toe = "toe" + std::to_string(k), entry = "name: " + toe + "}";
+      const size_t at = t.find(entry);
+      EXPECT_NE(at, std::string::npos) << toe;
+      t.replace(
+          at, entry.size(),
+          "name: " + toe + ", friction: " + format_number(mu) + ", d: " + std::to_string(d) + "}");
+    }
+    const std::string init = "  q: {vision60.z: 0.463372545558797}";
+    const size_t at = t.find(init);
+    EXPECT_NE(at, std::string::npos);
+    t.replace(at, init.size(),
+              init + "\n  v: {vision60.x: " + format_number(vx) +
+                  ", vision60.y: " + format_number(vy) + "}");
+    return write("v60.yaml", t);
   }
   std::filesystem::path dir_;
 };

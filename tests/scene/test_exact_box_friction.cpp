@@ -75,27 +75,6 @@ class ExactBoxFriction : public test_support::SceneFiles {
     }
     return write("quad.yaml", t);
   }
-  // robots/vision60_drop_scene.yaml with friction mu, d on its four toes and
-  // a horizontal velocity (vx, vy) m/s.
-  std::string vision60(double mu, int d, double vx, double vy) {
-    write("vision60.urdf", io::read_file(kRobots + "vision60.urdf"));
-    std::string t = io::read_file(kRobots + "vision60_drop_scene.yaml");
-    for (int k = 0; k < 4; ++k) {
-      const std::string toe = "toe" + std::to_string(k), entry = "name: " + toe + "}";
-      const size_t at = t.find(entry);
-      EXPECT_NE(at, std::string::npos) << toe;
-      t.replace(
-          at, entry.size(),
-          "name: " + toe + ", friction: " + format_number(mu) + ", d: " + std::to_string(d) + "}");
-    }
-    const std::string init = "  q: {vision60.z: 0.463372545558797}";
-    const size_t at_init = t.find(init);
-    EXPECT_NE(at_init, std::string::npos);
-    t.replace(at_init, init.size(),
-              init + "\n  v: {vision60.x: " + format_number(vx) +
-                  ", vision60.y: " + format_number(vy) + "}");
-    return write("v60.yaml", t);
-  }
   // robots/box_drop_scene.yaml with friction and a horizontal velocity
   // (vx, vy) in the world (m/s).
   std::string drop(int d, double vx, double vy, double mu = kMu) {
@@ -413,7 +392,7 @@ TEST_F(ExactBoxFriction, QuadrupedLandingFasterReleasesTheFootItsSlipUnloads) {
 // since cone_boundary.cpp: tests/scene/test_vision60_friction.cpp.
 TEST_F(ExactBoxFriction, Vision60LandingSidewaysTakesTheConeLcpGuess) {
   for (const auto& [d, vx, vy] : {std::tuple{2, 0.3, 0.1}, std::tuple{4, 1.0, 0.0}}) {
-    const mech::Model model = scene::load_model(vision60(0.3, d, vx, vy));
+    const mech::Model model = scene::load_model(vision60_friction(0.3, d, vx, vy));
     sim::Options o;
     o.t_end = 0.3;
     o.dt_out = 1e-3;

@@ -40,34 +40,11 @@ namespace {
 
 using Eigen::VectorXd;
 
-const std::string kRobots = std::string(LCSIM_SOURCE_DIR) + "/robots/";
 constexpr double kG = 9.81, kT = 0.3;  // m/s^2, s
 constexpr double kWeight = 26.2 * kG;  // N (the robot's mass, robots/vision60_drop_scene.yaml)
 
-class Vision60Friction : public test_support::SceneFiles {
- protected:
-  // robots/vision60_drop_scene.yaml with friction mu, d on its four toes and
-  // a horizontal velocity (vx, vy) m/s.
-  std::string scene(double mu, int d, double vx, double vy) {
-    write("vision60.urdf", io::read_file(kRobots + "vision60.urdf"));
-    std::string t = io::read_file(kRobots + "vision60_drop_scene.yaml");
-    for (int k = 0; k < 4; ++k) {
-      const std::string toe = "toe" + std::to_string(k), entry = "name: " + toe + "}";
-      const size_t at = t.find(entry);
-      EXPECT_NE(at, std::string::npos) << toe;
-      t.replace(
-          at, entry.size(),
-          "name: " + toe + ", friction: " + format_number(mu) + ", d: " + std::to_string(d) + "}");
-    }
-    const std::string init = "  q: {vision60.z: 0.463372545558797}";
-    const size_t at = t.find(init);
-    EXPECT_NE(at, std::string::npos);
-    t.replace(at, init.size(),
-              init + "\n  v: {vision60.x: " + format_number(vx) +
-                  ", vision60.y: " + format_number(vy) + "}");
-    return write("v60.yaml", t);
-  }
-};
+// The scene: test_support::SceneFiles::vision60_friction.
+class Vision60Friction : public test_support::SceneFiles {};
 
 sim::Trajectory run(const mech::Model& model, const std::string& method, double h, double dt_out) {
   sim::Options o;
@@ -109,7 +86,7 @@ TEST_F(Vision60Friction, LandingsOnceRefusedRunAndMoreauJeanConvergesToThem) {
       {0.3, 4, 0.3, 0.3}, {0.8, 2, 1.0, 0.0}, {0.8, 2, 0.3, 0.3}, {0.8, 2, 0.0, 1.0},
       {0.8, 4, 1.0, 0.0}, {0.8, 4, 0.3, 0.3}, {0.8, 4, 0.0, 1.0}};
   for (const auto& [mu, d, vx, vy] : cases) {
-    const mech::Model model = scene::load_model(scene(mu, d, vx, vy));
+    const mech::Model model = scene::load_model(vision60_friction(mu, d, vx, vy));
     const std::string at = "mu = " + format_number(mu) + ", d = " + std::to_string(d) + ", v = (" +
                            format_number(vx) + ", " + format_number(vy) + ")";
     const sim::Trajectory ex = run(model, "event", 0.0, 1e-3);

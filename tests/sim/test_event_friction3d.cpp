@@ -436,15 +436,22 @@ TEST(EventFriction3d, RandomModelsDissipateAndKeepTheCoulombLaw) {
 // (the cone's impact law at e = 0 removes the normal velocity and takes at
 // most mu P_N off the sliding, on the polygon), then slides to rest as
 // mech::cone_slide from the velocity the impact left, where it left it.
+// The block dropped from 0.05 m while sliding at 2 m/s along psi, run by the
+// exact method to t_end (the two tests below).
+sim::Trajectory sliding_landing(int d, double psi, double t_end) {
+  const double s0 = 2.0;
+  const VectorXd x0 =
+      (VectorXd(6) << 0, 0, 0.05, s0 * std::cos(psi), s0 * std::sin(psi), 0).finished();
+  sim::Options o;
+  o.t_end = t_end;
+  return sim::simulate(block(d), x0, o, "event");
+}
+
 TEST(EventFriction3d, AfterAnImpactSlidesToRestAsTheClosedForm) {
   for (int d : {2, 4})
     for (double a : {0.0, 0.5, 0.3}) {
-      const double psi = a * kPi / d, s0 = 2.0;
-      const VectorXd x0 =
-          (VectorXd(6) << 0, 0, 0.05, s0 * std::cos(psi), s0 * std::sin(psi), 0).finished();
-      sim::Options o;
-      o.t_end = 1.5;
-      const sim::Trajectory tr = sim::simulate(block(d), x0, o, "event");
+      const double psi = a * kPi / d;
+      const sim::Trajectory tr = sliding_landing(d, psi, 1.5);
       const std::string at = "d = " + std::to_string(d) + ", psi = " + std::to_string(psi);
       ASSERT_EQ(tr.status, Status::kCompleted) << at << ": " << tr.message;
       ASSERT_GE(tr.events.size(), 2u) << at;
@@ -479,12 +486,8 @@ TEST(EventFriction3d, TheLandingsFrictionImpulseIsReportedAlongBothTangents) {
   const double mass = 2.0, w = std::sqrt(2 * kG * 0.05), pn = mass * w;
   for (int d : {2, 4})
     for (double a : {0.0, 0.5, 0.3}) {
-      const double psi = a * kPi / d, s0 = 2.0;
-      const VectorXd x0 =
-          (VectorXd(6) << 0, 0, 0.05, s0 * std::cos(psi), s0 * std::sin(psi), 0).finished();
-      sim::Options o;
-      o.t_end = 0.2;
-      const sim::Trajectory tr = sim::simulate(block(d), x0, o, "event");
+      const double psi = a * kPi / d;
+      const sim::Trajectory tr = sliding_landing(d, psi, 0.2);
       const std::string at = "d = " + std::to_string(d) + ", psi = " + std::to_string(psi);
       ASSERT_EQ(tr.status, Status::kCompleted) << at << ": " << tr.message;
       ASSERT_FALSE(tr.events.empty()) << at;
