@@ -147,3 +147,27 @@ def test_bad_3d_friction_is_one_line_and_exit_2_from_simulate(tmp_path, lcsim_bi
         assert r.returncode == 2, (new, r.stderr)
         assert r.stderr.count("\n") == 1, r.stderr
         assert want in r.stderr, r.stderr
+
+
+def test_an_event_reports_the_impacts_second_tangent_impulse():
+    """The exact method's landing event carries the impact law's impulses along both
+    tangents (Event.friction_impulse2 was empty on 3-D contacts, found on bullet3's
+    r2d2): the point dropped 0.05 m while sliding at 3 m/s on the bisector pi/8 (d = 4)
+    gets at its impact the law's impulses at the state before it, to 1e-12 (the same
+    law on the same state; rounding of the event's state at ~1e-15)."""
+    a = math.pi / 8
+    model = lcsim.Model.mechanical(
+        M=np.eye(3), E=np.array([[0.0, 0.0, 1.0]]), g=np.array([0.0]), f=[0, 0, -9.81],
+        constraint_names=["floor"],
+        friction=[{"contact": "floor", "tangents": [[1, 0, 0], [0, 1, 0]], "mu": 0.5,
+                   "d": 4}])
+    x0 = [0, 0, 0.05, 3 * math.cos(a), 3 * math.sin(a), 0]
+    tr = lcsim.simulate(model, x0, t_end=0.2, method="event")
+    assert tr.ok, tr.message
+    hit = tr.events[0]
+    assert hit.type == "impact"
+    law = lcsim.impacts(model, hit.state_before, rules=["inelastic"])["inelastic"]
+    assert len(hit.friction_impulse2) == 1
+    assert abs(hit.friction_impulse2[0] - law.friction_impulse2[0]) < 1e-12
+    assert abs(hit.friction_impulse[0] - law.friction_impulse[0]) < 1e-12
+    assert abs(law.friction_impulse2[0]) > 0.1  # a real second-tangent impulse
