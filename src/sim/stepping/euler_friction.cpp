@@ -290,19 +290,10 @@ class EulerFrictionRun {
   // velocity_scale), and a sliding 3-D contact's facet.
   void label_modes() {
     const double V = std::max(v_free_size_, v_.size() > 0 ? v_.lpNorm<Eigen::Infinity>() : 0.0);
-    for (size_t fi = 0; fi < fmode_.size(); ++fi) {
-      if (fmode_[fi] != FrictionMode::kStick) continue;  // open
-      const mech::FrictionalContact& fc = m_.friction[fi];
-      const double p2 = u_t2_.size() > 0 ? friction_->lambda_T2()(fc.contact) : 0.0;
-      fmode_[fi] = friction_mode_after_step(fc, m_.edges_of(fc), lambda_(fc.contact),
-                                            lambda_T_(fc.contact), p2, v_, V);
-    }
-    for (size_t fi = 0; fi < facet_.size(); ++fi) {
-      const mech::FrictionalContact& fc = m_.friction[fi];
-      facet_[fi] = fmode_[fi] == FrictionMode::kSlip
-                       ? impact::cone_facet(fc.sliding(v_), fc.tangent2.dot(v_), m_.edges_of(fc))
-                       : impact::ConeFacet{};
-    }
+    label_closed_contacts(
+        m_, [this](int c) { return lambda_(c); }, lambda_T_,
+        u_t2_.size() > 0 ? &friction_->lambda_T2() : nullptr, v_, V, fmode_);
+    slip_facets(m_, fmode_, v_, facet_);
   }
 
   void record(double t) {

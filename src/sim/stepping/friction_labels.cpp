@@ -41,7 +41,7 @@ bool strictly_inside_cone(double p1, double p2, double mu_pn, int d) {
 // cone (strictly_inside_cone) or its sliding velocity is zero to the step's
 // rounding band; else slip (on the boundary, sliding above the band): along
 // the sliding velocity's sign for a planar contact, kSlip (its facet from
-// the velocity, facet_after_step) for a 3-D one.
+// the velocity, slip_facets) for a 3-D one.
 // The band is scaled by the model's velocities, not the contact's own: a
 // sticking contact's velocity v+ = v_free + W^-1 G' lambda is the
 // cancellation of terms of the size of the step's velocities (|v_free|, and
@@ -75,6 +75,16 @@ FrictionMode friction_mode_after_step(const mech::FrictionalContact& fc, int d, 
   if (inside || std::max(std::abs(s), std::abs(s2)) <= band) return FrictionMode::kStick;
   if (fc.is_3d()) return FrictionMode::kSlip;
   return s > 0.0 ? FrictionMode::kSlipPositive : FrictionMode::kSlipNegative;
+}
+
+void slip_facets(const mech::MechanicalModel& m, const std::vector<FrictionMode>& mode,
+                 const VectorXd& v, std::vector<impact::ConeFacet>& facet) {
+  for (size_t fi = 0; fi < facet.size(); ++fi) {
+    const mech::FrictionalContact& fc = m.friction[fi];
+    facet[fi] = mode[fi] == FrictionMode::kSlip
+                    ? impact::cone_facet(fc.sliding(v), fc.tangent2.dot(v), m.edges_of(fc))
+                    : impact::ConeFacet{};
+  }
 }
 
 }  // namespace lcsim::sim::detail

@@ -101,15 +101,6 @@ constexpr double kPgsTolerance = 1e-13;  // natural residual <= tol * (1 + ||b||
 constexpr int kPgsMaxSweeps = 5000;
 constexpr int kPivotFallbackMax = 2000;
 
-// The cone facet holding a sliding 3-D contact's friction force after a
-// step with velocity v (Sample::friction_facet): the facet of maximal
-// dissipation for its sliding velocity (impact::cone_facet, as the impact
-// names it).
-impact::ConeFacet facet_after_step(const mech::MechanicalModel& m,
-                                   const mech::FrictionalContact& fc, const VectorXd& v) {
-  return impact::cone_facet(fc.sliding(v), fc.tangent2.dot(v), m.edges_of(fc));
-}
-
 // One Moreau–Jean run: the trajectory it builds, the state (q, v) and what
 // the steps keep from one to the next (active set, impulses, the Delassus
 // matrix, scratch vectors).
@@ -481,9 +472,7 @@ class MjRun {
       // The facets only where a sample is kept (a run that records none, or
       // few, skips the 2d edges' trigonometry per sliding contact and step:
       // a third of a 3-D friction step at 10^4 contacts, bench/README.md).
-      for (size_t fi = 0; fi < facet_.size(); ++fi)
-        facet_[fi] = fmode_[fi] == FrictionMode::kSlip ? facet_after_step(m_, m_.friction[fi], v_)
-                                                       : impact::ConeFacet{};
+      slip_facets(m_, fmode_, v_, facet_);
       s.friction_facet = facet_;
     }
     if (sens_) sens_->fill(s.dx, s.dx_exists);
@@ -496,15 +485,9 @@ class MjRun {
   // between the step and the next one: z_, pos_, lambda_T_ and the second
   // tangents' impulses are the step's, v_ its end velocity.
   void label_modes() {
-    const double V = velocity_scale(v_);
-    for (size_t fi = 0; fi < fmode_.size(); ++fi) {
-      if (fmode_[fi] != FrictionMode::kStick) continue;  // open (closed ones are kStick here)
-      const mech::FrictionalContact& fc = m_.friction[fi];
-      const double p2 = u_t2_.size() > 0 ? friction_->lambda_T2()(fc.contact) : 0.0;
-      fmode_[fi] =
-          friction_mode_after_step(fc, m_.edges_of(fc), z_(pos_[static_cast<size_t>(fc.contact)]),
-                                   lambda_T_(fc.contact), p2, v_, V);
-    }
+    label_closed_contacts(
+        m_, [this](int c) { return z_(pos_[static_cast<size_t>(c)]); }, lambda_T_,
+        u_t2_.size() > 0 ? &friction_->lambda_T2() : nullptr, v_, velocity_scale(v_), fmode_);
   }
 
   const mech::Model& model_;
