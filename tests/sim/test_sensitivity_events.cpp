@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "support/coupled_bar.hpp"
 #include "support/sensitivity_fd.hpp"
 
 namespace lcsim {
@@ -607,32 +608,7 @@ TEST(SensitivityEvents, FrictionImpactBarAgainstFiniteDifferences) {
     double mu, e, T;
   };
   for (const auto& [mu, e, T] : {Case{1.5, 0.0, 0.6}, Case{0.2, 0.0, 0.6}, Case{0.2, 0.5, 0.55}}) {
-    mech::Model m;
-    m.name = "bar";
-    mech::MechanicalModel& b = m.mechanical.emplace();
-    Eigen::SparseMatrix<double> M(3, 3), E(1, 3);
-    M.insert(0, 0) = 1, M.insert(1, 1) = 1, M.insert(2, 2) = 0.1;
-    E.insert(0, 1) = 1, E.insert(0, 2) = -0.5;
-    b.M = M;
-    b.D = Eigen::SparseMatrix<double>(3, 3);
-    b.K = Eigen::SparseMatrix<double>(3, 3);
-    b.E = E;
-    b.f = VectorXd::Zero(3);
-    b.f(1) = -9.81;
-    b.g = VectorXd::Zero(1);
-    b.coordinates = {"x", "y", "theta"};
-    b.constraints = {"corner"};
-    b.restitution = VectorXd::Constant(1, e);
-    mech::FrictionalContact fc;
-    fc.contact = 0;
-    fc.tangent = Eigen::SparseVector<double>(3);
-    fc.tangent.insert(0) = 1;
-    fc.tangent.insert(1) = 0.2;
-    fc.tangent.insert(2) = 0.4;
-    fc.mu = mu;
-    b.friction = {fc};
-    m.initial = VectorXd(6);
-    m.initial << 0, 0.3, 0, 1, 0, 0.4;
+    mech::Model m = test_support::coupled_bar(mu, e);
     m.t_end = T;
     const sim::Trajectory plain = run(m, m.initial, m.t_end);
     ASSERT_TRUE(plain.ok()) << plain.message;

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "support/coupled_bar.hpp"
 #include "support/sensitivity_fd.hpp"
 
 namespace lcsim {
@@ -313,39 +314,6 @@ TEST(SensitivityFrictionParams, RestitutionClosedForms) {
   }
 }
 
-// The bar of tests/sim/test_sensitivity_events.cpp (x, y, theta; M =
-// diag(1, 1, 0.1); gap y - 0.5 theta, tangent x' + 0.2 y' + 0.4 theta':
-// W_NT = -1.8) from (0, 0.3, 0, 1, 0, 0.4).
-mech::Model coupled_bar(double mu, double e) {
-  mech::Model m;
-  m.name = "bar";
-  mech::MechanicalModel& b = m.mechanical.emplace();
-  Eigen::SparseMatrix<double> M(3, 3), E(1, 3);
-  M.insert(0, 0) = 1, M.insert(1, 1) = 1, M.insert(2, 2) = 0.1;
-  E.insert(0, 1) = 1, E.insert(0, 2) = -0.5;
-  b.M = M;
-  b.D = Eigen::SparseMatrix<double>(3, 3);
-  b.K = Eigen::SparseMatrix<double>(3, 3);
-  b.E = E;
-  b.f = VectorXd::Zero(3);
-  b.f(1) = -9.81;
-  b.g = VectorXd::Zero(1);
-  b.coordinates = {"x", "y", "theta"};
-  b.constraints = {"corner"};
-  b.restitution = VectorXd::Constant(1, e);
-  mech::FrictionalContact fc;
-  fc.contact = 0;
-  fc.tangent = Eigen::SparseVector<double>(3);
-  fc.tangent.insert(0) = 1;
-  fc.tangent.insert(1) = 0.2;
-  fc.tangent.insert(2) = 0.4;
-  fc.mu = mu;
-  b.friction = {fc};
-  m.initial = VectorXd(6);
-  m.initial << 0, 0.3, 0, 1, 0, 0.4;
-  return m;
-}
-
 // M[i][j] and e[c] against central differences (tests/support/
 // sensitivity_fd.hpp: x(T) and every event time): the coupled bar landing
 // with mu = 1.5 (stick) and mu = 0.2 (slip), plastic, to 0.6 s, and with mu
@@ -363,7 +331,7 @@ TEST(SensitivityFrictionParams, MassAndRestitutionAgainstFiniteDifferences) {
     double mu, e, T;
   };
   for (const auto& [mu, e, T] : {Bar{1.5, 0.0, 0.6}, Bar{0.2, 0.0, 0.6}, Bar{0.2, 0.5, 0.55}}) {
-    const mech::Model m = coupled_bar(mu, e);
+    const mech::Model m = test_support::coupled_bar(mu, e);
     const sim::Trajectory plain = run(m, T);
     ASSERT_TRUE(plain.ok()) << plain.message;
     const int per = static_cast<int>(6 + plain.events.size());
