@@ -114,8 +114,6 @@ void mass_restitution_impact_columns(const std::vector<SensParam>& params, int n
   }
 }
 
-namespace {}  // namespace
-
 bool Sensitivity::friction_impact_map(double t, const EventResult::ImpactRound& rd, MatrixXd& J,
                                       MatrixXd& dR) {
   const mech::MechanicalModel& m = *model_.mechanical;
