@@ -83,15 +83,20 @@ struct Evaluator {
   // is no error of the model).
   void contact_errors(const VectorXd& q, Errors& e) const {
     constexpr double kRounding = 16.0 * std::numeric_limits<double>::epsilon();
+    const VectorXd dq = q - q0;
     for (std::size_t k = 0; k < scene.contacts.size(); ++k) {
       const ContactFrame& c = scene.contacts[k];
       const ContactProbe at = probe_contact(dyn, c, start.planes[k], q);
       const double moved = (at.seen - start.seen[k]).norm();
-      const double linear = c.gap + c.normal_row.dot(q - q0);
+      const double linear = c.gap + c.normal_row.dot(dq);
       const double off = std::abs(at.gap - linear);
       const double size = at.seen.norm() + start.seen[k].norm() + std::abs(at.gap) +
                           std::abs(c.gap) + std::abs(linear);
-      if (off <= kRounding * size || off < std::min(std::abs(at.gap), std::abs(linear))) continue;
+      // A point back where it started (moved = 0) has no relative error, as
+      // in the contact ranges; the ratio would be infinite.
+      if (!(moved > 0.0) || off <= kRounding * size ||
+          off < std::min(std::abs(at.gap), std::abs(linear)))
+        continue;
       if (off / moved > e.contact) e.contact = off / moved, e.worst_contact = k;
     }
   }

@@ -30,9 +30,9 @@ using Eigen::VectorXd;
 //                relative to the contact point's displacement (the measure of
 //                the contact ranges below), counted where the difference could
 //                decide whether the contact is open: |phi - gap| >= min(|phi|,
-//                |gap|) (a rolling wheel's rim point the linear model keeps at
-//                the bottom, a foot swinging near the floor), not for a point
-//                far from its plane in both models
+//                |gap|), for a point that moved (a rolling wheel's rim point
+//                the linear model keeps at the bottom, a foot swinging near
+//                the floor), not for a point far from its plane in both models
 //   error        e(q) = max(e_M(q), e_F(q), e_C(q))
 // For a pendulum about its hanging equilibrium, e_F = |theta - sin theta| / |theta| ~ theta^2/6.
 struct LinearisationCheck {
